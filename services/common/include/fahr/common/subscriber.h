@@ -1,0 +1,98 @@
+// A typed reader. Every sample lands in a LatestSample triple buffer (the
+// newest, for loops that poll without blocking or allocating) and, if set,
+// in a handler called on the vendor thread (for consumers that need every
+// sample: loggers, lockstep inputs).
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+
+#include "fahr/common/clock.h"
+#include "fahr/common/latest_sample.h"
+#include "fahr/common/participant.h"
+#include "fahr/common/topics.h"
+
+namespace fahr::common {
+
+template <class T>
+class Subscriber final : private detail::SampleSink {
+ public:
+  using Handler = std::function<void(const T&, const SampleInfo&)>;
+
+  // `handler`, if given, sees every sample on the vendor thread; it must be
+  // quick and must not call back into this subscriber.
+  explicit Subscriber(Participant& participant, QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole),
+                      std::string_view topic_name = TopicTraits<T>::kName, Handler handler = {})
+      : handler_(std::move(handler)) {
+    detail::EndpointSpec spec{&detail::type_support<T>(), std::string(topic_name), qos};
+    reader_ = participant.backend().create_reader(spec, this);
+  }
+  ~Subscriber() override { reader_.reset(); }  // stop deliveries before members go
+  Subscriber(const Subscriber&) = delete;
+  Subscriber& operator=(const Subscriber&) = delete;
+
+  // Consumer side (one thread): true if a newer sample arrived since the
+  // last fetch; newest()/newest_info() then refer to it. Wait-free.
+  bool fetch_newest() { return latest_.fetch(); }
+  bool has_sample() const { return latest_.has_value(); }
+  const T& newest() const { return latest_.value(); }
+  const SampleInfo& newest_info() const { return latest_.info(); }
+
+  // Blocks until a sample beyond `seen` samples has arrived or the timeout
+  // passes; returns the number received so far. For start-up, lockstep and
+  // event-driven loops (it locks): a 1 kHz tick polls fetch_newest() instead.
+  std::uint64_t wait_for_samples(std::uint64_t seen, std::chrono::nanoseconds timeout) {
+    std::unique_lock lock(wait_mutex_);
+    wait_cv_.wait_for(lock, timeout, [&] { return latest_.published() > seen; });
+    return latest_.published();
+  }
+  std::uint64_t received() const { return latest_.published(); }
+  std::uint64_t missed() const { return missed_.load(std::memory_order_relaxed); }
+  int matched_writers() const { return reader_->matched_writers(); }
+
+ private:
+  void deliver(const void* sample, std::int64_t source_time_ns) override {
+    const T& typed = *static_cast<const T*>(sample);
+    const auto& header = typed.header();
+    SampleInfo info;
+    info.seq = header.seq();
+    info.writer_id = header.writer_id();
+    info.source_time_ns = source_time_ns;
+    info.receive_time_ns = wall_now_ns();
+    {
+      // Sequence gaps per writer: tracks the most recent writer only, which
+      // is exact for the single-writer topics fahr has.
+      std::lock_guard lock(gap_mutex_);
+      if (info.writer_id == last_writer_ && info.seq > last_seq_ + 1) {
+        info.missed_before = info.seq - last_seq_ - 1;
+        missed_.fetch_add(info.missed_before, std::memory_order_relaxed);
+      }
+      last_writer_ = info.writer_id;
+      last_seq_ = info.seq;
+    }
+    if (handler_) handler_(typed, info);
+    latest_.publish(typed, info);
+    {
+      std::lock_guard lock(wait_mutex_);
+    }
+    wait_cv_.notify_all();
+  }
+
+  Handler handler_;
+  LatestSample<T> latest_;
+  std::mutex gap_mutex_;
+  std::uint32_t last_writer_ = 0;
+  std::uint64_t last_seq_ = 0;
+  std::atomic<std::uint64_t> missed_{0};
+  std::mutex wait_mutex_;
+  std::condition_variable wait_cv_;
+  std::unique_ptr<detail::ReaderBackend> reader_;
+};
+
+}  // namespace fahr::common

@@ -1,0 +1,266 @@
+// Fast DDS 2.9 backend: the fastddsgen TopicDataTypes go straight to the
+// vendor; listeners turn its statuses into TransportEvents.
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <atomic>
+#include <cstdlib>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+
+#include "backends.h"
+#include "fahr/common/clock.h"
+#include "fahr/common/config_error.h"
+
+namespace fahr::common::detail {
+namespace {
+
+namespace dds = eprosima::fastdds::dds;
+using eprosima::fastrtps::Duration_t;
+
+// Samples larger than this get a dynamically sized history instead of one
+// preallocated at the type's bound (a DeformationState's bound is 1.7 MB).
+constexpr std::uint32_t kPreallocateLimitBytes = 64 * 1024;
+
+Duration_t to_duration(std::chrono::nanoseconds d) {
+  const auto ns = d.count();
+  return Duration_t(static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000));
+}
+
+template <class Qos>
+void apply_profile(const QosProfile& profile, std::uint32_t max_sample_bytes, Qos& qos) {
+  qos.reliability().kind = profile.reliability == Reliability::kReliable ? dds::RELIABLE_RELIABILITY_QOS
+                                                                          : dds::BEST_EFFORT_RELIABILITY_QOS;
+  qos.durability().kind = profile.durability == Durability::kTransientLocal ? dds::TRANSIENT_LOCAL_DURABILITY_QOS
+                                                                             : dds::VOLATILE_DURABILITY_QOS;
+  if (profile.history_depth == 0) {
+    qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  } else {
+    qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+    qos.history().depth = profile.history_depth;
+  }
+  if (profile.deadline.count() > 0) qos.deadline().period = to_duration(profile.deadline);
+  if (profile.liveliness_lease.count() > 0) {
+    qos.liveliness().kind = dds::MANUAL_BY_TOPIC_LIVELINESS_QOS;
+    qos.liveliness().lease_duration = to_duration(profile.liveliness_lease);
+    qos.liveliness().announcement_period = to_duration(profile.liveliness_lease / 3);
+  }
+  if (profile.lifespan.count() > 0) qos.lifespan().duration = to_duration(profile.lifespan);
+  if (max_sample_bytes > kPreallocateLimitBytes) {
+    qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  }
+}
+
+TransportEvent make_event(EventKind kind, std::string_view topic, std::int32_t total, std::int32_t change) {
+  TransportEvent event;
+  event.time_ns = wall_now_ns();
+  event.kind = kind;
+  set_event_topic(event, topic);
+  event.total_count = total;
+  event.total_count_change = change;
+  return event;
+}
+
+class FastWriter final : public WriterBackend, private dds::DataWriterListener {
+ public:
+  FastWriter(dds::Publisher& publisher, dds::Topic& topic, const QosProfile& profile, std::uint32_t max_bytes,
+             EventLog& events)
+      : publisher_(publisher), topic_name_(topic.get_name()), events_(events) {
+    dds::DataWriterQos qos = publisher.get_default_datawriter_qos();
+    apply_profile(profile, max_bytes, qos);
+    writer_ = publisher.create_datawriter(&topic, qos, this, dds::StatusMask::all());
+    if (writer_ == nullptr) throw std::runtime_error("Fast DDS refused a writer on " + topic_name_);
+  }
+  ~FastWriter() override {
+    writer_->set_listener(nullptr);
+    publisher_.delete_datawriter(writer_);
+  }
+
+  bool write(const void* sample, std::int64_t source_time_ns) override {
+    const eprosima::fastrtps::Time_t stamp(static_cast<std::int32_t>(source_time_ns / 1'000'000'000),
+                                           static_cast<std::uint32_t>(source_time_ns % 1'000'000'000));
+    return writer_->write_w_timestamp(const_cast<void*>(sample), dds::HANDLE_NIL, stamp) == ReturnCode_t::RETCODE_OK;
+  }
+  void assert_liveliness() override { writer_->assert_liveliness(); }
+  int matched_readers() const override { return matched_.load(); }
+
+ private:
+  void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& s) override {
+    matched_.store(s.current_count);
+    auto event = make_event(EventKind::kPublicationMatched, topic_name_, s.total_count, s.current_count_change);
+    event.current_count = s.current_count;
+    events_.record(event);
+  }
+  void on_offered_deadline_missed(dds::DataWriter*, const dds::OfferedDeadlineMissedStatus& s) override {
+    events_.record(make_event(EventKind::kOfferedDeadlineMissed, topic_name_, s.total_count, s.total_count_change));
+  }
+  void on_offered_incompatible_qos(dds::DataWriter*, const dds::OfferedIncompatibleQosStatus& s) override {
+    events_.record(make_event(EventKind::kOfferedIncompatibleQos, topic_name_, s.total_count, s.total_count_change));
+  }
+  void on_liveliness_lost(dds::DataWriter*, const dds::LivelinessLostStatus& s) override {
+    events_.record(make_event(EventKind::kLivelinessLost, topic_name_, s.total_count, s.total_count_change));
+  }
+
+  dds::Publisher& publisher_;
+  std::string topic_name_;
+  EventLog& events_;
+  dds::DataWriter* writer_ = nullptr;
+  std::atomic<int> matched_{0};
+};
+
+class FastReader final : public ReaderBackend, private dds::DataReaderListener {
+ public:
+  FastReader(dds::Subscriber& subscriber, dds::Topic& topic, const TypeSupport& type, const QosProfile& profile,
+             std::uint32_t max_bytes, SampleSink* sink, EventLog& events)
+      : subscriber_(subscriber), topic_name_(topic.get_name()), type_(type), sink_(sink), events_(events),
+        scratch_(type.new_sample()) {
+    dds::DataReaderQos qos = subscriber.get_default_datareader_qos();
+    apply_profile(profile, max_bytes, qos);
+    reader_ = subscriber.create_datareader(&topic, qos, this, dds::StatusMask::all());
+    if (reader_ == nullptr) throw std::runtime_error("Fast DDS refused a reader on " + topic_name_);
+  }
+  ~FastReader() override {
+    reader_->set_listener(nullptr);
+    subscriber_.delete_datareader(reader_);
+    type_.delete_sample(scratch_);
+  }
+  int matched_writers() const override { return matched_.load(); }
+
+ private:
+  void on_data_available(dds::DataReader* reader) override {
+    dds::SampleInfo info;
+    while (reader->take_next_sample(scratch_, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data) sink_->deliver(scratch_, info.source_timestamp.to_ns());
+    }
+  }
+  void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& s) override {
+    matched_.store(s.current_count);
+    auto event = make_event(EventKind::kSubscriptionMatched, topic_name_, s.total_count, s.current_count_change);
+    event.current_count = s.current_count;
+    events_.record(event);
+  }
+  void on_requested_deadline_missed(dds::DataReader*, const dds::RequestedDeadlineMissedStatus& s) override {
+    events_.record(make_event(EventKind::kRequestedDeadlineMissed, topic_name_, s.total_count, s.total_count_change));
+  }
+  void on_liveliness_changed(dds::DataReader*, const dds::LivelinessChangedStatus& s) override {
+    auto event = make_event(EventKind::kLivelinessChanged, topic_name_, s.alive_count + s.not_alive_count, 1);
+    event.current_count = s.alive_count;
+    event.not_alive_count = s.not_alive_count;
+    events_.record(event);
+  }
+  void on_sample_rejected(dds::DataReader*, const dds::SampleRejectedStatus& s) override {
+    events_.record(make_event(EventKind::kSampleRejected, topic_name_, s.total_count, s.total_count_change));
+  }
+  void on_requested_incompatible_qos(dds::DataReader*, const dds::RequestedIncompatibleQosStatus& s) override {
+    events_.record(make_event(EventKind::kRequestedIncompatibleQos, topic_name_, s.total_count, s.total_count_change));
+  }
+  void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& s) override {
+    events_.record(make_event(EventKind::kSampleLost, topic_name_, s.total_count, s.total_count_change));
+  }
+
+  dds::Subscriber& subscriber_;
+  std::string topic_name_;
+  const TypeSupport& type_;
+  SampleSink* sink_;
+  EventLog& events_;
+  void* scratch_;
+  dds::DataReader* reader_ = nullptr;
+  std::atomic<int> matched_{0};
+};
+
+class FastParticipant final : public ParticipantBackend {
+ public:
+  FastParticipant(const TransportConfig& config, EventLog& events) : events_(events) {
+    auto* factory = dds::DomainParticipantFactory::get_instance();
+    std::string profile = config.profile_file;
+    if (profile.empty()) {
+      const char* env = std::getenv("FASTRTPS_DEFAULT_PROFILES_FILE");
+      if (env != nullptr && *env != '\0') {
+        profile = env;
+        TransportConfig check = config;
+        check.profile_file = profile;
+        validate(check);
+      }
+    }
+    if (!profile.empty() && factory->load_XML_profiles_file(profile) != ReturnCode_t::RETCODE_OK) {
+      throw ConfigError("DDS profile '" + profile + "': Fast DDS could not parse it (malformed XML profile)");
+    }
+    // The factory's default QoS carries an XML default profile, if any.
+    dds::DomainParticipantQos qos = factory->get_default_participant_qos();
+    qos.name(config.participant_name);
+    participant_ = factory->create_participant(config.domain_id, qos);
+    if (participant_ == nullptr) {
+      throw std::runtime_error("Fast DDS could not create a participant in domain " +
+                               std::to_string(config.domain_id));
+    }
+    dds::PublisherQos pub_qos = participant_->get_default_publisher_qos();
+    dds::SubscriberQos sub_qos = participant_->get_default_subscriber_qos();
+    if (!config.partition.empty()) {
+      pub_qos.partition().push_back(config.partition.c_str());
+      sub_qos.partition().push_back(config.partition.c_str());
+    }
+    publisher_ = participant_->create_publisher(pub_qos);
+    subscriber_ = participant_->create_subscriber(sub_qos);
+  }
+
+  ~FastParticipant() override {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+
+  std::unique_ptr<WriterBackend> create_writer(const EndpointSpec& spec) override {
+    auto [topic, max_bytes] = topic_for(spec);
+    return std::make_unique<FastWriter>(*publisher_, *topic, spec.qos, max_bytes, events_);
+  }
+
+  std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec, SampleSink* sink) override {
+    auto [topic, max_bytes] = topic_for(spec);
+    return std::make_unique<FastReader>(*subscriber_, *topic, *spec.type, spec.qos, max_bytes, sink, events_);
+  }
+
+ private:
+  std::pair<dds::Topic*, std::uint32_t> topic_for(const EndpointSpec& spec) {
+    std::lock_guard lock(mutex_);
+    auto type_it = types_.find(spec.type->type_name);
+    if (type_it == types_.end()) {
+      dds::TypeSupport support(static_cast<dds::TopicDataType*>(spec.type->make_fast_type()));
+      if (support.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+        throw std::runtime_error(std::string("Fast DDS refused type ") + spec.type->type_name);
+      }
+      type_it = types_.emplace(spec.type->type_name, support).first;
+    }
+    auto topic_it = topics_.find(spec.topic_name);
+    if (topic_it == topics_.end()) {
+      dds::Topic* topic = participant_->create_topic(spec.topic_name, spec.type->type_name, dds::TOPIC_QOS_DEFAULT);
+      if (topic == nullptr) throw std::runtime_error("Fast DDS refused topic " + spec.topic_name);
+      topic_it = topics_.emplace(spec.topic_name, topic).first;
+    }
+    return {topic_it->second, type_it->second->m_typeSize};
+  }
+
+  EventLog& events_;
+  dds::DomainParticipant* participant_ = nullptr;
+  dds::Publisher* publisher_ = nullptr;
+  dds::Subscriber* subscriber_ = nullptr;
+  std::mutex mutex_;
+  std::map<std::string, dds::TypeSupport> types_;
+  std::map<std::string, dds::Topic*> topics_;
+};
+
+}  // namespace
+
+std::unique_ptr<ParticipantBackend> make_fast_backend(const TransportConfig& config, EventLog& events) {
+  return std::make_unique<FastParticipant>(config, events);
+}
+
+}  // namespace fahr::common::detail

@@ -1,0 +1,39 @@
+// Participant: validation, identity and the choice of backend.
+#include "fahr/common/participant.h"
+
+#include <random>
+
+#include "backends.h"
+
+namespace fahr::common {
+
+namespace detail {
+void set_event_topic(TransportEvent& event, std::string_view topic) {
+  const std::size_t n = std::min(topic.size(), event.topic.size() - 1);
+  std::copy_n(topic.data(), n, event.topic.data());
+  event.topic[n] = '\0';
+}
+}  // namespace detail
+
+namespace {
+std::uint32_t random_writer_id() {
+  std::random_device device;
+  std::uint32_t id = 0;
+  while (id == 0) id = device();  // 0 means "no writer" in SampleInfo
+  return id;
+}
+}  // namespace
+
+Participant::Participant(const TransportConfig& config)
+    : config_(config), writer_id_(random_writer_id()), events_(std::make_unique<EventLog>()) {
+  validate(config_);
+  switch (config_.vendor) {
+    case Vendor::kFastDds: backend_ = detail::make_fast_backend(config_, *events_); break;
+    case Vendor::kCyclone: backend_ = detail::make_cyclone_backend(config_, *events_); break;
+    case Vendor::kInProcess: backend_ = detail::make_inprocess_backend(config_, *events_); break;
+  }
+}
+
+Participant::~Participant() = default;
+
+}  // namespace fahr::common

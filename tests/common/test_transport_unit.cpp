@@ -1,0 +1,158 @@
+// Transport unit tests on the in-process bus (and vendor configuration
+// errors): the API behaves the same whichever vendor carries it.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "fahr/common/config_error.h"
+#include "fahr/common/publisher.h"
+#include "fahr/common/subscriber.h"
+#include "sample_factory.h"
+
+namespace fahr::test {
+namespace {
+
+using common::ConfigError;
+using common::Participant;
+using common::TransportConfig;
+using common::Vendor;
+
+TransportConfig in_process(std::uint32_t domain) {
+  TransportConfig config;
+  config.vendor = Vendor::kInProcess;
+  config.domain_id = domain;
+  return config;
+}
+
+template <class T>
+void expect_in_process_round_trip(std::size_t n) {
+  Participant a(in_process(1));
+  Participant b(in_process(1));
+  common::Subscriber<T> sub(b);
+  common::Publisher<T> pub(a);
+  T sent;
+  fill(sent, 7, n);
+  ASSERT_TRUE(pub.write(sent));
+  ASSERT_TRUE(sub.fetch_newest());
+  EXPECT_EQ(cdr_bytes(sub.newest()), cdr_bytes(sent));
+  EXPECT_EQ(sub.newest_info().seq, 1U);
+  EXPECT_EQ(sub.newest_info().writer_id, a.writer_id());
+}
+
+TEST(InProcess, EveryTypeRoundTrips) {
+  expect_in_process_round_trip<msg::DevicePose>(0);
+  expect_in_process_round_trip<msg::ForceCommand>(0);
+  expect_in_process_round_trip<msg::ContactSet>(64);
+  expect_in_process_round_trip<msg::DeformationState>(1000);
+  expect_in_process_round_trip<msg::SceneDescription>(100);
+  expect_in_process_round_trip<msg::ServiceStatus>(8);
+  expect_in_process_round_trip<msg::ServiceEvents>(8);
+  expect_in_process_round_trip<msg::SimClock>(0);
+  expect_in_process_round_trip<msg::StepAck>(0);
+}
+
+TEST(InProcess, NewestWinsAndSequenceGapsAreCounted) {
+  Participant p(in_process(2));
+  common::Subscriber<msg::DevicePose> sub(p);
+  common::Publisher<msg::DevicePose> pub(p);
+  msg::DevicePose pose;
+  for (std::uint64_t i = 1; i <= 5; ++i) {
+    pose.servo_tick(i);
+    pub.write(pose);
+  }
+  ASSERT_TRUE(sub.fetch_newest());
+  EXPECT_EQ(sub.newest().servo_tick(), 5U);
+  EXPECT_EQ(sub.newest_info().seq, 5U);
+  EXPECT_FALSE(sub.fetch_newest()) << "nothing newer arrived";
+  EXPECT_EQ(sub.missed(), 0U);
+  EXPECT_EQ(sub.received(), 5U);
+}
+
+TEST(InProcess, TransientLocalReachesLateReaders) {
+  Participant p(in_process(3));
+  common::Publisher<msg::SceneDescription> pub(p);
+  msg::SceneDescription scene;
+  scene.body_id(9);
+  pub.write(scene);
+  common::Subscriber<msg::SceneDescription> late(p);
+  ASSERT_TRUE(late.fetch_newest());
+  EXPECT_EQ(late.newest().body_id(), 9U);
+}
+
+TEST(InProcess, BestEffortWriterDoesNotServeReliableReader) {
+  Participant p(in_process(4));
+  common::QosProfile reliable = common::QosProfile::for_role(common::TopicRole::kStateStream);
+  common::Subscriber<msg::DevicePose> sub(p, reliable);
+  common::Publisher<msg::DevicePose> pub(p);  // servo stream: best effort
+  EXPECT_EQ(pub.matched_readers(), 0);
+  EXPECT_EQ(p.events().count(common::EventKind::kRequestedIncompatibleQos), 1);
+  msg::DevicePose pose;
+  pub.write(pose);
+  EXPECT_FALSE(sub.fetch_newest());
+}
+
+TEST(InProcess, PartitionsSeparateStations) {
+  TransportConfig a = in_process(5);
+  a.partition = "station-a";
+  TransportConfig b = in_process(5);
+  b.partition = "station-b";
+  Participant pa(a);
+  Participant pb(b);
+  common::Subscriber<msg::DevicePose> sub(pb);
+  common::Publisher<msg::DevicePose> pub(pa);
+  msg::DevicePose pose;
+  pub.write(pose);
+  EXPECT_FALSE(sub.fetch_newest());
+}
+
+TEST(Config, UnknownVendorListsTheValidOnes) {
+  try {
+    common::resolve_vendor("opensplice");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("opensplice"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("fastdds, cyclonedds, inprocess"), std::string::npos);
+  }
+  setenv("FAHR_DDS", "zenoh", 1);
+  EXPECT_THROW(common::resolve_vendor(""), ConfigError);
+  setenv("FAHR_DDS", "cyclonedds", 1);
+  EXPECT_EQ(common::resolve_vendor(""), Vendor::kCyclone);
+  EXPECT_EQ(common::resolve_vendor("fastdds"), Vendor::kFastDds) << "the flag wins";
+  unsetenv("FAHR_DDS");
+}
+
+TEST(Config, DomainOutOfRangeIsRefused) {
+  TransportConfig config = in_process(231);
+  EXPECT_THROW(Participant p(config), ConfigError);
+  EXPECT_THROW(common::transport_config_from("inprocess", "999", "", "x"), ConfigError);
+  EXPECT_THROW(common::transport_config_from("inprocess", "seven", "", "x"), ConfigError);
+}
+
+TEST(Config, MissingAndMalformedProfilesAreRefused) {
+  TransportConfig config;
+  config.vendor = Vendor::kFastDds;
+  config.profile_file = "/nonexistent/profile.xml";
+  EXPECT_THROW(Participant p(config), ConfigError);
+
+  const auto dir = std::filesystem::temp_directory_path() / "fahr_profiles";
+  std::filesystem::create_directories(dir);
+  const auto bad_fast = (dir / "bad_fast.xml").string();
+  std::ofstream(bad_fast) << "<profiles><participant profile_name=\"x\"><rtps><unclosed></profiles>";
+  config.profile_file = bad_fast;
+  EXPECT_THROW(Participant p(config), ConfigError);
+
+  const auto bad_cyclone = (dir / "bad_cyclone.xml").string();
+  std::ofstream(bad_cyclone) << "<CycloneDDS><Domain><General><NoSuchSetting>1</NoSuchSetting></General></Domain></CycloneDDS>";
+  config.vendor = Vendor::kCyclone;
+  config.domain_id = 17;
+  config.profile_file = bad_cyclone;
+  EXPECT_THROW(Participant p(config), ConfigError);
+
+  config.profile_file = bad_fast;  // a Fast DDS file given to Cyclone
+  EXPECT_THROW(Participant p(config), ConfigError);
+}
+
+}  // namespace
+}  // namespace fahr::test

@@ -1,0 +1,98 @@
+// The other process of the multi-process transport tests.
+//   transport_peer echo   <vendor> <domain> <seconds>
+//       republishes every sample of every topic type from fahr/test/ping/<T>
+//       to fahr/test/pong/<T>, unchanged but for the writer's header stamp.
+//   transport_peer writer <vendor> <domain> <period_ms> <deadline_ms> <lease_ms>
+//                         <total_ms> <silent_at_ms> <silent_ms>
+//       writes DevicePose on fahr/test/qos every period, silent for a while.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fahr/common/participant.h"
+#include "fahr/common/publisher.h"
+#include "fahr/common/subscriber.h"
+#include "test_topics.h"
+
+using namespace fahr;
+using namespace fahr::common;
+using std::chrono::milliseconds;
+
+namespace {
+
+struct EchoBase {
+  virtual ~EchoBase() = default;
+};
+
+template <class T>
+struct Echo final : EchoBase {
+  explicit Echo(Participant& p)
+      : publisher(p, test::test_qos(), test::pong_topic<T>()),
+        subscriber(p, test::test_qos(), test::ping_topic<T>(), [this](const T& sample, const SampleInfo&) {
+          T copy = sample;
+          publisher.write(copy);
+        }) {}
+  Publisher<T> publisher;
+  Subscriber<T> subscriber;
+};
+
+int run_echo(Participant& participant, int seconds) {
+  std::vector<std::unique_ptr<EchoBase>> echoes;
+  echoes.push_back(std::make_unique<Echo<msg::DevicePose>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::ForceCommand>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::ContactSet>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::DeformationState>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::SceneDescription>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::ServiceStatus>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::ServiceEvents>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::SimClock>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::StepAck>>(participant));
+  std::this_thread::sleep_for(std::chrono::seconds(seconds));
+  return 0;
+}
+
+int run_writer(Participant& participant, char** argv) {
+  const int period_ms = std::atoi(argv[0]);
+  const int deadline_ms = std::atoi(argv[1]);
+  const int lease_ms = std::atoi(argv[2]);
+  const int total_ms = std::atoi(argv[3]);
+  const int silent_at_ms = std::atoi(argv[4]);
+  const int silent_ms = std::atoi(argv[5]);
+  Publisher<msg::DevicePose> publisher(participant, test::qos_under_test(deadline_ms, lease_ms), test::kQosTopic);
+  msg::DevicePose pose;
+  const auto start = std::chrono::steady_clock::now();
+  auto next = start;
+  for (int tick = 0;; ++tick) {
+    next += milliseconds(period_ms);
+    std::this_thread::sleep_until(next);
+    const auto elapsed = std::chrono::duration_cast<milliseconds>(std::chrono::steady_clock::now() - start).count();
+    if (elapsed >= total_ms) break;
+    if (elapsed >= silent_at_ms && elapsed < silent_at_ms + silent_ms) continue;
+    pose.servo_tick(static_cast<std::uint64_t>(tick));
+    publisher.write(pose);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 5) {
+    std::fprintf(stderr, "usage: transport_peer echo|writer <vendor> <domain> ...\n");
+    return 2;
+  }
+  const std::string mode = argv[1];
+  TransportConfig config;
+  config.vendor = resolve_vendor(argv[2]);
+  config.domain_id = static_cast<std::uint32_t>(std::atoi(argv[3]));
+  config.participant_name = "transport_peer";
+  Participant participant(config);
+  if (mode == "echo") return run_echo(participant, std::atoi(argv[4]));
+  if (mode == "writer" && argc >= 10) return run_writer(participant, argv + 4);
+  std::fprintf(stderr, "transport_peer: bad arguments\n");
+  return 2;
+}
