@@ -4,6 +4,7 @@
 // sample: loggers, lockstep inputs).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -49,7 +50,9 @@ class Subscriber final : private detail::SampleSink {
   // event-driven loops (it locks): a 1 kHz tick polls fetch_newest() instead.
   std::uint64_t wait_for_samples(std::uint64_t seen, std::chrono::nanoseconds timeout) {
     std::unique_lock lock(wait_mutex_);
+    waiters_.fetch_add(1, std::memory_order_seq_cst);
     wait_cv_.wait_for(lock, timeout, [&] { return latest_.published() > seen; });
+    waiters_.fetch_sub(1, std::memory_order_relaxed);
     return latest_.published();
   }
   std::uint64_t received() const { return latest_.published(); }
@@ -78,10 +81,12 @@ class Subscriber final : private detail::SampleSink {
     }
     if (handler_) handler_(typed, info);
     latest_.publish(typed, info);
-    {
-      std::lock_guard lock(wait_mutex_);
+    // Wake waiters only if there are any: most readers poll, and the lock
+    // and notify would otherwise cost every delivery.
+    if (waiters_.load(std::memory_order_seq_cst) > 0) {
+      { std::lock_guard lock(wait_mutex_); }
+      wait_cv_.notify_all();
     }
-    wait_cv_.notify_all();
   }
 
   Handler handler_;
@@ -92,6 +97,7 @@ class Subscriber final : private detail::SampleSink {
   std::atomic<std::uint64_t> missed_{0};
   std::mutex wait_mutex_;
   std::condition_variable wait_cv_;
+  std::atomic<int> waiters_{0};
   std::unique_ptr<detail::ReaderBackend> reader_;
 };
 

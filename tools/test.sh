@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Sets up the machine, builds fahr and runs the whole test suite:
+#   bash tools/test.sh
+# FAHR_BUILD_DIR (default build/) and FAHR_WERROR (default ON) adjust it;
+# FAHR_FUZZ_SECONDS (default 20) bounds each fuzz target's run.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build="${FAHR_BUILD_DIR:-$root/build}"
+
+bash "$root/tools/setup.sh"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DFAHR_WERROR="${FAHR_WERROR:-ON}"
+cmake --build "$build" -j2
+# Multi-process tests are RUN_SERIAL (they measure timing); the rest share the cores.
+ctest --test-dir "$build" --output-on-failure -j2
+if [ -x "$root/tools/run_fuzzers.sh" ]; then
+  bash "$root/tools/run_fuzzers.sh" "${FAHR_FUZZ_SECONDS:-20}"
+fi
