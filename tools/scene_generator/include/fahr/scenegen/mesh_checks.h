@@ -1,0 +1,50 @@
+// Geometric checks on generated meshes: closedness, orientation, tet
+// quality, point containment. Used by the generator (to refuse a bad scene),
+// by the test and by the renderer's statistics.
+#pragma once
+
+#include "fahr/scenegen/geometry_types.h"
+
+#include <array>
+#include <string>
+
+namespace fahr::scenegen {
+
+// Signed volume of a tet, positive for the orientation stated in TetMesh (mm^3).
+double tet_signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+// Smallest of the six interior dihedral angles of a tet, in degrees.
+double tet_min_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+// Volume enclosed by a closed surface (mm^3); positive when outward oriented.
+double enclosed_volume(const TriangleMesh& mesh);
+
+struct ClosednessReport {
+  int edge_count = 0;
+  int bad_edges = 0;           // undirected edges not used by exactly two triangles
+  int inconsistent_edges = 0;  // edges whose two triangles run them the same way
+  int degenerate_triangles = 0;
+  bool closed_and_oriented() const { return bad_edges == 0 && inconsistent_edges == 0; }
+};
+ClosednessReport check_closed(const TriangleMesh& mesh);
+
+// Generalised winding number of a closed surface around p: ~1 inside, ~0 outside.
+double winding_number(const TriangleMesh& mesh, const Vec3& p);
+
+// Distance (mm) from p to the nearest point of the surface.
+double distance_to_surface(const TriangleMesh& mesh, const Vec3& p);
+
+struct TetQuality {
+  int tet_count = 0;
+  double min_volume_mm3 = 0.0;
+  double max_volume_mm3 = 0.0;
+  double min_dihedral_deg = 0.0;
+  double max_dihedral_deg = 0.0;
+  int below_10_deg = 0;  // tets whose smallest dihedral is under 10 degrees
+};
+TetQuality tet_quality(const TetMesh& mesh);
+
+// Axis-aligned bounds of a point set.
+std::array<Vec3, 2> bounds(const std::vector<Vec3>& points);
+
+}  // namespace fahr::scenegen

@@ -1,0 +1,15 @@
+// Minimal readers for the files the generator writes, for its test and its
+// renderer only. The project's real loaders (with error reporting by file,
+// line and element) live in services/geometry.
+#pragma once
+
+#include "fahr/scenegen/geometry_types.h"
+
+#include <string>
+
+namespace fahr::scenegen {
+
+bool read_obj(const std::string& path, TriangleMesh& mesh, std::string& error);
+bool read_tetgen(const std::string& stem, TetMesh& mesh, std::string& error);
+
+}  // namespace fahr::scenegen

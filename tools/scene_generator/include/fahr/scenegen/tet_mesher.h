@@ -1,0 +1,36 @@
+// Tetrahedral mesher for an implicit solid: a regular cube grid, each cube
+// split into the six Kuhn (Freudenthal) tets around its main diagonal, which
+// is conforming across all cubes; tets whose centroid is inside are kept, then
+// boundary nodes are pulled onto the implicit surface, each move shortened or
+// refused when it would invert a tet or push it below the quality floor.
+#pragma once
+
+#include "fahr/scenegen/geometry_types.h"
+#include "fahr/scenegen/tongue_shape.h"
+
+#include <string>
+#include <vector>
+
+namespace fahr::scenegen {
+
+struct TetMesherSettings {
+  double cell_mm = 2.0;
+  double min_dihedral_deg = 8.0;       // snapping keeps every touched tet above this
+  double min_volume_fraction = 0.1;    // ... and above this fraction of a grid tet's volume
+  int snap_passes = 3;
+};
+
+struct TetMesherReport {
+  int grid_cells = 0;
+  int boundary_nodes = 0;
+  int snapped_fully = 0;
+  int snapped_partly = 0;
+  int not_snapped = 0;
+  double max_surface_gap_mm = 0.0;  // |implicit value| at boundary nodes after snapping
+  int nonmanifold_boundary_edges = 0;
+};
+
+TetMesh mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& settings,
+                            TetMesherReport& report);
+
+}  // namespace fahr::scenegen

@@ -1,0 +1,170 @@
+// Rigid anatomy as parametric closed surfaces (see param_surfaces.h).
+#include "fahr/scenegen/anatomy_surfaces.h"
+
+#include "fahr/scenegen/param_surfaces.h"
+#include "fahr/scenegen/piecewise_linear.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fahr::scenegen {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+int cells_for(double length_mm, double resolution_mm, int minimum = 2) {
+  return std::max(minimum, static_cast<int>(std::ceil(length_mm / resolution_mm)));
+}
+
+// Dental arch: the front edge of a slab curves back at its sides by this
+// much, so palate and jaw are U-shaped seen from above.
+constexpr double kArchSweepBackMm = 6.0;
+// Labial edge of a gum ridge is rounded over this fraction of the slab length.
+constexpr double kRidgeRoundFraction = 0.08;
+constexpr double kRidgeRoundMm = 2.0;
+
+double arch_x(double front_x, double length, double u, double lateral) {
+  return front_x - length * u - kArchSweepBackMm * (1.0 - u) * lateral * lateral;
+}
+
+// Closed rectangle loop in (radial, axial) with sharp corners, parametrised
+// by an index so that each side gets its own number of points.
+struct RectangleLoop {
+  int n_long;   // points along each long side
+  int n_short;  // points along each short side
+  int size() const { return 2 * (n_long + n_short); }
+  // Returns (radial fraction, axial fraction) for loop index j.
+  std::pair<double, double> at(int j) const {
+    j %= size();
+    const auto f = [](int k, int n) { return static_cast<double>(k) / static_cast<double>(n); };
+    if (j < n_long) return {0.0, f(j, n_long)};            // inner side, top to bottom
+    j -= n_long;
+    if (j < n_short) return {f(j, n_short), 1.0};          // bottom end, inner to outer
+    j -= n_short;
+    if (j < n_long) return {1.0, 1.0 - f(j, n_long)};      // outer side, bottom to top
+    j -= n_long;
+    return {1.0 - f(j, n_short), 0.0};                     // top end, outer to inner
+  }
+};
+
+int loop_index(double fraction, int size) {
+  return static_cast<int>(std::lround(fraction * static_cast<double>(size))) % size;
+}
+
+}  // namespace
+
+TriangleMesh make_palate(const PalateParameters& p, double resolution_mm) {
+  const auto map = [&p](double u, double v, double w) {
+    const double lateral = 2.0 * v - 1.0;
+    const double x = arch_x(p.front_x_mm, p.length_mm, u, lateral);
+    const double half_width =
+        p.front_half_width_mm + (p.back_half_width_mm - p.front_half_width_mm) * std::sqrt(u);
+    // Vault: rises inside the ridge, both across (ridge at the rim) and along
+    // (ridge at the front).
+    const double across = smoothstep(0.95, 0.45, std::abs(lateral));
+    const double along = smoothstep(0.0, 0.3, u);
+    double underside = p.gum_ridge_y_mm + p.vault_depth_mm * across * along;
+    if (u < kRidgeRoundFraction) {
+      const double r = 1.0 - u / kRidgeRoundFraction;
+      underside += kRidgeRoundMm * r * r;
+    }
+    return Vec3(x, underside + (p.top_y_mm - underside) * w, lateral * half_width);
+  };
+  const double width = 2.0 * p.back_half_width_mm;
+  return make_param_box(map, cells_for(p.length_mm, resolution_mm),
+                        cells_for(width, resolution_mm),
+                        cells_for(p.top_y_mm - p.gum_ridge_y_mm, 2.0 * resolution_mm));
+}
+
+TriangleMesh make_jaw(const JawParameters& p, const TongueParameters& tongue,
+                      double resolution_mm) {
+  constexpr double kWallRiseMm = 3.0;       // inner face of the mandibular body, horizontal run
+  constexpr double kRidgeBackSlopeMm = 4.0; // lingual slope of the lower gum ridge
+  constexpr double kRidgeCrestMm = 2.0;     // crest width of the lower gum ridge
+  constexpr double kMinThicknessMm = 3.0;   // bone under the floor never thinner than this
+  const auto map = [&](double u, double v, double w) {
+    const double lateral = 2.0 * v - 1.0;
+    const double x = arch_x(p.front_x_mm, p.length_mm, u, lateral);
+    const double half_width =
+        p.front_half_width_mm + (p.back_half_width_mm - p.front_half_width_mm) * std::pow(u, 0.8);
+    const double z = lateral * half_width;
+    // Floor: the tongue's attachment plane lowered by the gap.
+    const double floor_y = tongue.floor_y_at_x15_mm + tongue.floor_slope * (x + 15.0) -
+                           p.floor_gap_mm;
+    const double wall = smoothstep(p.wall_inner_half_width_mm,
+                                   p.wall_inner_half_width_mm + kWallRiseMm, std::abs(z));
+    const double ridge = smoothstep(p.front_x_mm - kRidgeCrestMm - kRidgeBackSlopeMm,
+                                    p.front_x_mm - kRidgeCrestMm, x);
+    const double rim = std::max(wall, ridge);
+    const double top = std::max(floor_y, floor_y + (p.ridge_y_mm - floor_y) * rim);
+    const double bottom = std::min(p.bottom_y_mm, top - kMinThicknessMm);
+    return Vec3(x, bottom + (top - bottom) * w, z);
+  };
+  const double width = 2.0 * p.back_half_width_mm;
+  return make_param_box(map, cells_for(p.length_mm, resolution_mm),
+                        cells_for(width, 0.75 * resolution_mm),
+                        cells_for(p.ridge_y_mm - p.bottom_y_mm, 2.0 * resolution_mm));
+}
+
+TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
+  constexpr double kCheekSweepBackMm = 6.0;   // outer rim lies this far behind the lips
+  constexpr double kLipBulgeWidth = 0.15;     // radial fraction over which the lips bulge
+  const RectangleLoop loop{cells_for(p.face_half_width_mm - p.mouth_half_width_mm, resolution_mm),
+                           cells_for(p.thickness_mm, 0.5 * resolution_mm)};
+  const auto map = [&](double around, double loop_fraction) {
+    const double a = 2.0 * kPi * around;
+    const auto [radial, axial] = loop.at(loop_index(loop_fraction, loop.size()));
+    // Quadratic spacing from the rim outwards: the lips get more rings than the cheeks.
+    const double r = radial * radial;
+    const Eigen::Vector2d inner(p.mouth_half_width_mm * std::cos(a),
+                                p.mouth_half_height_mm * std::sin(a));
+    const Eigen::Vector2d outer(p.face_half_width_mm * std::cos(a),
+                                p.face_half_height_mm * std::sin(a));
+    const Eigen::Vector2d zy = inner + r * (outer - inner);
+    // Cheeks sweep back at the sides only; above and below the mouth the face
+    // stays in front of the gums.
+    const double dish = kCheekSweepBackMm * r * r * std::cos(a) * std::cos(a);
+    const double lips = p.lip_protrusion_mm * std::exp(-(r / kLipBulgeWidth) * (r / kLipBulgeWidth));
+    const double back = p.back_x_mm - dish;
+    const double front = p.back_x_mm + p.thickness_mm + lips - dish;
+    return Vec3(back + (front - back) * axial, p.mouth_centre_y_mm + zy.y(), zy.x());
+  };
+  const int n_around = cells_for(2.0 * kPi * p.mouth_half_width_mm, 0.5 * resolution_mm, 24);
+  return make_param_torus(map, n_around, loop.size());
+}
+
+TriangleMesh make_larynx_trachea(const AirwayParameters& p, double resolution_mm) {
+  const double tilt = p.tilt_deg * kPi / 180.0;
+  const Vec3 inlet(p.inlet_x_mm, p.inlet_y_mm, 0.0);
+  const Vec3 down(-std::sin(tilt), -std::cos(tilt), 0.0);     // along the airway, inferior
+  const Vec3 anterior(std::cos(tilt), -std::sin(tilt), 0.0);  // towards the tongue base
+  const Vec3 lateral(0.0, 0.0, 1.0);
+  const double total = p.larynx_length_mm + p.trachea_length_mm;
+  const double top_span = p.epiglottis_height_mm + total;
+  const RectangleLoop loop{cells_for(top_span, resolution_mm),
+                           cells_for(p.wall_thickness_mm, 0.5 * resolution_mm)};
+  const auto map = [&](double around, double loop_fraction) {
+    const double a = 2.0 * kPi * around;
+    const auto [radial, axial] = loop.at(loop_index(loop_fraction, loop.size()));
+    // Epiglottis: the rim rises on the anterior side only (a = 0).
+    const double front = std::max(0.0, std::cos(a));
+    const double rise = p.epiglottis_height_mm * front * front;
+    const double s = -rise + (total + rise) * axial;  // axial position, mm below the inlet
+    double lumen = p.trachea_lumen_radius_mm +
+                   (p.inlet_lumen_radius_mm - p.trachea_lumen_radius_mm) *
+                       smoothstep(p.larynx_length_mm, 0.0, s);
+    double forward = 0.0;
+    if (s < 0.0) {
+      const double t = -s / p.epiglottis_height_mm;
+      forward = p.epiglottis_flare_mm * t * t * front;
+    }
+    const double r = lumen + p.wall_thickness_mm * radial;
+    return Vec3(inlet + s * down + (r * std::cos(a) + forward) * anterior +
+                r * std::sin(a) * lateral);
+  };
+  const int n_around = cells_for(2.0 * kPi * (p.inlet_lumen_radius_mm + p.wall_thickness_mm),
+                                 0.5 * resolution_mm, 24);
+  return make_param_torus(map, n_around, loop.size());
+}
+
+}  // namespace fahr::scenegen

@@ -1,0 +1,120 @@
+// Parametric closed surfaces: quads of a parameter grid split into two
+// triangles each; shared grid points are shared vertices, so the surfaces are
+// watertight by construction.
+#include "fahr/scenegen/param_surfaces.h"
+
+#include "fahr/scenegen/mesh_checks.h"
+
+#include <algorithm>
+#include <vector>
+
+namespace fahr::scenegen {
+namespace {
+
+void add_quad(TriangleMesh& mesh, int a, int b, int c, int d) {
+  // Quad a-b-c-d counter-clockwise; split along a-c.
+  mesh.triangles.push_back({a, b, c});
+  mesh.triangles.push_back({a, c, d});
+}
+
+double grid_coordinate(int i, int n) { return static_cast<double>(i) / static_cast<double>(n); }
+
+}  // namespace
+
+void orient_outward(TriangleMesh& mesh) {
+  if (enclosed_volume(mesh) < 0.0) {
+    for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
+  }
+}
+
+TriangleMesh make_param_box(const BoxMap& map, int nu, int nv, int nw) {
+  TriangleMesh mesh;
+  const int n[3] = {nu, nv, nw};
+  const auto lattice = [&](int i, int j, int k) { return (i * (nv + 1) + j) * (nw + 1) + k; };
+  std::vector<int> index(static_cast<size_t>((nu + 1) * (nv + 1) * (nw + 1)), -1);
+  for (int i = 0; i <= nu; ++i) {
+    for (int j = 0; j <= nv; ++j) {
+      for (int k = 0; k <= nw; ++k) {
+        const bool on_boundary = i == 0 || i == nu || j == 0 || j == nv || k == 0 || k == nw;
+        if (!on_boundary) continue;
+        index[static_cast<size_t>(lattice(i, j, k))] = static_cast<int>(mesh.vertices.size());
+        mesh.vertices.push_back(
+            map(grid_coordinate(i, nu), grid_coordinate(j, nv), grid_coordinate(k, nw)));
+      }
+    }
+  }
+  // Each face of the cube: fixed axis f at value 0 or n[f]; the free axes a, b
+  // follow f cyclically, so e_a x e_b = e_f (outward on the far face).
+  for (int f = 0; f < 3; ++f) {
+    const int a = (f + 1) % 3;
+    const int b = (f + 2) % 3;
+    for (const int side : {0, 1}) {
+      for (int p = 0; p < n[a]; ++p) {
+        for (int q = 0; q < n[b]; ++q) {
+          int c[4][3];
+          const int pa[4] = {p, p + 1, p + 1, p};
+          const int qb[4] = {q, q, q + 1, q + 1};
+          for (int r = 0; r < 4; ++r) {
+            c[r][f] = side * n[f];
+            c[r][a] = pa[r];
+            c[r][b] = qb[r];
+          }
+          int id[4];
+          for (int r = 0; r < 4; ++r) {
+            id[r] = index[static_cast<size_t>(lattice(c[r][0], c[r][1], c[r][2]))];
+          }
+          if (side == 1) {
+            add_quad(mesh, id[0], id[1], id[2], id[3]);
+          } else {
+            add_quad(mesh, id[0], id[3], id[2], id[1]);
+          }
+        }
+      }
+    }
+  }
+  orient_outward(mesh);
+  return mesh;
+}
+
+TriangleMesh make_param_torus(const TorusMap& map, int n_around, int n_loop) {
+  TriangleMesh mesh;
+  for (int i = 0; i < n_around; ++i) {
+    for (int j = 0; j < n_loop; ++j) {
+      mesh.vertices.push_back(map(grid_coordinate(i, n_around), grid_coordinate(j, n_loop)));
+    }
+  }
+  const auto id = [&](int i, int j) { return (i % n_around) * n_loop + (j % n_loop); };
+  for (int i = 0; i < n_around; ++i) {
+    for (int j = 0; j < n_loop; ++j) {
+      add_quad(mesh, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+    }
+  }
+  orient_outward(mesh);
+  return mesh;
+}
+
+TriangleMesh make_param_sphere(const SphereMap& map, int n_along, int n_around) {
+  TriangleMesh mesh;
+  mesh.vertices.push_back(map(0.0, 0.0));
+  for (int i = 1; i < n_along; ++i) {
+    for (int j = 0; j < n_around; ++j) {
+      mesh.vertices.push_back(map(grid_coordinate(i, n_along), grid_coordinate(j, n_around)));
+    }
+  }
+  const int last_pole = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.push_back(map(1.0, 0.0));
+  const auto id = [&](int i, int j) { return 1 + (i - 1) * n_around + (j % n_around); };
+  for (int j = 0; j < n_around; ++j) {
+    mesh.triangles.push_back({0, id(1, j + 1), id(1, j)});
+    mesh.triangles.push_back({last_pole, id(n_along - 1, j), id(n_along - 1, j + 1)});
+  }
+  for (int i = 1; i + 1 < n_along; ++i) {
+    for (int j = 0; j < n_around; ++j) {
+      add_quad(mesh, id(i, j), id(i, j + 1), id(i + 1, j + 1), id(i + 1, j));
+    }
+  }
+  orient_outward(mesh);
+  return mesh;
+}
+
+}  // namespace fahr::scenegen

@@ -1,0 +1,215 @@
+// Kuhn-grid tet mesher with quality-guarded boundary snapping.
+#include "fahr/scenegen/tet_mesher.h"
+
+#include "fahr/scenegen/mesh_checks.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+
+namespace fahr::scenegen {
+namespace {
+
+// The six axis orders of the Kuhn split: a tet walks from corner (0,0,0) to
+// (1,1,1) adding one unit axis at a time in this order. Every cube uses the
+// same main diagonal, so shared faces are split identically (conforming).
+constexpr int kAxisOrders[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                   {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+
+// Faces of a positively oriented tet (a, b, c, d), outward.
+constexpr int kTetFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+std::array<int, 3> sorted_face(const std::array<int, 4>& t, int f) {
+  std::array<int, 3> k{t[kTetFaces[f][0]], t[kTetFaces[f][1]], t[kTetFaces[f][2]]};
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+struct Grid {
+  Vec3 origin;
+  double h;
+  int nx, ny, nz;
+  int node(int i, int j, int k) const { return (i * (ny + 1) + j) * (nz + 1) + k; }
+  Vec3 position(int i, int j, int k) const { return origin + h * Vec3(i, j, k); }
+};
+
+Grid make_grid(const TongueShape& shape, double h) {
+  // One spare cell on every side so the surface never touches the grid edge.
+  const Vec3 lo = shape.lower_bound() - Vec3::Constant(h);
+  const Vec3 hi = shape.upper_bound() + Vec3::Constant(h);
+  Grid g{lo, h, 0, 0, 0};
+  g.nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / h));
+  g.ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / h));
+  g.nz = static_cast<int>(std::ceil((hi.z() - lo.z()) / h));
+  // Centre the grid on z = 0 so the mesh is mirror symmetric about the mid-sagittal plane.
+  g.nz += g.nz % 2;
+  g.origin.z() = -0.5 * g.nz * h;
+  return g;
+}
+
+// Tets whose centroid is inside the solid, indices into the full grid.
+std::vector<std::array<int, 4>> inside_tets(const TongueShape& shape, const Grid& g) {
+  std::vector<std::array<int, 4>> tets;
+  for (int i = 0; i < g.nx; ++i) {
+    for (int j = 0; j < g.ny; ++j) {
+      for (int k = 0; k < g.nz; ++k) {
+        for (const auto& order : kAxisOrders) {
+          int c[3] = {i, j, k};
+          std::array<int, 4> t{};
+          std::array<Vec3, 4> p;
+          for (int v = 0; v < 4; ++v) {
+            if (v > 0) ++c[order[v - 1]];
+            t[v] = g.node(c[0], c[1], c[2]);
+            p[v] = g.position(c[0], c[1], c[2]);
+          }
+          const Vec3 centroid = 0.25 * (p[0] + p[1] + p[2] + p[3]);
+          if (shape.value(centroid) >= 0.0) continue;
+          if (tet_signed_volume(p[0], p[1], p[2], p[3]) < 0.0) std::swap(t[2], t[3]);
+          tets.push_back(t);
+        }
+      }
+    }
+  }
+  return tets;
+}
+
+// Boundary faces (outward) in tet order, and the set of boundary nodes.
+std::vector<std::array<int, 3>> boundary_faces(const std::vector<std::array<int, 4>>& tets) {
+  std::map<std::array<int, 3>, int> count;
+  for (const auto& t : tets) {
+    for (int f = 0; f < 4; ++f) ++count[sorted_face(t, f)];
+  }
+  std::vector<std::array<int, 3>> faces;
+  for (const auto& t : tets) {
+    for (int f = 0; f < 4; ++f) {
+      if (count[sorted_face(t, f)] == 1) {
+        faces.push_back({t[kTetFaces[f][0]], t[kTetFaces[f][1]], t[kTetFaces[f][2]]});
+      }
+    }
+  }
+  return faces;
+}
+
+// Tets kept by their centroid can meet along an edge only (four boundary
+// faces around one edge): the boundary is then not a manifold. Removing the
+// tets on such edges settles it in a pass or two.
+void remove_nonmanifold_edges(std::vector<std::array<int, 4>>& tets) {
+  constexpr int kMaxPasses = 10;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    std::map<std::pair<int, int>, int> edge_uses;
+    for (const auto& f : boundary_faces(tets)) {
+      for (int k = 0; k < 3; ++k) ++edge_uses[std::minmax(f[k], f[(k + 1) % 3])];
+    }
+    std::vector<std::pair<int, int>> bad;
+    for (const auto& [edge, uses] : edge_uses) {
+      if (uses != 2) bad.push_back(edge);
+    }
+    if (bad.empty()) return;
+    std::vector<std::array<int, 4>> kept;
+    for (const auto& t : tets) {
+      bool on_bad_edge = false;
+      for (const auto& [a, b] : bad) {
+        const bool has_a = std::find(t.begin(), t.end(), a) != t.end();
+        const bool has_b = std::find(t.begin(), t.end(), b) != t.end();
+        on_bad_edge = on_bad_edge || (has_a && has_b);
+      }
+      if (!on_bad_edge) kept.push_back(t);
+    }
+    tets.swap(kept);
+  }
+}
+
+bool tet_acceptable(const TetMesh& m, const std::array<int, 4>& t, double min_volume,
+                    double min_dihedral) {
+  const Vec3& a = m.nodes[t[0]];
+  const Vec3& b = m.nodes[t[1]];
+  const Vec3& c = m.nodes[t[2]];
+  const Vec3& d = m.nodes[t[3]];
+  return tet_signed_volume(a, b, c, d) >= min_volume &&
+         tet_min_dihedral_deg(a, b, c, d) >= min_dihedral;
+}
+
+}  // namespace
+
+TetMesh mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& settings,
+                            TetMesherReport& report) {
+  const Grid grid = make_grid(shape, settings.cell_mm);
+  report.grid_cells = grid.nx * grid.ny * grid.nz;
+  auto tets = inside_tets(shape, grid);
+  remove_nonmanifold_edges(tets);
+
+  // Compact the used grid nodes, in grid order (deterministic numbering).
+  std::map<int, int> renumber;
+  for (const auto& t : tets) {
+    for (const int v : t) renumber[v] = 0;
+  }
+  TetMesh mesh;
+  for (auto& [grid_id, new_id] : renumber) {
+    new_id = static_cast<int>(mesh.nodes.size());
+    const int k = grid_id % (grid.nz + 1);
+    const int j = (grid_id / (grid.nz + 1)) % (grid.ny + 1);
+    const int i = grid_id / ((grid.nz + 1) * (grid.ny + 1));
+    mesh.nodes.push_back(grid.position(i, j, k));
+  }
+  for (auto& t : tets) {
+    for (auto& v : t) v = renumber[v];
+  }
+  mesh.tets = tets;
+
+  std::vector<std::vector<int>> node_tets(mesh.nodes.size());
+  for (size_t ti = 0; ti < tets.size(); ++ti) {
+    for (const int v : tets[ti]) node_tets[v].push_back(static_cast<int>(ti));
+  }
+  const auto faces = boundary_faces(tets);
+  std::vector<int> boundary_nodes;
+  for (const auto& f : faces) boundary_nodes.insert(boundary_nodes.end(), f.begin(), f.end());
+  std::sort(boundary_nodes.begin(), boundary_nodes.end());
+  boundary_nodes.erase(std::unique(boundary_nodes.begin(), boundary_nodes.end()),
+                       boundary_nodes.end());
+  report.boundary_nodes = static_cast<int>(boundary_nodes.size());
+
+  // Snap: try the full move, then half, then a quarter; refuse a fraction
+  // that makes any incident tet smaller or flatter than the floor (or worse
+  // than it already was, for tets already under the floor).
+  const double grid_tet_volume = std::pow(settings.cell_mm, 3) / 6.0;
+  const double min_volume = settings.min_volume_fraction * grid_tet_volume;
+  std::vector<double> moved_fraction(mesh.nodes.size(), 0.0);
+  for (int pass = 0; pass < settings.snap_passes; ++pass) {
+    for (const int v : boundary_nodes) {
+      const Vec3 start = mesh.nodes[v];
+      const Vec3 target = shape.project_to_surface(start);
+      for (const double fraction : {1.0, 0.5, 0.25}) {
+        mesh.nodes[v] = start + fraction * (target - start);
+        bool ok = true;
+        for (const int ti : node_tets[v]) {
+          ok = ok && tet_acceptable(mesh, mesh.tets[ti], min_volume, settings.min_dihedral_deg);
+        }
+        if (ok) {
+          moved_fraction[v] = fraction;
+          break;
+        }
+        mesh.nodes[v] = start;
+        moved_fraction[v] = 0.0;
+      }
+    }
+  }
+  for (const int v : boundary_nodes) {
+    const double gap = std::abs(shape.value(mesh.nodes[v]));
+    report.max_surface_gap_mm = std::max(report.max_surface_gap_mm, gap);
+    if (moved_fraction[v] >= 1.0) {
+      ++report.snapped_fully;
+    } else if (moved_fraction[v] > 0.0) {
+      ++report.snapped_partly;
+    } else {
+      ++report.not_snapped;
+    }
+  }
+  mesh.boundary = faces;
+
+  TriangleMesh surface{mesh.nodes, mesh.boundary};
+  report.nonmanifold_boundary_edges = check_closed(surface).bad_edges;
+  return mesh;
+}
+
+}  // namespace fahr::scenegen
