@@ -156,3 +156,68 @@ TEST(Config, MissingAndMalformedProfilesAreRefused) {
 
 }  // namespace
 }  // namespace fahr::test
+
+#include "fahr/common/service_reporter.h"
+
+namespace fahr::test {
+namespace {
+
+TEST(ServiceReporter, ReportsTickStatisticsLatePeriodsAndQosEvents) {
+  Participant p(in_process(6));
+  common::Subscriber<msg::ServiceStatus> status(p);
+  common::Subscriber<msg::ServiceEvents> events(p);
+  common::TickRecorder recorder;
+  common::ServiceReporter reporter(p, {"test_service", 1000.0, std::chrono::hours(1)}, recorder,
+                                   [](auto& metrics) { metrics.emplace_back("latency_p99_ms", 1.25); });
+  std::int64_t start = 1'000'000'000;
+  for (std::uint64_t tick = 0; tick < 101; ++tick) {
+    start += tick == 50 ? 3'000'000 : 1'000'000;  // one period of 3 ms: late
+    recorder.push({tick, start, 200'000, 150'000});
+  }
+  reporter.report();
+  ASSERT_TRUE(status.fetch_newest());
+  const auto& s = status.newest();
+  EXPECT_EQ(s.service_name().to_string(), "test_service");
+  EXPECT_EQ(s.ticks(), 101U);
+  EXPECT_EQ(s.late_periods(), 1U);
+  EXPECT_EQ(s.period().count(), 100U);
+  EXPECT_EQ(s.period().p50_ns(), 1'000'000);
+  EXPECT_EQ(s.period().max_ns(), 3'000'000);
+  EXPECT_EQ(s.tick_cpu().p50_ns(), 150'000);
+  ASSERT_EQ(s.metrics().size(), 1U);
+  EXPECT_EQ(s.metrics()[0].value(), 1.25);
+  ASSERT_TRUE(events.fetch_newest());
+  EXPECT_EQ(events.newest().tick_spans().size(), 101U);
+  bool saw_match = false;
+  for (const auto& e : events.newest().qos_events()) saw_match |= e.kind() == msg::QOS_PUBLICATION_MATCHED;
+  EXPECT_TRUE(saw_match) << "the reporter's own publications matched the test's readers";
+}
+
+TEST(TickRecorder, DropsWhenFullInsteadOfBlocking) {
+  common::TickRecorder recorder;
+  for (std::size_t i = 0; i < common::TickRecorder::kCapacity + 10; ++i) recorder.push({i, 0, 0, 0});
+  EXPECT_EQ(recorder.dropped(), 10U);
+  std::size_t n = 0;
+  recorder.drain([&](const common::TickRecord&) { ++n; });
+  EXPECT_EQ(n, common::TickRecorder::kCapacity);
+}
+
+}  // namespace
+}  // namespace fahr::test
+
+namespace fahr::test {
+namespace {
+
+TEST(Config, ShippedProfilesLoad) {
+  for (auto [vendor, file] : {std::pair{Vendor::kFastDds, "fastdds_loopback.xml"},
+                              std::pair{Vendor::kCyclone, "cyclonedds_loopback.xml"}}) {
+    TransportConfig config;
+    config.vendor = vendor;
+    config.domain_id = 18;
+    config.profile_file = std::string(FAHR_DEPLOYMENT_DIR) + "/dds/" + file;
+    EXPECT_NO_THROW(Participant p(config)) << file;
+  }
+}
+
+}  // namespace
+}  // namespace fahr::test
