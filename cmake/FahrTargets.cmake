@@ -15,6 +15,7 @@ function(fahr_sanitize target)
   if(FAHR_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+    target_compile_definitions(${target} PRIVATE FAHR_SANITIZE_BUILD)
   endif()
 endfunction()
 

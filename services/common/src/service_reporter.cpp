@@ -52,14 +52,20 @@ ServiceReporter::ServiceReporter(Participant& participant, ReporterSettings sett
       thread_([this] { run(); }) {}
 
 ServiceReporter::~ServiceReporter() {
-  stop_.store(true);
+  {
+    std::lock_guard lock(stop_mutex_);
+    stop_ = true;
+  }
+  stop_cv_.notify_all();
   thread_.join();
 }
 
 void ServiceReporter::run() {
-  while (!stop_.load()) {
-    std::this_thread::sleep_for(settings_.report_period);
+  std::unique_lock lock(stop_mutex_);
+  while (!stop_cv_.wait_for(lock, settings_.report_period, [this] { return stop_; })) {
+    lock.unlock();
     report();
+    lock.lock();
   }
 }
 

@@ -106,6 +106,20 @@ class LockstepClient {
   Subscriber<msg::SimClock> clock_;
 };
 
+// QoS for lockstep outputs: reliable, deep enough for StepInput, and
+// transient local: a participant's first outputs may be written before the
+// reader in another process has matched its writer (joining only proves
+// each side exists), and must still reach it.
+template <class T>
+QosProfile lockstep_output_qos() {
+  QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole);
+  qos.reliability = Reliability::kReliable;
+  qos.durability = Durability::kTransientLocal;
+  qos.history_depth = 8;
+  qos.liveliness_lease = {};
+  return qos;
+}
+
 // The input of one topic in lockstep: every sample kept by the step that
 // produced it (a few steps deep), so a consumer reads exactly the step the
 // read rule names even when the producer has already published the next.
@@ -128,10 +142,8 @@ class StepInput {
 
  private:
   static QosProfile input_qos() {
-    QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole);
-    qos.reliability = Reliability::kReliable;
+    QosProfile qos = lockstep_output_qos<T>();
     qos.history_depth = static_cast<int>(kDepth);
-    qos.liveliness_lease = {};
     return qos;
   }
   void store(const T& sample) {
@@ -161,14 +173,5 @@ class StepInput {
   Subscriber<T> subscriber_;
 };
 
-// QoS for lockstep outputs: reliable, deep enough for StepInput.
-template <class T>
-QosProfile lockstep_output_qos() {
-  QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole);
-  qos.reliability = Reliability::kReliable;
-  qos.history_depth = 8;
-  qos.liveliness_lease = {};
-  return qos;
-}
 
 }  // namespace fahr::common

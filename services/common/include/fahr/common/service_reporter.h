@@ -7,6 +7,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <functional>
 #include <string>
 #include <thread>
@@ -58,7 +60,9 @@ class ServiceReporter {
   std::int64_t last_report_ns_ = 0;
   std::vector<std::int64_t> periods_, durations_, cpus_;
   std::vector<msg::TickSpan> spans_;
-  std::atomic<bool> stop_{false};
+  std::mutex stop_mutex_;
+  std::condition_variable stop_cv_;
+  bool stop_ = false;
   std::thread thread_;
 };
 
