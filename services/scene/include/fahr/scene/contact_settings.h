@@ -1,0 +1,40 @@
+// Contact response and tool coupling (issue 6), and which body pairs the
+// scene includes or excludes from contact testing by declaration.
+#pragma once
+
+#include <cstddef>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "fahr/scene/defaults.h"
+
+namespace fahr::scene {
+
+enum class ContactResponse {
+  kForceAware,  // the paper's constraint: freeze past the renderable force
+  kPenalty,     // baseline: force proportional to penetration
+};
+
+std::string_view to_string(ContactResponse response);
+
+// Two indices into Scene::bodies, first < second.
+using BodyIndexPair = std::pair<std::size_t, std::size_t>;
+
+struct ContactSettings {
+  ContactResponse response = ContactResponse::kForceAware;
+  double coupling_stiffness_npm = kDefaultCouplingStiffnessNPerM;  // N/m, (0, 1e5]
+  double coupling_damping_nspm = kDefaultCouplingDampingNsPerM;    // N s/m, [0, 1e3]
+  // Fraction of the renderable force below which frozen tool constraints
+  // re-activate: they do at (1 - hysteresis) * limit, [0, 0.9].
+  double force_aware_hysteresis = kDefaultForceAwareHysteresis;
+  double penalty_stiffness_npm = kDefaultPenaltyStiffnessNPerM;  // N/m, (0, 1e6]
+  // Deformable/obstacle pairs whose world boxes come within this are tested, m, [0, 1].
+  double deformable_obstacle_margin_m = kDefaultDeformableObstacleMarginM;
+  // Deformable/obstacle pairs declared in contact whatever their distance.
+  std::vector<BodyIndexPair> include_pairs;
+  // Pairs never tested, whatever their roles.
+  std::vector<BodyIndexPair> exclude_pairs;
+};
+
+}  // namespace fahr::scene

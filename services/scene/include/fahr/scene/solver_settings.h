@@ -1,0 +1,39 @@
+// FEM solver choices (issue 4): linear solver, Algorithm 1 projection, and
+// the contact compliance the haptic loop solves on.
+#pragma once
+
+#include <chrono>
+#include <string_view>
+
+#include "fahr/scene/defaults.h"
+
+namespace fahr::scene {
+
+enum class LinearSolver {
+  kCholmod,  // sparse direct (SuiteSparse), factorised when the matrix changes
+  kPcg,      // preconditioned conjugate gradient, warm-started, budgeted
+};
+
+enum class ComplianceMode {
+  kExact,   // W = J A^-1 J^T from the current factorisation
+  kLagged,  // W of the previous factorisation (cheaper, one step old)
+  kNone,    // no compliance: the haptic loop sees only positions
+};
+
+std::string_view to_string(LinearSolver solver);
+std::string_view to_string(ComplianceMode mode);
+
+struct FemSolverSettings {
+  LinearSolver linear_solver = LinearSolver::kCholmod;
+  double cg_tolerance = kDefaultCgTolerance;                        // relative residual, (0, 1)
+  int cg_max_iterations = kDefaultCgMaxIterations;                  // [1, 100000]
+  int projection_max_iterations = kDefaultProjectionMaxIterations;  // [1, 10000]
+  double projection_tolerance_m = kDefaultProjectionToleranceM;     // m, (0, 1e-2]
+  ComplianceMode compliance = ComplianceMode::kExact;
+  int max_candidate_contacts = kDefaultMaxCandidateContacts;  // [0, 1024]
+  // ContactSets older than this are ignored and counted, (0, 10 s].
+  std::chrono::nanoseconds max_contact_age = kDefaultMaxContactAge;
+  double sleep_speed_mps = kDefaultSleepSpeedMps;  // m/s, [0, 1]
+};
+
+}  // namespace fahr::scene
