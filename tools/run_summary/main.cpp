@@ -1,0 +1,155 @@
+// fahr_run_summary: listens to a running co-simulation for a fixed time and
+// prints what a training-lab run should be judged by: each service's rate,
+// late periods and tick CPU time, deadline misses from its ServiceEvents,
+// motion-to-force latency (from the gateway's metrics), peak force against
+// the device's limit and lost-track episodes (from ForceCommand).
+//
+//   fahr_run_summary --duration-s S [--dds V] [--domain N] [--dds-profile F]
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "fahr/common/config_error.h"
+#include "fahr/common/subscriber.h"
+
+namespace {
+
+using namespace fahr;
+
+struct ServiceTally {
+  std::string vendor;
+  double nominal_hz = 0;
+  std::vector<double> measured_hz;
+  std::uint64_t ticks = 0;
+  std::uint64_t late_periods = 0;
+  std::int64_t worst_cpu_p99_ns = 0;
+  std::int64_t worst_period_max_ns = 0;
+  std::map<std::string, double> metrics;  // newest value of each
+  std::map<int, long> qos_events;         // kind -> count
+};
+
+struct Tally {
+  std::mutex mutex;
+  std::map<std::string, ServiceTally> services;
+  std::uint64_t commands = 0;
+  double peak_command_n = 0;
+  double peak_reaction_n = 0;
+  std::uint64_t lost_track_episodes = 0;
+  bool lost_track = false;
+  double max_gap_m = 0;
+  double limit_n = 0;
+  double peak_rendered_n = 0;
+  std::uint64_t poses = 0;
+};
+
+double norm(const msg::Vec3& v) { return std::sqrt(v.x() * v.x() + v.y() * v.y() + v.z() * v.z()); }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+void print(const Tally& t, double duration_s) {
+  std::printf("\n## fahr run summary (%.1f s)\n\n", duration_s);
+  std::printf("| service | vendor | nominal Hz | measured Hz (median) | ticks | late periods | tick CPU p99 us (worst) | period max ms (worst) | deadline misses |\n");
+  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const auto& [name, s] : t.services) {
+    long misses = 0;
+    for (int k : {msg::QOS_REQUESTED_DEADLINE_MISSED, msg::QOS_OFFERED_DEADLINE_MISSED}) {
+      auto it = s.qos_events.find(k);
+      if (it != s.qos_events.end()) misses += it->second;
+    }
+    std::printf("| %s | %s | %.0f | %.1f | %llu | %llu | %.1f | %.2f | %ld |\n", name.c_str(), s.vendor.c_str(),
+                s.nominal_hz, median(s.measured_hz), static_cast<unsigned long long>(s.ticks),
+                static_cast<unsigned long long>(s.late_periods), static_cast<double>(s.worst_cpu_p99_ns) / 1e3,
+                static_cast<double>(s.worst_period_max_ns) / 1e6, misses);
+  }
+  std::printf("\n| figure | value |\n|---|---:|\n");
+  std::printf("| DevicePose samples | %llu |\n", static_cast<unsigned long long>(t.poses));
+  std::printf("| ForceCommand samples | %llu |\n", static_cast<unsigned long long>(t.commands));
+  std::printf("| device force limit (renderable, last) N | %.2f |\n", t.limit_n);
+  std::printf("| peak rendered force N | %.2f |\n", t.peak_rendered_n);
+  std::printf("| peak commanded force N | %.2f |\n", t.peak_command_n);
+  std::printf("| peak tissue reaction N | %.2f |\n", t.peak_reaction_n);
+  std::printf("| lost-track episodes | %llu |\n", static_cast<unsigned long long>(t.lost_track_episodes));
+  std::printf("| largest device-proxy gap mm | %.2f |\n", t.max_gap_m * 1e3);
+  for (const auto& [name, s] : t.services) {
+    for (const auto& [metric, value] : s.metrics) {
+      if (metric.find("latency") != std::string::npos || metric.find("motion_to_force") != std::string::npos) {
+        std::printf("| %s %s | %.3f |\n", name.c_str(), metric.c_str(), value);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Summarise a running fahr co-simulation"};
+  std::string dds, domain, profile;
+  double duration_s = 10;
+  app.add_option("--duration-s", duration_s, "how long to listen");
+  app.add_option("--dds", dds, "DDS vendor");
+  app.add_option("--domain", domain, "DDS domain id");
+  app.add_option("--dds-profile", profile, "vendor XML configuration");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    common::Participant participant(common::transport_config_from(dds, domain, profile, "fahr_run_summary"));
+    Tally tally;
+    common::QosProfile reports = common::QosProfile::for_role(common::TopicRole::kReport);
+    common::Subscriber<msg::ServiceStatus> status(
+        participant, reports, common::TopicTraits<msg::ServiceStatus>::kName,
+        [&](const msg::ServiceStatus& s, const common::SampleInfo&) {
+          std::lock_guard lock(tally.mutex);
+          auto& t = tally.services[s.service_name().to_string()];
+          t.vendor = s.dds_vendor().to_string();
+          t.nominal_hz = s.nominal_rate_hz();
+          if (s.measured_rate_hz() > 0) t.measured_hz.push_back(s.measured_rate_hz());
+          t.ticks = s.ticks();
+          t.late_periods = s.late_periods();
+          t.worst_cpu_p99_ns = std::max(t.worst_cpu_p99_ns, s.tick_cpu().p99_ns());
+          t.worst_period_max_ns = std::max(t.worst_period_max_ns, s.period().max_ns());
+          for (const auto& m : s.metrics()) t.metrics[m.name().to_string()] = m.value();
+        });
+    common::Subscriber<msg::ServiceEvents> events(
+        participant, reports, common::TopicTraits<msg::ServiceEvents>::kName,
+        [&](const msg::ServiceEvents& e, const common::SampleInfo&) {
+          std::lock_guard lock(tally.mutex);
+          auto& t = tally.services[e.service_name().to_string()];
+          for (const auto& q : e.qos_events()) t.qos_events[q.kind()] += std::max(q.total_count_change(), 0);
+        });
+    common::Subscriber<msg::ForceCommand> commands(
+        participant, common::QosProfile::for_role(common::TopicRole::kServoStream),
+        common::TopicTraits<msg::ForceCommand>::kName, [&](const msg::ForceCommand& c, const common::SampleInfo&) {
+          std::lock_guard lock(tally.mutex);
+          ++tally.commands;
+          tally.peak_command_n = std::max(tally.peak_command_n, norm(c.force_n()));
+          tally.peak_reaction_n = std::max(tally.peak_reaction_n, c.tissue_reaction_n());
+          if (c.lost_track() && !tally.lost_track) ++tally.lost_track_episodes;
+          tally.lost_track = c.lost_track();
+          tally.max_gap_m = std::max(tally.max_gap_m, norm(c.device_minus_proxy_m()));
+        });
+    common::Subscriber<msg::DevicePose> poses(
+        participant, common::QosProfile::for_role(common::TopicRole::kServoStream),
+        common::TopicTraits<msg::DevicePose>::kName, [&](const msg::DevicePose& p, const common::SampleInfo&) {
+          std::lock_guard lock(tally.mutex);
+          ++tally.poses;
+          tally.limit_n = p.renderable_force_n();
+          tally.peak_rendered_n = std::max(tally.peak_rendered_n, norm(p.rendered_force_n()));
+        });
+    std::this_thread::sleep_for(std::chrono::duration<double>(duration_s));
+    std::lock_guard lock(tally.mutex);
+    print(tally, duration_s);
+    return 0;
+  } catch (const common::ConfigError& e) {
+    std::fprintf(stderr, "fahr_run_summary: %s\n", e.what());
+    return 2;
+  }
+}
