@@ -4,6 +4,8 @@
 // the vendors' own threads do not count against the loop under test.
 #include <gtest/gtest.h>
 
+#include "allocation_counter.h"
+
 #include <chrono>
 #include <cstdlib>
 #include <new>
@@ -13,37 +15,11 @@
 #include "fahr/common/subscriber.h"
 #include "sample_factory.h"
 
-namespace {
-thread_local bool counting = false;
-thread_local long allocations = 0;
-}  // namespace
-
-// GCC's -Wmismatched-new-delete cannot see that these two pair up.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t size) {
-  if (counting) ++allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
 
 namespace fahr::test {
 namespace {
 
 using namespace std::chrono_literals;
-
-class AllocationCounter {
- public:
-  AllocationCounter() {
-    allocations = 0;
-    counting = true;
-  }
-  ~AllocationCounter() { counting = false; }
-  long count() const { return allocations; }
-};
 
 TEST(NoAllocation, InProcessWriteAndTakeNewest) {
   common::TransportConfig config;

@@ -3,6 +3,8 @@
 // back-end the library has and hostile commands mixed in.
 #include <gtest/gtest.h>
 
+#include "allocation_counter.h"
+
 #include <cstdlib>
 #include <limits>
 #include <new>
@@ -12,35 +14,9 @@
 #include "fahr/device/simulated_backend.h"
 #include "test_support.h"
 
-namespace {
-thread_local bool counting = false;
-thread_local long allocations = 0;
-}  // namespace
-
-// GCC's -Wmismatched-new-delete cannot see that these pair up.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t size) {
-  if (counting) ++allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
 
 namespace fahr::test {
 namespace {
-
-class AllocationCounter {
- public:
-  AllocationCounter() {
-    allocations = 0;
-    counting = true;
-  }
-  ~AllocationCounter() { counting = false; }
-  long count() const { return allocations; }
-};
 
 // Commands of every kind the safety layer handles: good, huge, NaN, stale.
 device::ForceCommandSample hostile(std::uint64_t tick, const Vec3& position_m) {

@@ -1,41 +1,12 @@
 // Proves the SDF and BVH queries allocate nothing (they run in the 1 kHz
-// haptic tick): global operator new is replaced by a counting one.
+// haptic tick), counted with fahr::test::AllocationCounter.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <random>
 
+#include "allocation_counter.h"
 #include "fahr/geometry/signed_distance_field.h"
 #include "test_support.h"
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) {
-    return p;
-  }
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  return operator new(size);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace fahr::geometry {
 namespace {
@@ -52,13 +23,12 @@ TEST(QueryAllocation, SdfQueriesAllocateNothing) {
     p = Eigen::Vector3d(u(rng), u(rng), u(rng));
   }
   double sink = 0.0;
-  const long before = g_allocations.load();
+  fahr::test::AllocationCounter counter;
   for (const auto& p : points) {
     sink += sdf.query(p).distance_m + sdf.query_exact(p).distance_m + sdf.grid_distance(p);
     sink += sdf.bvh().closest_point(p, 1e-4).distance_squared;
   }
-  const long after = g_allocations.load();
-  EXPECT_EQ(after - before, 0) << "queries allocated";
+  EXPECT_EQ(counter.count(), 0) << "queries allocated";
   EXPECT_TRUE(std::isfinite(sink));
 }
 
