@@ -1,7 +1,12 @@
 // Runs fahr_scene_generator twice with its defaults and checks that both runs
 // and the committed meshes/neonatal files are byte-identical (so what is
 // committed is exactly the generator's output), that every tet has positive
-// volume and that every surface is closed and outward oriented.
+// volume, that every surface is closed and outward oriented, and that
+// fahr::geometry reads every surface as closed, manifold, fold-free and
+// non-degenerate and builds a signed distance field for it.
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/geometry/surface_loader.h"
+#include "fahr/geometry/surface_mesh.h"
 #include "fahr/scenegen/mesh_checks.h"
 #include "fahr/scenegen/mesh_readers.h"
 
@@ -11,9 +16,11 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <exception>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -32,6 +39,8 @@ const std::vector<std::string> kSceneFiles = {
     "miller0.obj", "miller1.obj", "scene_parameters.txt"};
 const std::vector<std::string> kSurfaces = {"palate", "jaw", "lips_face", "larynx_trachea",
                                             "miller0", "miller1"};
+constexpr double kMetresPerMm = 1e-3;
+constexpr double kSdfCellM = 1e-3;  // the 1 mm cell the haptic and AIST code use
 
 std::string slurp(const fs::path& path) {
   std::ifstream file(path, std::ios::binary);
@@ -121,6 +130,71 @@ TEST_F(SceneGeneratorTest, SurfacesAreClosedAndOutward) {
     EXPECT_EQ(closed.inconsistent_edges, 0) << name << ": inconsistent orientation";
     EXPECT_GT(fahr::scenegen::enclosed_volume(mesh), 0.0) << name << ": not outward";
   }
+}
+
+// What the geometry library needs of a rigid obstacle or tool: every
+// topology count zero, and a signed (not unsigned) field.
+void expect_clean_and_signed(const fahr::geometry::SurfaceMesh& surface, const std::string& name) {
+  const fahr::geometry::SurfaceTopology& t = surface.topology();
+  EXPECT_EQ(t.boundary_edge_count, 0u) << name << ": boundary edges";
+  EXPECT_EQ(t.non_manifold_edge_count, 0u) << name << ": non-manifold edges";
+  EXPECT_EQ(t.inconsistent_edge_count, 0u) << name << ": inconsistently oriented edges";
+  EXPECT_EQ(t.non_manifold_vertex_count, 0u) << name << ": non-manifold vertices";
+  EXPECT_EQ(t.folded_edge_count, 0u) << name << ": folded (back to back) edges";
+  EXPECT_EQ(t.degenerate_triangle_count, 0u) << name << ": degenerate triangles";
+  EXPECT_GT(surface.enclosed_volume_m3(), 0.0) << name << ": not outward";
+  fahr::geometry::SdfOptions options;
+  options.cell_size_m = kSdfCellM;
+  options.unsigned_mode = false;
+  try {
+    const fahr::geometry::SignedDistanceField field(surface, options);
+    EXPECT_TRUE(field.is_signed()) << name;
+    // A point well outside the box must come out positive.
+    const Eigen::Vector3d outside =
+        surface.bounds_max() + Eigen::Vector3d::Constant(5.0 * kSdfCellM);
+    EXPECT_GT(field.query(outside).distance_m, 0.0) << name << ": sign outside";
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << name << ": no signed distance field: " << e.what();
+  }
+}
+
+TEST_F(SceneGeneratorTest, GeometryLibraryLoadsCleanSurfacesWithSignedFields) {
+  for (const auto& name : kSurfaces) {
+    const fs::path path = *first_ / (name + ".obj");
+    try {
+      const fahr::geometry::SurfaceMesh surface =
+          fahr::geometry::load_surface(path, kMetresPerMm);
+      EXPECT_GT(surface.triangle_count(), 0u) << name;
+      expect_clean_and_signed(surface, name);
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << path << ": " << e.what();
+    }
+  }
+}
+
+TEST_F(SceneGeneratorTest, TongueBoundaryIsCleanWithSignedField) {
+  TetMesh tongue;
+  std::string error;
+  ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "tongue").string(), tongue, error)) << error;
+  // Only the nodes the boundary uses, so the surface has no stray vertices.
+  std::vector<int> compact(tongue.nodes.size(), -1);
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<fahr::geometry::Triangle> triangles;
+  for (const auto& f : tongue.boundary) {
+    fahr::geometry::Triangle t{};
+    for (size_t k = 0; k < 3; ++k) {
+      const auto v = static_cast<size_t>(f[k]);
+      ASSERT_LT(v, tongue.nodes.size());
+      if (compact[v] < 0) {
+        compact[v] = static_cast<int>(vertices.size());
+        vertices.push_back(tongue.nodes[v] * kMetresPerMm);
+      }
+      t[k] = static_cast<fahr::geometry::Index>(compact[v]);
+    }
+    triangles.push_back(t);
+  }
+  const fahr::geometry::SurfaceMesh surface(std::move(vertices), std::move(triangles));
+  expect_clean_and_signed(surface, "tongue boundary");
 }
 
 TEST_F(SceneGeneratorTest, FixedNodesAreTongueNodes) {

@@ -123,19 +123,43 @@ int main(int argc, char** argv) {
   blades["miller1"] = make_miller_blade(params.miller1, res);
 
   bool ok = mesher_report.nonmanifold_boundary_edges == 0 && quality.min_volume_mm3 > 0.0;
-  const auto report_surface = [&ok](const std::string& name, const TriangleMesh& m) {
+  const auto report_surface = [&ok](const std::string& name, const TriangleMesh& generated) {
+    const TriangleMesh m = as_written(generated);
     const auto closed = check_closed(m);
     const auto box = bounds(m.vertices);
     const double volume = enclosed_volume(m);
     std::printf("%s: %zu vertices, %zu triangles, volume %.1f mm^3, bad edges %d, inconsistent %d,"
-                " degenerate %d; bounds x [%.1f, %.1f] y [%.1f, %.1f] z [%.1f, %.1f] mm\n",
+                " folded %d, degenerate %d, sharpest edge %.1f deg; bounds x [%.1f, %.1f]"
+                " y [%.1f, %.1f] z [%.1f, %.1f] mm\n",
                 name.c_str(), m.vertices.size(), m.triangles.size(), volume, closed.bad_edges,
-                closed.inconsistent_edges, closed.degenerate_triangles, box[0].x(), box[1].x(),
-                box[0].y(), box[1].y(), box[0].z(), box[1].z());
-    ok = ok && closed.closed_and_oriented() && volume > 0.0;
+                closed.inconsistent_edges, closed.folded_edges, closed.degenerate_triangles,
+                closed.sharpest_edge_deg, box[0].x(), box[1].x(), box[0].y(), box[1].y(),
+                box[0].z(), box[1].z());
+    ok = ok && closed.clean() && volume > 0.0;
   };
   for (const auto& [name, m] : anatomy) report_surface(name, m);
   for (const auto& [name, m] : blades) report_surface(name, m);
+  {
+    // The tongue boundary must be as clean as the rigid surfaces.
+    const TriangleMesh boundary = as_written(TriangleMesh{tongue.nodes, tongue.boundary});
+    const auto closed = check_closed(boundary);
+    std::printf("tongue boundary: bad edges %d, inconsistent %d, folded %d, degenerate %d,"
+                " sharpest edge %.1f deg\n",
+                closed.bad_edges, closed.inconsistent_edges, closed.folded_edges,
+                closed.degenerate_triangles, closed.sharpest_edge_deg);
+    ok = ok && closed.clean() && enclosed_volume(boundary) > 0.0;
+  }
+  // Palate and jaw are images of a box: a map that folds the box over itself
+  // gives a surface that overlaps itself (back to back where it is flat).
+  const std::map<std::string, ParamBox> boxes = {
+      {"palate", palate_box(params.palate, res)},
+      {"jaw", jaw_box(params.jaw, params.tongue, res)}};
+  for (const auto& [name, box] : boxes) {
+    const int folded = folded_box_tets(box);
+    std::printf("%s: %d folded or flat tets in its %dx%dx%d parameter lattice\n", name.c_str(),
+                folded, box.nu, box.nv, box.nw);
+    ok = ok && folded == 0;
+  }
 
   // Nothing may intersect at rest: tongue nodes against every rigid body,
   // rigid bodies against each other, and the blades at their initial pose.

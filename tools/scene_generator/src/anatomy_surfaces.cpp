@@ -18,14 +18,36 @@ int cells_for(double length_mm, double resolution_mm, int minimum = 2) {
 
 // Dental arch: the front edge of a slab curves back at its sides by this
 // much, so palate and jaw are U-shaped seen from above.
-constexpr double kArchSweepBackMm = 6.0;
+constexpr double kPalateArchSweepBackMm = 6.0;
+constexpr double kJawArchSweepBackMm = 4.0;
 // Labial edge of a gum ridge is rounded over this fraction of the slab length.
 constexpr double kRidgeRoundFraction = 0.08;
 constexpr double kRidgeRoundMm = 2.0;
 
-double arch_x(double front_x, double length, double u, double lateral) {
-  return front_x - length * u - kArchSweepBackMm * (1.0 - u) * lateral * lateral;
+// Seen from above, a slab is the image of (u, lateral) in [0, 1] x [-1, 1]:
+// x from arch_x, z = lateral * half_width(u). The front edge (u = 0) is a
+// parabola reaching the side edge at a corner; the map only stays one-to-one
+// (no part of the slab folded over another) when that corner is convex, i.e.
+// when the side edge leaves it less steeply than the parabola arrives:
+// half_width'(0) / (length - sweep) < front_half_width / (2 sweep).
+double arch_x(double front_x, double length, double sweep_mm, double u, double lateral) {
+  return front_x - length * u - sweep_mm * (1.0 - u) * lateral * lateral;
 }
+
+// u^power with a finite slope at u = 0: ((u + a)^power - a^power), scaled to
+// run from 0 to 1. A bare u^power (power < 1) has an infinite slope at the
+// front, which makes the corner above reflex and folds the slab there.
+double eased_power(double u, double power, double ease) {
+  const double start = std::pow(ease, power);
+  return (std::pow(u + ease, power) - start) / (std::pow(1.0 + ease, power) - start);
+}
+// Chosen so the arch corners are convex with some margin (at the default
+// dimensions the thinnest projected cell corner is 5.7 degrees in the
+// palate, 3.6 in the jaw) while the half width differs from the bare power
+// by at most 1.0 mm (palate) and 1.1 mm (jaw). The jaw also needs the
+// shallower sweep: with 6 mm its corner stays reflex for any ease.
+constexpr double kPalateWidthEase = 0.2;
+constexpr double kJawWidthEase = 0.3;
 
 // Closed rectangle loop in (radial, axial) with sharp corners, parametrised
 // by an index so that each side gets its own number of points.
@@ -53,12 +75,12 @@ int loop_index(double fraction, int size) {
 
 }  // namespace
 
-TriangleMesh make_palate(const PalateParameters& p, double resolution_mm) {
-  const auto map = [&p](double u, double v, double w) {
+ParamBox palate_box(const PalateParameters& p, double resolution_mm) {
+  const auto map = [p](double u, double v, double w) {
     const double lateral = 2.0 * v - 1.0;
-    const double x = arch_x(p.front_x_mm, p.length_mm, u, lateral);
-    const double half_width =
-        p.front_half_width_mm + (p.back_half_width_mm - p.front_half_width_mm) * std::sqrt(u);
+    const double x = arch_x(p.front_x_mm, p.length_mm, kPalateArchSweepBackMm, u, lateral);
+    const double half_width = p.front_half_width_mm + (p.back_half_width_mm - p.front_half_width_mm) *
+                                                          eased_power(u, 0.5, kPalateWidthEase);
     // Vault: rises inside the ridge, both across (ridge at the rim) and along
     // (ridge at the front).
     const double across = smoothstep(0.95, 0.45, std::abs(lateral));
@@ -71,22 +93,24 @@ TriangleMesh make_palate(const PalateParameters& p, double resolution_mm) {
     return Vec3(x, underside + (p.top_y_mm - underside) * w, lateral * half_width);
   };
   const double width = 2.0 * p.back_half_width_mm;
-  return make_param_box(map, cells_for(p.length_mm, resolution_mm),
-                        cells_for(width, resolution_mm),
-                        cells_for(p.top_y_mm - p.gum_ridge_y_mm, 2.0 * resolution_mm));
+  return {map, cells_for(p.length_mm, resolution_mm), cells_for(width, resolution_mm),
+          cells_for(p.top_y_mm - p.gum_ridge_y_mm, 2.0 * resolution_mm)};
 }
 
-TriangleMesh make_jaw(const JawParameters& p, const TongueParameters& tongue,
-                      double resolution_mm) {
+TriangleMesh make_palate(const PalateParameters& p, double resolution_mm) {
+  return make_param_box(palate_box(p, resolution_mm));
+}
+
+ParamBox jaw_box(const JawParameters& p, const TongueParameters& tongue, double resolution_mm) {
   constexpr double kWallRiseMm = 3.0;       // inner face of the mandibular body, horizontal run
   constexpr double kRidgeBackSlopeMm = 4.0; // lingual slope of the lower gum ridge
   constexpr double kRidgeCrestMm = 2.0;     // crest width of the lower gum ridge
   constexpr double kMinThicknessMm = 3.0;   // bone under the floor never thinner than this
-  const auto map = [&](double u, double v, double w) {
+  const auto map = [p, tongue](double u, double v, double w) {
     const double lateral = 2.0 * v - 1.0;
-    const double x = arch_x(p.front_x_mm, p.length_mm, u, lateral);
-    const double half_width =
-        p.front_half_width_mm + (p.back_half_width_mm - p.front_half_width_mm) * std::pow(u, 0.8);
+    const double x = arch_x(p.front_x_mm, p.length_mm, kJawArchSweepBackMm, u, lateral);
+    const double half_width = p.front_half_width_mm + (p.back_half_width_mm - p.front_half_width_mm) *
+                                                          eased_power(u, 0.8, kJawWidthEase);
     const double z = lateral * half_width;
     // Floor: the tongue's attachment plane lowered by the gap.
     const double floor_y = tongue.floor_y_at_x15_mm + tongue.floor_slope * (x + 15.0) -
@@ -101,9 +125,13 @@ TriangleMesh make_jaw(const JawParameters& p, const TongueParameters& tongue,
     return Vec3(x, bottom + (top - bottom) * w, z);
   };
   const double width = 2.0 * p.back_half_width_mm;
-  return make_param_box(map, cells_for(p.length_mm, resolution_mm),
-                        cells_for(width, 0.75 * resolution_mm),
-                        cells_for(p.ridge_y_mm - p.bottom_y_mm, 2.0 * resolution_mm));
+  return {map, cells_for(p.length_mm, resolution_mm), cells_for(width, 0.75 * resolution_mm),
+          cells_for(p.ridge_y_mm - p.bottom_y_mm, 2.0 * resolution_mm)};
+}
+
+TriangleMesh make_jaw(const JawParameters& p, const TongueParameters& tongue,
+                      double resolution_mm) {
+  return make_param_box(jaw_box(p, tongue, resolution_mm));
 }
 
 TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {

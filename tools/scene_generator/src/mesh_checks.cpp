@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <utility>
+#include <vector>
 
 namespace fahr::scenegen {
 namespace {
@@ -90,12 +91,32 @@ ClosednessReport check_closed(const TriangleMesh& mesh) {
   // Directed edge counts keyed by (from, to); a closed, consistently oriented
   // surface runs every edge once in each direction.
   std::map<std::pair<int, int>, int> directed;
+  // Triangles of each undirected edge, for the fold test.
+  std::map<std::pair<int, int>, std::vector<int>> edge_triangles;
+  std::vector<Vec3> normals;
+  normals.reserve(mesh.triangles.size());
   ClosednessReport report;
   for (const auto& t : mesh.triangles) {
     const Vec3 n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
                        .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
-    if (n.norm() <= 1e-12) ++report.degenerate_triangles;
-    for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+    const bool degenerate = n.norm() <= 1e-12 || t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
+    if (degenerate) ++report.degenerate_triangles;
+    normals.push_back(degenerate ? Vec3::Zero() : Vec3(n.normalized()));
+    const int index = static_cast<int>(normals.size()) - 1;
+    for (int k = 0; k < 3; ++k) {
+      ++directed[{t[k], t[(k + 1) % 3]}];
+      const auto key = std::minmax(t[k], t[(k + 1) % 3]);
+      edge_triangles[{key.first, key.second}].push_back(index);
+    }
+  }
+  for (const auto& [edge, triangles] : edge_triangles) {
+    if (triangles.size() != 2) continue;
+    const Vec3& n1 = normals[static_cast<size_t>(triangles[0])];
+    const Vec3& n2 = normals[static_cast<size_t>(triangles[1])];
+    if (n1.isZero() || n2.isZero()) continue;
+    if ((n1 + n2).norm() < kFoldedNormalSum) ++report.folded_edges;
+    const double opening = 180.0 - std::acos(std::clamp(n1.dot(n2), -1.0, 1.0)) * 180.0 / kPi;
+    report.sharpest_edge_deg = std::min(report.sharpest_edge_deg, opening);
   }
   std::map<std::pair<int, int>, std::pair<int, int>> undirected;
   for (const auto& [edge, count] : directed) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <string>
 
 namespace fahr::scenegen {
 namespace {
@@ -40,6 +41,14 @@ std::string format_mm(double value) {
   char buffer[48];
   std::snprintf(buffer, sizeof(buffer), "%.4f", rounded);
   return buffer;
+}
+
+TriangleMesh as_written(const TriangleMesh& mesh) {
+  TriangleMesh rounded = mesh;
+  for (auto& v : rounded.vertices) {
+    for (int k = 0; k < 3; ++k) v[k] = std::stod(format_mm(v[k]));
+  }
+  return rounded;
 }
 
 bool write_tetgen(const TetMesh& mesh, const std::string& stem, const std::string& header,

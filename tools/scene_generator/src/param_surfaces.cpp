@@ -76,6 +76,62 @@ TriangleMesh make_param_box(const BoxMap& map, int nu, int nv, int nw) {
   return mesh;
 }
 
+TriangleMesh make_param_box(const ParamBox& box) {
+  return make_param_box(box.map, box.nu, box.nv, box.nw);
+}
+
+int folded_box_tets(const ParamBox& box) {
+  const int nu = box.nu;
+  const int nv = box.nv;
+  const int nw = box.nw;
+  std::vector<Vec3> lattice;
+  lattice.reserve(static_cast<size_t>((nu + 1) * (nv + 1) * (nw + 1)));
+  for (int i = 0; i <= nu; ++i) {
+    for (int j = 0; j <= nv; ++j) {
+      for (int k = 0; k <= nw; ++k) {
+        lattice.push_back(
+            box.map(grid_coordinate(i, nu), grid_coordinate(j, nv), grid_coordinate(k, nw)));
+      }
+    }
+  }
+  const auto at = [&](int i, int j, int k) -> const Vec3& {
+    return lattice[static_cast<size_t>((i * (nv + 1) + j) * (nw + 1) + k)];
+  };
+  // Kuhn split: a monotone path from corner (0,0,0) to (1,1,1) per axis
+  // permutation; the identity map gives each tet the volume sign(permutation) / 6.
+  constexpr int kPermutations[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1},
+                                       {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+  constexpr double kPermutationSign[6] = {1.0, 1.0, 1.0, -1.0, -1.0, -1.0};
+  int positive = 0;
+  int negative = 0;
+  int flat = 0;
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) {
+      for (int k = 0; k < nw; ++k) {
+        for (int p = 0; p < 6; ++p) {
+          int corner[3] = {i, j, k};
+          Vec3 tet[4];
+          tet[0] = at(corner[0], corner[1], corner[2]);
+          for (int step = 0; step < 3; ++step) {
+            ++corner[kPermutations[p][step]];
+            tet[step + 1] = at(corner[0], corner[1], corner[2]);
+          }
+          const double volume =
+              kPermutationSign[p] * (tet[1] - tet[0]).dot((tet[2] - tet[0]).cross(tet[3] - tet[0]));
+          if (volume > 0.0) {
+            ++positive;
+          } else if (volume < 0.0) {
+            ++negative;
+          } else {
+            ++flat;
+          }
+        }
+      }
+    }
+  }
+  return std::min(positive, negative) + flat;
+}
+
 TriangleMesh make_param_torus(const TorusMap& map, int n_around, int n_loop) {
   TriangleMesh mesh;
   for (int i = 0; i < n_around; ++i) {

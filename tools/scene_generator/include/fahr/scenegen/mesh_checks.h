@@ -19,12 +19,27 @@ double tet_min_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const V
 // Volume enclosed by a closed surface (mm^3); positive when outward oriented.
 double enclosed_volume(const TriangleMesh& mesh);
 
+// Two unit normals whose sum is shorter than this lie back to back; the same
+// threshold as fahr::geometry's kFoldedNormalSum (this library must not
+// depend on services/, so it is repeated here).
+inline constexpr double kFoldedNormalSum = 1e-6;
+
 struct ClosednessReport {
   int edge_count = 0;
   int bad_edges = 0;           // undirected edges not used by exactly two triangles
   int inconsistent_edges = 0;  // edges whose two triangles run them the same way
   int degenerate_triangles = 0;
+  // Edges whose two triangles lie back to back (anti-parallel normals): the
+  // surface folds onto itself with zero thickness there.
+  int folded_edges = 0;
+  // Smallest opening angle between the two triangles of an edge (180 = flat,
+  // 0 = folded), over edges shared by exactly two non-degenerate triangles.
+  double sharpest_edge_deg = 180.0;
   bool closed_and_oriented() const { return bad_edges == 0 && inconsistent_edges == 0; }
+  // Closed, oriented, and usable for a signed distance: no folds, no zero-area triangles.
+  bool clean() const {
+    return closed_and_oriented() && folded_edges == 0 && degenerate_triangles == 0;
+  }
 };
 ClosednessReport check_closed(const TriangleMesh& mesh);
 

@@ -25,4 +25,9 @@ bool write_index_list(const std::vector<int>& indices, const std::string& path,
 // the last rounding step).
 std::string format_mm(double value);
 
+// The mesh as write_obj puts it on disk: every coordinate rounded to the
+// written 0.1 um. Checks run on this, so a triangle that rounding flattens or
+// folds is caught before it is written.
+TriangleMesh as_written(const TriangleMesh& mesh);
+
 }  // namespace fahr::scenegen

@@ -15,6 +15,23 @@ namespace fahr::scenegen {
 using BoxMap = std::function<Vec3(double u, double v, double w)>;
 TriangleMesh make_param_box(const BoxMap& map, int nu, int nv, int nw);
 
+// A box map with its lattice, so the surface and its check see the same grid.
+struct ParamBox {
+  BoxMap map;
+  int nu = 1;
+  int nv = 1;
+  int nw = 1;
+};
+TriangleMesh make_param_box(const ParamBox& box);
+
+// Whether the map folds the box over itself at the lattice's resolution:
+// every lattice cell is split into six Kuhn tets and the tets whose image has
+// zero volume or the opposite orientation to the majority are counted. Zero
+// means the map is locally one-to-one on the lattice, so the boundary surface
+// cannot fold back over itself (an injective map also needs no two distant
+// cells to overlap, which this does not test).
+int folded_box_tets(const ParamBox& box);
+
 // Torus-topology surface: both parameters periodic on [0, 1). Good for rings
 // and thick-walled tubes (face around the mouth, larynx and trachea).
 using TorusMap = std::function<Vec3(double around, double loop)>;
