@@ -1,0 +1,47 @@
+// The system matrix A = mass_scale M + stiffness_scale K(R) on a sparsity
+// pattern fixed at set-up, written in place through an element-to-non-zero map.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fahr/fem/element_rest.h"
+#include "fahr/fem/material.h"
+
+namespace fahr::fem {
+
+// Column-major, both triangles stored (CG multiplies with it; CHOLMOD reads
+// the upper triangle only). Indices are int, as CHOLMOD_INT expects.
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+class SystemAssembly {
+ public:
+  // Builds the pattern of all node pairs sharing a tet (3x3 blocks) and the
+  // map from element blocks to non-zeros. fixed_dof[k] != 0 decouples DOF k:
+  // its row and column are zero apart from a positive diagonal.
+  void build(std::size_t node_count, const ElementRest& rest, std::span<const std::uint8_t> fixed_dof);
+
+  // Writes A = mass_scale diag(m) + stiffness_scale sum_e R_e K0_e R_e^T.
+  // mass_per_dof_kg has one entry per DOF. No allocation.
+  void assemble(const ElementRest& rest, std::span<const Eigen::Matrix3d> rotations,
+                const LameParameters& lame, std::span<const double> mass_per_dof_kg,
+                double mass_scale, double stiffness_scale);
+
+  const SparseMatrix& matrix() const { return a_; }
+  // Index into matrix().valuePtr() of each DOF's diagonal entry.
+  std::span<const int> diagonal_index() const { return diagonal_index_; }
+
+ private:
+  SparseMatrix a_;
+  // Per element, per block (a, b), per column c of the block: the index of the
+  // first of three contiguous row entries. 48 entries per element.
+  std::vector<std::uint32_t> block_column_start_;
+  std::vector<int> diagonal_index_;
+  std::vector<int> fixed_off_diagonal_;  // non-zeros zeroed for fixed DOFs
+  std::vector<int> fixed_diagonal_dof_;  // DOFs whose diagonal is set alone
+};
+
+}  // namespace fahr::fem

@@ -1,0 +1,179 @@
+// One deformable body: corotational linear FEM on tetrahedra, one linearised
+// implicit Euler step per call, then the Algorithm 1 projection of a
+// ContactSet, and contact compliance on request.
+//
+// The step (with v the velocity, f the corotated elastic force plus gravity
+// and external forces, all at the start of the step):
+//   M (v' - v) = h (f - D v' - K h v'),   D = alpha M + beta K,  K = R K0 R^T
+//   =>  A v' = M v + h f,   A = (1 + h alpha) M + (h beta + h^2) K
+//   x' = x + h v'
+// which is one Newton step of backward Euler with f linearised about x
+// (Baraff and Witkin 1998; Mueller and Gross 2004 for the corotation). The
+// right-hand side needs no K, so a lagged A only changes the dynamics, never
+// the static equilibrium. Fixed DOFs are decoupled rows with v' = 0.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "fahr/fem/assembly.h"
+#include "fahr/fem/cg_solver.h"
+#include "fahr/fem/cholmod_solver.h"
+#include "fahr/fem/compliance.h"
+#include "fahr/fem/contact_set.h"
+#include "fahr/fem/element_rest.h"
+#include "fahr/fem/material.h"
+#include "fahr/fem/projection.h"
+#include "fahr/fem/sleep.h"
+#include "fahr/fem/solver_settings.h"
+#include "fahr/fem/sphere_links.h"
+#include "fahr/fem/warped_factor.h"
+
+namespace fahr::fem {
+
+struct BodySettings {
+  Material material = neonatal_tongue();
+  std::chrono::duration<double> time_step{0.002};             // h, s, > 0
+  Eigen::Vector3d gravity_m_per_s2{0.0, -9.81, 0.0};           // m/s^2, body frame
+  SolverSettings solver;
+  ProjectionSettings projection;
+  SleepSettings sleep;
+  // A ContactSet whose state_step is more than this many steps behind the
+  // body's step (or ahead of it) is ignored and counted as stale.
+  std::uint64_t max_contact_age_steps = 4;
+  std::size_t max_compliance_spheres = 64;  // capacity of compliance()
+};
+
+struct StepReport {
+  std::uint64_t step = 0;    // steps taken so far, this one included
+  double time_s = 0.0;       // simulated time after the step, s
+  bool asleep = false;       // no solve was done
+  bool refactorised = false; // a numeric factorisation happened this step
+  bool solve_failed = false; // non-finite or failed solve: state kept, v = 0
+  int solver_iterations = 0; // CG iterations (0 for a direct solve)
+  double solver_relative_residual = 0.0;
+  int inverted_elements = 0; // det F <= 0 at the start of the step
+  bool contacts_applied = false;
+  bool contacts_stale = false;
+  bool contacts_invalid = false;  // links reference nodes this body lacks
+  ProjectionReport projection;
+  double kinetic_energy_j = 0.0;  // after the step, J
+  double residual_force_n = 0.0;  // |f| over free DOFs at the start, N
+};
+
+struct Energy {
+  double kinetic_j = 0.0;
+  double elastic_j = 0.0;            // corotational strain energy, J
+  double gravity_potential_j = 0.0;  // -m g . x summed, J (relative to origin)
+  double total_j() const { return kinetic_j + elastic_j + gravity_potential_j; }
+};
+
+class Body;
+
+struct BodyOrError {
+  std::unique_ptr<Body> body;
+  std::string error;  // empty on success
+};
+
+class Body {
+ public:
+  // Set-up: rest data, lumped mass, sparsity pattern, symbolic analysis and
+  // the first factorisation. rest_positions_m: one per node, m. tets: four
+  // node indices each, positive volume. fixed_nodes: never move.
+  static BodyOrError create(const BodySettings& settings, std::span<const Eigen::Vector3d> rest_positions_m,
+                            std::span<const Tet> tets, std::span<const std::uint32_t> fixed_nodes);
+
+  // One step. `contacts` may be null (no set this step); `links` is needed
+  // when contacts are given. No allocation after the first step, apart from
+  // CHOLMOD's own (malloc) workspace on refactorisation steps.
+  StepReport step(const ContactSet* contacts = nullptr, const SphereLinks* links = nullptr);
+
+  // W = h^2 J A^-1 J^T for the listed spheres, (3k x 3k) row-major float,
+  // m/N, from the solver's factorisation: exact when it was refactorised this
+  // step (kCholmod with refactor_period 1), the lagged A otherwise.
+  bool compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links, std::span<float> out);
+
+  // External nodal force, N, held until changed; a non-zero force wakes.
+  void set_external_force(std::uint32_t node, const Eigen::Vector3d& force_n);
+  void clear_external_forces();
+  // Teleports a node (a test's yank), m; velocity unchanged. Wakes the body.
+  void set_node_position(std::uint32_t node, const Eigen::Vector3d& position_m);
+  void set_velocities_zero();
+  void wake();
+
+  // Corotational elastic force of the current positions, 3 per node, N.
+  void elastic_forces(std::span<double> out_n);
+  Energy energy();
+
+  std::size_t node_count() const { return mass_kg_.size(); }
+  std::size_t element_count() const { return rest_.size(); }
+  std::span<const double> positions_m() const { return {x_.data(), static_cast<std::size_t>(x_.size())}; }
+  std::span<const double> velocities_m_per_s() const { return {v_.data(), static_cast<std::size_t>(v_.size())}; }
+  Eigen::Vector3d position(std::uint32_t node) const { return x_.segment<3>(3 * Eigen::Index{node}); }
+  Eigen::Vector3d rest_position(std::uint32_t node) const { return rest_x_.segment<3>(3 * Eigen::Index{node}); }
+  std::span<const double> mass_kg() const { return mass_kg_; }
+  std::span<const double> inverse_mass_per_kg() const { return inverse_mass_; }
+  bool fixed(std::uint32_t node) const { return inverse_mass_[node] == 0.0; }
+  bool asleep() const { return sleep_.asleep(); }
+  std::uint64_t step_index() const { return step_; }
+  std::uint64_t stale_sets_ignored() const { return stale_sets_; }
+  std::uint64_t invalid_sets_ignored() const { return invalid_sets_; }
+  double time_step_s() const { return h_; }
+  double total_mass_kg() const { return total_mass_kg_; }
+  const BodySettings& settings() const { return settings_; }
+  const SparseMatrix& system_matrix() const { return assembly_.matrix(); }
+  double factor_nonzeros() const { return cholmod_.factor_nonzeros(); }
+
+ private:
+  Body() = default;
+  std::string initialise(std::span<const Eigen::Vector3d> rest_positions_m, std::span<const Tet> tets,
+                         std::span<const std::uint32_t> fixed_nodes);
+  // Rotations, elastic forces into force_ (accumulated), inverted count.
+  int update_rotations_and_forces(bool accumulate_energy, double* elastic_energy_j);
+  // The stages of step().
+  void compute_forces(StepReport& report);
+  void prepare_system(StepReport& report);
+  void solve_velocity(StepReport& report);
+  void integrate_and_project(const ContactSet* contacts, const SphereLinks* links, StepReport& report);
+  void finish_step(StepReport& report);
+  void assemble_system();
+  bool refactorise();
+  // True if an element rotated more than the setting since the factorisation.
+  bool rotated_since_factor() const;
+  bool accept_contacts(const ContactSet* contacts, const SphereLinks* links, StepReport& report);
+  double kinetic_energy() const;
+
+  BodySettings settings_;
+  double h_ = 0.0;
+  LameParameters lame_;
+  ElementRest rest_;
+  std::vector<double> mass_kg_;        // per node
+  std::vector<double> inverse_mass_;   // per node, 0 when fixed
+  std::vector<double> mass_per_dof_;   // per DOF, massless nodes get the mean
+  std::vector<std::uint8_t> fixed_dof_;
+  double total_mass_kg_ = 0.0;
+
+  Eigen::VectorXd rest_x_, x_, v_, x_start_, force_, external_force_, gravity_force_, rhs_, v_next_;
+  std::vector<Eigen::Matrix3d> rotations_;
+  std::vector<Eigen::Matrix3d> rotations_at_factor_;
+
+  SystemAssembly assembly_;
+  CholmodSolver cholmod_;
+  WarpedFactor warp_;
+  CgSolver cg_;
+  ComplianceBlock compliance_;
+  SleepMonitor sleep_;
+  int steps_since_factor_ = 0;
+  bool external_force_set_ = false;
+  std::uint64_t step_ = 0;
+  std::uint64_t stale_sets_ = 0;
+  std::uint64_t invalid_sets_ = 0;
+};
+
+}  // namespace fahr::fem

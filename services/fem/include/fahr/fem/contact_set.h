@@ -1,0 +1,42 @@
+// The library-side view of the haptic-to-FEM contact contract (DESIGN.md,
+// "The contact contract"): absolute constraints, not deltas.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace fahr::fem {
+
+enum class ContactKind : std::uint8_t {
+  kTool,      // force-aware: active or frozen as the haptic side decides
+  kObstacle,  // palate, jaw: always a hard non-penetration constraint
+};
+
+enum class ContactState : std::uint8_t {
+  kActive,     // (c' - q) . n >= r
+  kFrozen,     // c' = hold_centre_m
+  kCandidate,  // near, not touching: only its compliance is wanted
+};
+
+struct Contact {
+  std::uint32_t sphere_id = 0;  // index into SphereLinks
+  ContactKind kind = ContactKind::kTool;
+  ContactState state = ContactState::kCandidate;
+  // Contact plane: the nearest point of the rigid surface, m (body frame),
+  // and the unit normal pointing from that surface toward the sphere centre.
+  Eigen::Vector3d plane_point_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d hold_centre_m = Eigen::Vector3d::Zero();  // frozen target, m
+  double penetration_m = 0.0;  // as the haptic side saw it, m (reported only)
+  double force_n = 0.0;        // contact force lambda the haptic solve found, N
+};
+
+struct ContactSet {
+  // The FEM step whose state the haptic side used; a set older than the
+  // body's maximum age (in steps) is ignored and counted as stale.
+  std::uint64_t state_step = 0;
+  std::vector<Contact> contacts;  // projected in this order
+};
+
+}  // namespace fahr::fem

@@ -1,0 +1,30 @@
+// Linear elastic material in SI units and Rayleigh damping coefficients.
+#pragma once
+
+namespace fahr::fem {
+
+// Isotropic linear elasticity (used in the rotated frame of each element) and
+// Rayleigh damping D = alpha M + beta K.
+struct Material {
+  double youngs_modulus_pa = 7740.0;   // E, Pa, > 0
+  double poisson_ratio = 0.45;         // nu, dimensionless, in [0, 0.5)
+  double density_kg_per_m3 = 1040.0;   // rho, kg/m^3, > 0
+  double rayleigh_mass_per_s = 1.0;    // alpha, 1/s, >= 0
+  double rayleigh_stiffness_s = 0.01;  // beta, s, >= 0
+};
+
+// Defaults for neonatal tongue tissue. No neonatal measurement is known to
+// us; the stiffness is the adult in-vivo value, see material.cpp for sources.
+Material neonatal_tongue();
+
+struct LameParameters {
+  double lambda_pa = 0.0;  // first Lame parameter, Pa
+  double mu_pa = 0.0;      // shear modulus, Pa
+};
+
+LameParameters lame_parameters(const Material& material);
+
+// Empty when valid, otherwise a sentence naming the offending field.
+const char* validate(const Material& material);
+
+}  // namespace fahr::fem

@@ -1,0 +1,43 @@
+// Settings of the linear solve inside the implicit Euler step.
+#pragma once
+
+#include "fahr/fem/cg_solver.h"
+
+namespace fahr::fem {
+
+enum class LinearSolver {
+  kCholmod,            // direct, on a factorisation of A (current or lagged)
+  kConjugateGradient,  // iterative, on the current A, warm-started from v
+};
+
+struct SolverSettings {
+  LinearSolver kind = LinearSolver::kCholmod;
+  // Steps between numeric refactorisations of A (for kCholmod the solve, for
+  // CG the lagged-Cholesky preconditioner and the compliance factor).
+  // 1: every step, the exact linearised implicit Euler step.
+  // N > 1: the factorisation of an earlier A is reused for N steps.
+  // 0: only the rest matrix, factorised once at set-up.
+  // Reusing a factorisation changes the dynamics (the Jacobian is lagged) but
+  // not the static equilibrium, because the force is always exact.
+  int refactor_period = 1;
+  // Also refactorise when some element has rotated by more than this since
+  // the last factorisation, rad (0 disables). A factorisation is only wrong
+  // by the rotation of the material (the material is linear in its rotated
+  // frame), so this is "factorise when the matrix changes": 0.1 rad (6
+  // degrees) keeps the lagged Jacobian close enough that the step stays
+  // damped (a never-refreshed factor oscillates at 45 degrees), while a
+  // body deforming gently refactorises rarely.
+  double refactor_rotation_rad = 0.1;
+  // Rotate a reused factorisation per node into the current frame (see
+  // warped_factor.h). Off only to measure what it buys.
+  bool warp_lagged_factor = false;
+  // Factor kind and fill-reducing ordering of the CHOLMOD factorisation.
+  CholmodOptions cholmod;
+  CgPreconditioner preconditioner = CgPreconditioner::kJacobi;
+  // |b - A v| <= tolerance |b|: 1e-6 makes the velocity error far below the
+  // per-step change at haptic rates; looser budgets are benchmarked.
+  double cg_relative_tolerance = 1e-6;
+  int cg_max_iterations = 100;
+};
+
+}  // namespace fahr::fem

@@ -1,0 +1,132 @@
+// Pattern building once, value writing every step.
+#include "fahr/fem/assembly.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace fahr::fem {
+namespace {
+
+std::vector<std::vector<std::uint32_t>> node_neighbours(std::size_t node_count, const ElementRest& rest) {
+  std::vector<std::vector<std::uint32_t>> neighbours(node_count);
+  for (std::size_t i = 0; i < node_count; ++i) neighbours[i].push_back(static_cast<std::uint32_t>(i));
+  for (const Tet& tet : rest.tets) {
+    for (const std::uint32_t a : tet) {
+      for (const std::uint32_t b : tet) neighbours[a].push_back(b);
+    }
+  }
+  for (auto& list : neighbours) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return neighbours;
+}
+
+}  // namespace
+
+void SystemAssembly::build(std::size_t node_count, const ElementRest& rest,
+                           std::span<const std::uint8_t> fixed_dof) {
+  const auto neighbours = node_neighbours(node_count, rest);
+  const std::size_t dofs = 3 * node_count;
+  std::vector<int> outer(dofs + 1, 0);
+  for (std::size_t j = 0; j < node_count; ++j) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      outer[3 * j + c + 1] = outer[3 * j + c] + static_cast<int>(3 * neighbours[j].size());
+    }
+  }
+  const auto nnz = static_cast<std::size_t>(outer[dofs]);
+  std::vector<int> inner(nnz);
+  for (std::size_t j = 0; j < node_count; ++j) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      auto k = static_cast<std::size_t>(outer[3 * j + c]);
+      for (const std::uint32_t i : neighbours[j]) {
+        for (std::size_t r = 0; r < 3; ++r) inner[k++] = static_cast<int>(3 * i + r);
+      }
+    }
+  }
+  const auto dofs_index = static_cast<Eigen::Index>(dofs);
+  a_.resize(dofs_index, dofs_index);
+  a_.resizeNonZeros(static_cast<Eigen::Index>(nnz));
+  std::copy(outer.begin(), outer.end(), a_.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), a_.innerIndexPtr());
+  std::fill(a_.valuePtr(), a_.valuePtr() + nnz, 0.0);
+
+  auto rank_of = [&](std::uint32_t column_node, std::uint32_t row_node) {
+    const auto& list = neighbours[column_node];
+    return static_cast<std::size_t>(std::lower_bound(list.begin(), list.end(), row_node) - list.begin());
+  };
+  block_column_start_.resize(48 * rest.size());
+  for (std::size_t e = 0; e < rest.size(); ++e) {
+    const Tet& tet = rest.tets[e];
+    for (std::size_t a = 0; a < 4; ++a) {
+      for (std::size_t b = 0; b < 4; ++b) {
+        const std::size_t rank = rank_of(tet[b], tet[a]);
+        for (std::size_t c = 0; c < 3; ++c) {
+          block_column_start_[48 * e + 12 * a + 3 * b + c] =
+              static_cast<std::uint32_t>(static_cast<std::size_t>(outer[3 * tet[b] + c]) + 3 * rank);
+        }
+      }
+    }
+  }
+  diagonal_index_.resize(dofs);
+  for (std::size_t j = 0; j < node_count; ++j) {
+    const std::size_t rank = rank_of(static_cast<std::uint32_t>(j), static_cast<std::uint32_t>(j));
+    for (std::size_t c = 0; c < 3; ++c) {
+      diagonal_index_[3 * j + c] = outer[3 * j + c] + static_cast<int>(3 * rank + c);
+    }
+  }
+  fixed_off_diagonal_.clear();
+  fixed_diagonal_dof_.clear();
+  for (std::size_t col = 0; col < dofs; ++col) {
+    if (fixed_dof[col] != 0) fixed_diagonal_dof_.push_back(static_cast<int>(col));
+    for (int k = outer[col]; k < outer[col + 1]; ++k) {
+      const auto row = static_cast<std::size_t>(inner[static_cast<std::size_t>(k)]);
+      if (row != col && (fixed_dof[row] != 0 || fixed_dof[col] != 0)) fixed_off_diagonal_.push_back(k);
+    }
+  }
+}
+
+void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Matrix3d> rotations,
+                              const LameParameters& lame, std::span<const double> mass_per_dof_kg,
+                              double mass_scale, double stiffness_scale) {
+  double* values = a_.valuePtr();
+  std::memset(values, 0, sizeof(double) * static_cast<std::size_t>(a_.nonZeros()));
+  for (std::size_t e = 0; e < rest.size(); ++e) {
+    // Rotated gradients r_a = R g_a give R K_ab R^T =
+    // V (lambda r_a r_b^T + mu r_b r_a^T + mu (g_a . g_b) I).
+    const Eigen::Matrix<double, 3, 4>& g = rest.gradients[e];
+    const Eigen::Matrix<double, 3, 4> r = rotations[e] * g;
+    const double scale = stiffness_scale * rest.volume_m3[e];
+    const double lambda = scale * lame.lambda_pa;
+    const double mu = scale * lame.mu_pa;
+    const std::uint32_t* starts = &block_column_start_[48 * e];
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        const double shear_diagonal = mu * g.col(a).dot(g.col(b));
+        for (int c = 0; c < 3; ++c) {
+          double* column = values + starts[12 * a + 3 * b + c];
+          const double rbc = r(c, b);
+          const double rac = r(c, a);
+          for (int d = 0; d < 3; ++d) {
+            column[d] += lambda * r(d, a) * rbc + mu * r(d, b) * rac;
+          }
+          column[c] += shear_diagonal;
+        }
+      }
+    }
+  }
+  const std::size_t dofs = diagonal_index_.size();
+  for (std::size_t k = 0; k < dofs; ++k) {
+    values[diagonal_index_[k]] += mass_scale * mass_per_dof_kg[k];
+  }
+  for (const int k : fixed_off_diagonal_) values[k] = 0.0;
+  // A fixed DOF keeps only its mass term: the row reads m v = 0, and the
+  // diagonal stays of the size of its neighbours for conditioning (the body
+  // gives massless nodes a representative mass for this).
+  for (const int dof : fixed_diagonal_dof_) {
+    const auto k = static_cast<std::size_t>(dof);
+    values[diagonal_index_[k]] = mass_scale * mass_per_dof_kg[k];
+  }
+}
+
+}  // namespace fahr::fem

@@ -1,0 +1,337 @@
+// The per-step pipeline of one body: forces, system, solve, projection, sleep.
+#include "fahr/fem/body.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "fahr/fem/corotation.h"
+#include "fahr/fem/lumped_mass.h"
+
+namespace fahr::fem {
+
+BodyOrError Body::create(const BodySettings& settings, std::span<const Eigen::Vector3d> rest_positions_m,
+                         std::span<const Tet> tets, std::span<const std::uint32_t> fixed_nodes) {
+  BodyOrError result;
+  const std::string material_error = validate(settings.material);
+  if (!material_error.empty()) {
+    result.error = material_error;
+    return result;
+  }
+  if (!(settings.time_step.count() > 0.0) || !std::isfinite(settings.time_step.count())) {
+    result.error = "time_step must be finite and > 0";
+    return result;
+  }
+  if (settings.solver.refactor_period < 0 || settings.solver.cg_max_iterations < 0 ||
+      !(settings.solver.cg_relative_tolerance >= 0.0)) {
+    result.error = "solver settings: refactor_period and cg_max_iterations must be >= 0, tolerance >= 0";
+    return result;
+  }
+  if (!settings.gravity_m_per_s2.allFinite()) {
+    result.error = "gravity_m_per_s2 must be finite";
+    return result;
+  }
+  std::unique_ptr<Body> body(new Body());
+  body->settings_ = settings;
+  result.error = body->initialise(rest_positions_m, tets, fixed_nodes);
+  if (result.error.empty()) result.body = std::move(body);
+  return result;
+}
+
+std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m, std::span<const Tet> tets,
+                             std::span<const std::uint32_t> fixed_nodes) {
+  if (rest_positions_m.empty() || tets.empty()) return "mesh has no nodes or no tets";
+  std::string error = build_element_rest(rest_positions_m, tets, rest_);
+  if (!error.empty()) return error;
+  const std::size_t n = rest_positions_m.size();
+  const auto dofs = static_cast<Eigen::Index>(3 * n);
+  h_ = settings_.time_step.count();
+  lame_ = lame_parameters(settings_.material);
+  mass_kg_ = lumped_mass(rest_, n, settings_.material.density_kg_per_m3);
+  inverse_mass_.assign(n, 0.0);
+  fixed_dof_.assign(3 * n, 0);
+  for (const std::uint32_t node : fixed_nodes) {
+    if (node >= n) return "fixed node " + std::to_string(node) + " out of range";
+    for (std::size_t d = 0; d < 3; ++d) fixed_dof_[3 * node + d] = 1;
+  }
+  total_mass_kg_ = 0.0;
+  for (const double m : mass_kg_) total_mass_kg_ += m;
+  const double mean_mass = total_mass_kg_ / static_cast<double>(n);
+  mass_per_dof_.assign(3 * n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    // A node in no tet has no mass and no stiffness: it is held fixed, and
+    // its decoupled row gets a representative mass for conditioning.
+    if (!(mass_kg_[i] > 0.0)) {
+      for (std::size_t d = 0; d < 3; ++d) fixed_dof_[3 * i + d] = 1;
+    }
+    if (fixed_dof_[3 * i] == 0) inverse_mass_[i] = 1.0 / mass_kg_[i];
+    for (std::size_t d = 0; d < 3; ++d) mass_per_dof_[3 * i + d] = mass_kg_[i] > 0.0 ? mass_kg_[i] : mean_mass;
+  }
+  rest_x_.resize(dofs);
+  for (std::size_t i = 0; i < n; ++i) rest_x_.segment<3>(3 * static_cast<Eigen::Index>(i)) = rest_positions_m[i];
+  x_ = rest_x_;
+  v_.setZero(dofs);
+  x_start_.setZero(dofs);
+  force_.setZero(dofs);
+  external_force_.setZero(dofs);
+  rhs_.setZero(dofs);
+  v_next_.setZero(dofs);
+  gravity_force_.setZero(dofs);
+  for (std::size_t i = 0; i < n; ++i) {
+    gravity_force_.segment<3>(3 * static_cast<Eigen::Index>(i)) = mass_kg_[i] * settings_.gravity_m_per_s2;
+  }
+  rotations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
+  rotations_at_factor_ = rotations_;
+  assembly_.build(n, rest_, fixed_dof_);
+  cg_.resize(3 * n);
+  compliance_.reserve(3 * n, settings_.max_compliance_spheres);
+  warp_.resize(n);
+  warp_.set_enabled(settings_.solver.warp_lagged_factor);
+  if (!cholmod_.analyze(assembly_.matrix(), settings_.solver.cholmod)) return "CHOLMOD symbolic analysis failed";
+  assemble_system();
+  if (!refactorise()) return "the rest system matrix is not positive definite";
+  return {};
+}
+
+void Body::assemble_system() {
+  const double alpha = settings_.material.rayleigh_mass_per_s;
+  const double beta = settings_.material.rayleigh_stiffness_s;
+  assembly_.assemble(rest_, rotations_, lame_, mass_per_dof_, 1.0 + h_ * alpha, h_ * beta + h_ * h_);
+}
+
+bool Body::refactorise() {
+  steps_since_factor_ = 0;
+  std::copy(rotations_.begin(), rotations_.end(), rotations_at_factor_.begin());
+  warp_.mark_factorised();
+  return cholmod_.factorize();
+}
+
+int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_energy_j) {
+  int inverted = 0;
+  const double* x = x_.data();
+  double* f = force_.data();
+  for (std::size_t e = 0; e < rest_.size(); ++e) {
+    const Tet& tet = rest_.tets[e];
+    const Eigen::Map<const Eigen::Vector3d> x0(x + 3 * std::size_t{tet[0]});
+    Eigen::Matrix3d ds;
+    ds.col(0) = Eigen::Map<const Eigen::Vector3d>(x + 3 * std::size_t{tet[1]}) - x0;
+    ds.col(1) = Eigen::Map<const Eigen::Vector3d>(x + 3 * std::size_t{tet[2]}) - x0;
+    ds.col(2) = Eigen::Map<const Eigen::Vector3d>(x + 3 * std::size_t{tet[3]}) - x0;
+    const Eigen::Matrix3d deformation = ds * rest_.dm_inv[e];
+    const Corotation corotation = rotation_from_deformation(deformation);
+    inverted += corotation.inverted ? 1 : 0;
+    const Eigen::Matrix3d& r = corotation.rotation;
+    rotations_[e] = r;
+    // Small strain in the rotated frame, linear stress, rotated back:
+    // f = -R K0 (R^T x - X) written per element as -V P Dm^-T.
+    const Eigen::Matrix3d unrotated = r.transpose() * deformation;
+    const Eigen::Matrix3d strain = 0.5 * (unrotated + unrotated.transpose()) - Eigen::Matrix3d::Identity();
+    const double trace = strain.trace();
+    Eigen::Matrix3d stress = 2.0 * lame_.mu_pa * strain;
+    stress.diagonal().array() += lame_.lambda_pa * trace;
+    const double volume = rest_.volume_m3[e];
+    const Eigen::Matrix3d h = -volume * (r * stress) * rest_.dm_inv[e].transpose();
+    Eigen::Map<Eigen::Vector3d>(f + 3 * std::size_t{tet[0]}) -= h.col(0) + h.col(1) + h.col(2);
+    for (Eigen::Index a = 0; a < 3; ++a) {
+      Eigen::Map<Eigen::Vector3d>(f + 3 * std::size_t{tet[static_cast<std::size_t>(a + 1)]}) += h.col(a);
+    }
+    if (accumulate_energy) {
+      *elastic_energy_j += volume * (lame_.mu_pa * strain.squaredNorm() + 0.5 * lame_.lambda_pa * trace * trace);
+    }
+  }
+  return inverted;
+}
+
+bool Body::rotated_since_factor() const {
+  const double threshold = settings_.solver.refactor_rotation_rad;
+  if (!(threshold > 0.0)) return false;
+  // The angle of R_now R_then^T exceeds the threshold iff its trace,
+  // sum_ij R_now(i,j) R_then(i,j), is below 1 + 2 cos(threshold).
+  const double min_trace = 1.0 + 2.0 * std::cos(threshold);
+  for (std::size_t e = 0; e < rotations_.size(); ++e) {
+    if (rotations_[e].cwiseProduct(rotations_at_factor_[e]).sum() < min_trace) return true;
+  }
+  return false;
+}
+
+bool Body::accept_contacts(const ContactSet* contacts, const SphereLinks* links, StepReport& report) {
+  if (contacts == nullptr || links == nullptr || contacts->contacts.empty()) return false;
+  if (links->node_bound() > node_count()) {
+    // Links built for another mesh: using them would index past the arrays.
+    ++invalid_sets_;
+    report.contacts_invalid = true;
+    return false;
+  }
+  // Unsigned arithmetic: a set from the future wraps to a huge age, so it is
+  // rejected as well (it cannot refer to a state this body has produced).
+  const std::uint64_t age = step_ - contacts->state_step;
+  if (contacts->state_step > step_ || age > settings_.max_contact_age_steps) {
+    ++stale_sets_;
+    report.contacts_stale = true;
+    return false;
+  }
+  return true;
+}
+
+double Body::kinetic_energy() const {
+  double energy = 0.0;
+  for (std::size_t i = 0; i < mass_kg_.size(); ++i) {
+    energy += 0.5 * mass_kg_[i] * v_.segment<3>(3 * static_cast<Eigen::Index>(i)).squaredNorm();
+  }
+  return energy;
+}
+
+void Body::finish_step(StepReport& report) {
+  ++step_;
+  report.step = step_;
+  report.time_s = static_cast<double>(step_) * h_;
+}
+
+void Body::compute_forces(StepReport& report) {
+  force_ = gravity_force_ + external_force_;
+  report.inverted_elements = update_rotations_and_forces(false, nullptr);
+  double residual_squared = 0.0;
+  for (Eigen::Index k = 0; k < force_.size(); ++k) {
+    if (fixed_dof_[static_cast<std::size_t>(k)] == 0) residual_squared += force_[k] * force_[k];
+  }
+  report.residual_force_n = std::sqrt(residual_squared);
+}
+
+void Body::prepare_system(StepReport& report) {
+  const SolverSettings& solver = settings_.solver;
+  const bool cg = solver.kind == LinearSolver::kConjugateGradient;
+  const bool factor_needed = !cg || solver.preconditioner == CgPreconditioner::kLaggedCholesky;
+  const bool factor_due = (solver.refactor_period > 0 && steps_since_factor_ + 1 >= solver.refactor_period) ||
+                          (factor_needed && solver.refactor_period != 1 && rotated_since_factor());
+  if (factor_needed) warp_.update_rotations(rest_, rotations_);
+  // CG multiplies with the current A; the direct solve only needs A when it
+  // refactorises.
+  if (cg || (factor_due && factor_needed)) assemble_system();
+  if (factor_due && factor_needed) {
+    report.refactorised = refactorise();
+  } else {
+    ++steps_since_factor_;
+  }
+}
+
+void Body::solve_velocity(StepReport& report) {
+  for (Eigen::Index k = 0; k < rhs_.size(); ++k) {
+    const auto dof = static_cast<std::size_t>(k);
+    rhs_[k] = fixed_dof_[dof] != 0 ? 0.0 : mass_per_dof_[dof] * v_[k] + h_ * force_[k];
+  }
+  const SolverSettings& solver = settings_.solver;
+  const auto dofs = static_cast<std::size_t>(rhs_.size());
+  if (solver.kind == LinearSolver::kConjugateGradient) {
+    v_next_ = v_;  // warm start from the previous velocity
+    const CgResult result = cg_.solve(assembly_.matrix(), assembly_.diagonal_index(), {rhs_.data(), dofs},
+                                      {v_next_.data(), dofs}, solver.cg_relative_tolerance,
+                                      solver.cg_max_iterations, solver.preconditioner, &cholmod_, &warp_);
+    report.solver_iterations = result.iterations;
+    report.solver_relative_residual = result.relative_residual;
+  } else {
+    warp_.solve(cholmod_, rhs_.data(), v_next_.data());
+  }
+}
+
+void Body::integrate_and_project(const ContactSet* contacts, const SphereLinks* links, StepReport& report) {
+  x_start_ = x_;
+  x_ += h_ * v_next_;
+  if (contacts == nullptr) {
+    v_ = v_next_;
+    return;
+  }
+  report.contacts_applied = true;
+  report.projection = project_contacts(*contacts, *links, inverse_mass_, settings_.projection,
+                                       {x_.data(), static_cast<std::size_t>(x_.size())});
+  v_ = (x_ - x_start_) / h_;
+}
+
+StepReport Body::step(const ContactSet* contacts, const SphereLinks* links) {
+  StepReport report;
+  const bool use_contacts = accept_contacts(contacts, links, report);
+  bool touching = external_force_set_;
+  if (use_contacts) {
+    for (const Contact& contact : contacts->contacts) touching = touching || contact_is_projected(contact);
+  }
+  if (sleep_.asleep() && touching) sleep_.wake();
+  if (sleep_.asleep()) {
+    report.asleep = true;
+    finish_step(report);
+    return report;
+  }
+  // 1. forces at x^n, 2. A as the solver settings ask, 3. A v' = M v + h f.
+  compute_forces(report);
+  prepare_system(report);
+  solve_velocity(report);
+  if (!v_next_.allFinite()) {
+    // Guard against a broken factorisation or CG breakdown: keep the state,
+    // stop the motion, and report; never publish NaN.
+    report.solve_failed = true;
+    v_.setZero();
+    finish_step(report);
+    return report;
+  }
+  // 4. x' = x + h v', Algorithm 1 projection, v = (x~ - x^n) / h.
+  integrate_and_project(use_contacts ? contacts : nullptr, links, report);
+  // 5. Sleep bookkeeping.
+  report.kinetic_energy_j = kinetic_energy();
+  const double weight = total_mass_kg_ * settings_.gravity_m_per_s2.norm();
+  if (sleep_.update(settings_.sleep, report.kinetic_energy_j, total_mass_kg_, report.residual_force_n, weight,
+                    touching)) {
+    v_.setZero();
+  }
+  finish_step(report);
+  return report;
+}
+
+bool Body::compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links, std::span<float> out) {
+  const SolverSettings& solver = settings_.solver;
+  const bool factor_unused = solver.kind == LinearSolver::kConjugateGradient &&
+                             solver.preconditioner == CgPreconditioner::kJacobi;
+  if (factor_unused && solver.refactor_period > 0 && steps_since_factor_ >= solver.refactor_period) {
+    // Jacobi-CG keeps no factorisation per step; A of the last step is
+    // assembled, so refresh the factor from it when it is older than asked.
+    warp_.update_rotations(rest_, rotations_);
+    if (!refactorise()) return false;
+  }
+  if (factor_unused) warp_.update_rotations(rest_, rotations_);
+  return compliance_.compute(spheres, links, fixed_dof_, cholmod_, warp_, h_, out);
+}
+
+void Body::set_external_force(std::uint32_t node, const Eigen::Vector3d& force_n) {
+  external_force_.segment<3>(3 * Eigen::Index{node}) = force_n;
+  if (force_n.squaredNorm() > 0.0) {
+    external_force_set_ = true;
+    sleep_.wake();
+  }
+}
+
+void Body::clear_external_forces() {
+  external_force_.setZero();
+  external_force_set_ = false;
+}
+
+void Body::set_node_position(std::uint32_t node, const Eigen::Vector3d& position_m) {
+  x_.segment<3>(3 * Eigen::Index{node}) = position_m;
+  sleep_.wake();
+}
+
+void Body::set_velocities_zero() { v_.setZero(); }
+
+void Body::wake() { sleep_.wake(); }
+
+void Body::elastic_forces(std::span<double> out_n) {
+  force_.setZero();
+  update_rotations_and_forces(false, nullptr);
+  std::copy(force_.data(), force_.data() + force_.size(), out_n.begin());
+}
+
+Energy Body::energy() {
+  Energy energy;
+  force_.setZero();
+  update_rotations_and_forces(true, &energy.elastic_j);
+  energy.kinetic_j = kinetic_energy();
+  energy.gravity_potential_j = -gravity_force_.dot(x_);
+  return energy;
+}
+
+}  // namespace fahr::fem

@@ -1,0 +1,59 @@
+// Material defaults and their sources.
+#include "fahr/fem/material.h"
+
+#include <cmath>
+
+namespace fahr::fem {
+
+// Stiffness: Cheng, Gandevia, Green, Sinkus and Bilston measured the tongue of
+// seven adults in vivo with magnetic resonance elastography and report a
+// storage shear modulus of 2.67 +- 0.29 kPa ("Viscoelastic properties of the
+// tongue and soft palate using MR elastography", J Biomech 44(3):450-454,
+// 2011, https://pubmed.ncbi.nlm.nih.gov/21040923/). With nu = 0.45,
+// E = 2 G (1 + nu) = 7.74 kPa. Neonatal values were not found; adult tissue
+// stands in until a measurement exists.
+// Poisson ratio: muscle is nearly incompressible (nu near 0.5), but linear
+// tetrahedra lock volumetrically as nu approaches 0.5; 0.45 is the usual
+// compromise in surgical simulation and matches the project's solver notes.
+// Density: skeletal muscle is about 1040-1060 kg/m^3; 1040 is used.
+// Damping: alpha and beta are numerical choices (a lowest tongue mode near
+// 5 Hz gets a few percent of critical damping from alpha; beta damps the
+// high-frequency element modes), not measurements.
+Material neonatal_tongue() {
+  Material material;
+  material.youngs_modulus_pa = 2.0 * 2670.0 * (1.0 + 0.45);
+  material.poisson_ratio = 0.45;
+  material.density_kg_per_m3 = 1040.0;
+  material.rayleigh_mass_per_s = 1.0;
+  material.rayleigh_stiffness_s = 0.01;
+  return material;
+}
+
+LameParameters lame_parameters(const Material& material) {
+  const double e = material.youngs_modulus_pa;
+  const double nu = material.poisson_ratio;
+  LameParameters lame;
+  lame.mu_pa = e / (2.0 * (1.0 + nu));
+  lame.lambda_pa = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  return lame;
+}
+
+const char* validate(const Material& material) {
+  if (!(material.youngs_modulus_pa > 0.0) || !std::isfinite(material.youngs_modulus_pa)) {
+    return "material.youngs_modulus_pa must be finite and > 0";
+  }
+  // nu = 0.5 divides by zero in lambda; negative ratios are legal physics but
+  // not tissue, and below -1 the material is unstable.
+  if (!(material.poisson_ratio > -1.0 && material.poisson_ratio < 0.5)) {
+    return "material.poisson_ratio must be in (-1, 0.5)";
+  }
+  if (!(material.density_kg_per_m3 > 0.0) || !std::isfinite(material.density_kg_per_m3)) {
+    return "material.density_kg_per_m3 must be finite and > 0";
+  }
+  if (!(material.rayleigh_mass_per_s >= 0.0) || !(material.rayleigh_stiffness_s >= 0.0)) {
+    return "material Rayleigh coefficients must be >= 0";
+  }
+  return "";
+}
+
+}  // namespace fahr::fem

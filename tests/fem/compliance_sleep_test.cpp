@@ -1,0 +1,92 @@
+// Compliance blocks against a direct force-response experiment; sleep.
+#include <gtest/gtest.h>
+
+#include "scenes.h"
+
+namespace fahr::fem {
+namespace {
+
+SphereLinks tip_spheres(const TetMesh& mesh, std::size_t count) {
+  SphereLinks links;
+  for (std::size_t s = 0; s < count; ++s) {
+    const std::array<double, 4> w = {0.1, 0.2, 0.3, 0.4};
+    EXPECT_EQ(links.add_sphere(mesh.tets[mesh.tets.size() - 1 - 5 * s], w, 0.001), "");
+  }
+  return links;
+}
+
+TEST(Compliance, MatchesTheResponseOfOneStep) {
+  // At rest without gravity f = 0, so one step with force F on sphere t
+  // (spread as J^T F) moves sphere s by exactly W_st F.
+  const TetMesh mesh = test::bar_mesh(2);
+  BodySettings settings;
+  settings.gravity_m_per_s2.setZero();
+  settings.time_step = std::chrono::milliseconds(10);
+  const SphereLinks links = tip_spheres(mesh, 3);
+  const std::vector<std::uint32_t> spheres = {0, 1, 2};
+  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(body, nullptr);
+  std::vector<float> w(81);
+  ASSERT_TRUE(body->compliance(spheres, links, w));
+  for (int r = 0; r < 9; ++r) {
+    EXPECT_GT(w[static_cast<std::size_t>(10 * r)], 0.0f);
+    for (int c = 0; c < 9; ++c) {
+      EXPECT_NEAR(w[static_cast<std::size_t>(9 * r + c)], w[static_cast<std::size_t>(9 * c + r)],
+                  1e-6 * w[0]);
+    }
+  }
+  const Eigen::Vector3d force(0.002, -0.01, 0.004);  // N, on sphere 1
+  const auto nodes = links.nodes(1);
+  const auto weights = links.weights(1);
+  std::vector<Eigen::Vector3d> before;
+  for (std::uint32_t s = 0; s < 3; ++s) before.push_back(links.centre(s, body->positions_m().data()));
+  for (std::size_t m = 0; m < nodes.size(); ++m) body->set_external_force(nodes[m], weights[m] * force);
+  body->step();
+  for (std::uint32_t s = 0; s < 3; ++s) {
+    const Eigen::Vector3d moved = links.centre(s, body->positions_m().data()) - before[s];
+    Eigen::Vector3d predicted = Eigen::Vector3d::Zero();
+    for (std::size_t d = 0; d < 3; ++d) {
+      for (std::size_t e = 0; e < 3; ++e) {
+        predicted[static_cast<Eigen::Index>(d)] += w[(3 * s + d) * 9 + 3 + e] * force[static_cast<Eigen::Index>(e)];
+      }
+    }
+    // float storage: 1e-6 relative.
+    EXPECT_NEAR((moved - predicted).norm(), 0.0, 1e-6 * moved.norm() + 1e-15) << "sphere " << s;
+  }
+}
+
+TEST(Sleep, RestingBodySleepsAndWakesOnTouch) {
+  const TetMesh mesh = test::bar_mesh(2);
+  BodySettings settings;
+  settings.time_step = std::chrono::milliseconds(10);
+  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(body, nullptr);
+  int asleep_at = -1;
+  for (int k = 0; k < 2000 && asleep_at < 0; ++k) {
+    if (body->step().asleep || body->asleep()) asleep_at = k;
+  }
+  ASSERT_GE(asleep_at, 0) << "never fell asleep";
+  const std::vector<double> rest(body->positions_m().begin(), body->positions_m().end());
+  for (int k = 0; k < 10; ++k) EXPECT_TRUE(body->step().asleep);
+  for (std::size_t i = 0; i < rest.size(); ++i) ASSERT_EQ(rest[i], body->positions_m()[i]);
+  // A candidate-only contact does not wake; an active one does.
+  SphereLinks links = tip_spheres(mesh, 1);
+  ContactSet set;
+  Contact contact;
+  contact.state = ContactState::kCandidate;
+  set.contacts.push_back(contact);
+  set.state_step = body->step_index();
+  EXPECT_TRUE(body->step(&set, &links).asleep);
+  set.contacts[0].state = ContactState::kActive;
+  set.contacts[0].plane_point_m = Eigen::Vector3d(0, -1.0, 0);  // far below: touching, not violated
+  set.state_step = body->step_index();
+  EXPECT_FALSE(body->step(&set, &links).asleep);
+  // An external force wakes as well.
+  for (int k = 0; k < 2000 && !body->asleep(); ++k) body->step();
+  ASSERT_TRUE(body->asleep());
+  body->set_external_force(0, Eigen::Vector3d(0, 0.01, 0));
+  EXPECT_FALSE(body->step().asleep);
+}
+
+}  // namespace
+}  // namespace fahr::fem

@@ -1,0 +1,56 @@
+// Small scenes shared by the FEM tests.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <vector>
+
+#include "fahr/fem/body.h"
+#include "fahr/fem/box_mesh.h"
+
+namespace fahr::fem::test {
+
+// A 30 x 10 x 10 mm bar, cells 3 x 1 x 1 scaled by `refine`, tongue-like
+// material, its x = 0 face fixed.
+inline TetMesh bar_mesh(int refine = 2) {
+  return make_box_mesh({3 * refine, refine, refine}, Eigen::Vector3d(0.03, 0.01, 0.01));
+}
+
+inline std::vector<std::uint32_t> nodes_where(const TetMesh& mesh, auto predicate) {
+  std::vector<std::uint32_t> nodes;
+  for (std::size_t i = 0; i < mesh.nodes_m.size(); ++i) {
+    if (predicate(mesh.nodes_m[i])) nodes.push_back(static_cast<std::uint32_t>(i));
+  }
+  return nodes;
+}
+
+inline std::vector<std::uint32_t> fixed_x0(const TetMesh& mesh) {
+  return nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() < 1e-9; });
+}
+
+inline std::unique_ptr<Body> make_body(const BodySettings& settings, const TetMesh& mesh,
+                                       const std::vector<std::uint32_t>& fixed) {
+  BodyOrError made = Body::create(settings, mesh.nodes_m, mesh.tets, fixed);
+  if (!made.error.empty()) return nullptr;
+  return std::move(made.body);
+}
+
+inline double max_displacement(const Body& body) {
+  double largest = 0.0;
+  for (std::uint32_t i = 0; i < body.node_count(); ++i) {
+    largest = std::max(largest, (body.position(i) - body.rest_position(i)).norm());
+  }
+  return largest;
+}
+
+inline bool all_finite(const Body& body) {
+  for (const double x : body.positions_m()) {
+    if (!std::isfinite(x)) return false;
+  }
+  for (const double v : body.velocities_m_per_s()) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+}  // namespace fahr::fem::test
