@@ -1,0 +1,130 @@
+// The haptic contact response of one rigid tool, one tick per DevicePose:
+// the contact solve on the FEM's compliance, the force-aware decision, the
+// tool proxy, and what ForceCommand and ContactSet need. Everything is
+// sized at construction; tick() allocates nothing (a test proves it).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fahr/contact/contact_row.h"
+#include "fahr/contact/contact_solver.h"
+#include "fahr/contact/coupling.h"
+#include "fahr/contact/force_aware.h"
+#include "fahr/contact/force_output.h"
+#include "fahr/contact/pgs.h"
+#include "fahr/contact/tissue_compliance.h"
+#include "fahr/contact/tool_proxy.h"
+#include "fahr/fem/contact_set.h"
+
+namespace fahr::contact {
+
+enum class ResponseMode : std::uint8_t {
+  // Rows yield with the FEM's compliance W; force-aware. The rows' tissue
+  // centres must be the FEM's free-motion centres (README, "Which centre").
+  kCompliance,
+  // The naive loop for comparison: the same solve with W = 0 on the newest
+  // FEM positions (the published, projected centres), the tissue pushed by
+  // the tool at the device pose; never freezes.
+  kNaive,
+};
+
+struct ResponseSettings {
+  ResponseMode mode = ResponseMode::kCompliance;
+  CouplingSettings coupling;
+  ForceAwareSettings force_aware;
+  PgsSettings pgs;
+  std::size_t max_rows = 64;       // rows solved per tick (tool vs spheres and obstacles)
+  std::size_t max_contacts = 256;  // ContactSet entries per tick, incl. held spheres and obstacle contacts
+  std::size_t max_holds = 64;      // spheres held while frozen
+  // Compliance of a touching sphere whose W block the FEM did not send (it
+  // was not yet a candidate), m/N, >= 0. 1e-3 m/N is a 1 kN/m tissue spring,
+  // stiffer than the neonatal tongue under a ~3 mm sphere (~ 50 N/m), so the
+  // tool is not let in too far for the one FEM step until W arrives.
+  double fallback_compliance_mpn = 1e-3;
+};
+
+// One DevicePose as the response needs it (world frame).
+struct DeviceSample {
+  std::uint64_t pose_seq = 0;                                      // DevicePose header.seq
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();            // stylus (after workspace mapping), m
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity(); // world_from_stylus, unit
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();          // m/s
+  double renderable_force_n = 3.0;  // what the device can render now, N, >= 0
+  double max_stiffness_npm = 1480.0;  // highest stable stiffness, N/m, > 0 (Touch X: 1480)
+  double dt_s = 0.001;              // since the previous tick, s, > 0
+};
+
+struct TickInput {
+  DeviceSample device;
+  // Rows measured with the tool at proxy().position_m and the device's
+  // orientation (the reference pose p0 of the solve).
+  std::span<const ContactRow> rows;
+  TissueCompliance compliance;
+  // Tissue spheres against rigid obstacles (always hard), found by the
+  // collision stage: copied into the ContactSet after the tool contacts.
+  std::span<const fem::Contact> tissue_obstacle_contacts;
+};
+
+struct TickReport {
+  TrackingState state = TrackingState::kTracking;
+  SolverLoadReport load;
+  PgsReport pgs;
+  bool contacts_overflow = false;  // ContactSet entries dropped
+  bool holds_overflow = false;     // spheres not held while frozen
+  bool catch_up_limited = false;   // the proxy moved at the catch-up speed bound
+  bool yielded = false;            // a held proxy backed off to keep the reaction at the limit
+  double obstacle_reaction_n = 0.0;  // |force of rigid obstacles on the tool|, N
+};
+
+class ContactResponse {
+ public:
+  explicit ContactResponse(const ResponseSettings& settings);
+
+  // Puts the proxy at the device pose, tracking, no contacts.
+  void reset(const Eigen::Vector3d& position_m, const Eigen::Quaterniond& orientation);
+
+  const ForceOutput& tick(const TickInput& input);
+
+  const ToolProxy& proxy() const { return proxy_; }
+  TrackingState state() const { return state_; }
+  bool tool_frozen() const { return state_ == TrackingState::kLostTrack; }
+  // The ContactSet of the last tick, ordered: tool contacts in row order,
+  // held spheres no longer in the rows, then the obstacle contacts.
+  std::span<const fem::Contact> contacts() const { return {contacts_.data(), contact_count_}; }
+  const ForceOutput& output() const { return output_; }
+  const TickReport& report() const { return report_; }
+  const ResponseSettings& settings() const { return settings_; }
+
+ private:
+  struct Hold {
+    std::uint32_t sphere_id = 0;
+    Eigen::Vector3d centre_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d plane_point_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
+  };
+
+  Eigen::Vector3d move_proxy(const TickInput& input, const EffectiveCoupling& coupling);
+  Eigen::Vector3d yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n, double guess_stiffness_npm);
+  void capture_holds(const TissueCompliance& compliance);
+  const Hold* find_hold(std::uint32_t sphere_id) const;
+  void write_contacts(const TickInput& input, const Eigen::Vector3d& plane_shift_m);
+  void push_contact(const fem::Contact& contact);
+
+  ResponseSettings settings_;
+  ContactSolver solver_;
+  ToolProxy proxy_;
+  TrackingState state_ = TrackingState::kTracking;
+  double previous_reaction_n_ = 0.0;
+  std::vector<Hold> holds_;
+  std::size_t hold_count_ = 0;
+  std::vector<fem::Contact> contacts_;
+  std::size_t contact_count_ = 0;
+  ForceOutput output_;
+  TickReport report_;
+};
+
+}  // namespace fahr::contact

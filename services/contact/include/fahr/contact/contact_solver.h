@@ -1,0 +1,92 @@
+// The tool's contact problem on the FEM's compliance, one tick: builds the
+// Delassus matrix A_ij = n_i^T W_ij n_j of the rows, solves for lambda >= 0
+// with projected Gauss-Seidel (warm-started per row key), and gives the local
+// stiffness of the active set. Capacities are fixed at construction; nothing
+// allocates afterwards. The formulation is derived in ../../../README.md.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fahr/contact/contact_row.h"
+#include "fahr/contact/pgs.h"
+#include "fahr/contact/tissue_compliance.h"
+
+namespace fahr::contact {
+
+struct SolverLoadReport {
+  bool overflow = false;         // more rows than capacity: the extra rows were dropped
+  int missing_compliance = 0;    // tissue rows without a W block: fallback compliance used
+  int degenerate_normals = 0;    // rows whose normal is not unit length: dropped
+};
+
+class ContactSolver {
+ public:
+  // capacity: rows per tick (the DeformationState carries at most 64 spheres).
+  explicit ContactSolver(std::size_t capacity);
+
+  // Copies the rows (in order) and builds A from `compliance`. A tissue row
+  // without a block gets fallback_compliance_mpn on its diagonal (m/N, >= 0)
+  // and no coupling to the others; obstacle rows get 0 (rigid). Warm starts
+  // lambda from the previous stored solution with the same (kind, id).
+  SolverLoadReport load(std::span<const ContactRow> rows, const TissueCompliance& compliance,
+                        double fallback_compliance_mpn);
+
+  // W = 0 for every row (the naive loop: the tissue does not yield).
+  void make_rigid();
+
+  // The proxy in equilibrium with a coupling of stiffness k_eff (N/m, > 0)
+  // pulling it toward a target displaced by `target_offset_m` = x_t - p0:
+  //   (A + N^T N / k_eff) lambda >= d + N^T (x_t - p0),  lambda >= 0, compl.
+  // Returns the proxy displacement p - p0 = (x_t - p0) - N lambda / k_eff.
+  Eigen::Vector3d solve_coupled(double k_eff_npm, const Eigen::Vector3d& target_offset_m,
+                                const PgsSettings& settings);
+
+  // The proxy held at p0 + proxy_offset_m: A lambda >= d + N^T offset. Rows
+  // that cannot yield (A_ii = 0: obstacles, fully fixed spheres) carry no
+  // force here, since a held proxy needs none from them.
+  void solve_pinned(const Eigen::Vector3d& proxy_offset_m, const PgsSettings& settings);
+
+  // K = N_S (A_S + N_S^T N_S / k_c)^-1 N_S^T over rows with lambda > 0, N/m:
+  // d(force on the stylus)/d(device position) = -K. Symmetric PSD, <= k_c.
+  Eigen::Matrix3d local_stiffness(double k_c_npm);
+
+  // Remembers lambda per (kind, id) for the next tick's warm start.
+  void store_warm_start();
+  void clear_warm_start() { previous_count_ = 0; }
+
+  std::size_t size() const { return k_; }
+  std::size_t capacity() const { return capacity_; }
+  const ContactRow& row(std::size_t i) const { return rows_[i]; }
+  double lambda(std::size_t i) const { return lambda_[i]; }
+  double penetration(std::size_t i) const { return depth_[i]; }  // d_i at p0, m
+  double delassus(std::size_t i, std::size_t j) const { return a_[i * capacity_ + j]; }
+  // sum_i n_i lambda_i over rows of `kind`, N (the force the tool exerts on them).
+  Eigen::Vector3d resultant(RowKind kind) const;
+  // W_row(i),row(j) n_j summed with lambda_j over tissue rows: the predicted
+  // motion of row i's sphere centre under the solved forces, m.
+  Eigen::Vector3d predicted_motion(std::size_t i, const TissueCompliance& compliance) const;
+  const PgsReport& last_report() const { return report_; }
+
+ private:
+  std::size_t capacity_;
+  std::size_t k_ = 0;
+  std::vector<ContactRow> rows_;
+  std::vector<double> a_;       // Delassus A, capacity^2, m/N
+  std::vector<double> s_;       // system matrix of the current solve, capacity^2, m/N
+  std::vector<double> b_;       // right-hand side, m
+  std::vector<double> depth_;   // d at p0, m
+  std::vector<double> lambda_;  // N
+  std::vector<double> fallback_diagonal_;  // per row: 1 if A_ii came from the fallback
+  std::vector<std::uint64_t> previous_keys_;
+  std::vector<double> previous_lambda_;
+  std::size_t previous_count_ = 0;
+  std::vector<std::uint32_t> active_;  // rows of the active set (local stiffness)
+  std::vector<double> factor_;         // capacity^2
+  std::vector<double> columns_;        // 3 x capacity right-hand sides
+  PgsReport report_;
+};
+
+}  // namespace fahr::contact

@@ -1,0 +1,41 @@
+// The paper's force-aware constraint (section 3.2) as a small state machine:
+// tool constraints are active while the tissue reaction stays within the
+// force the device can render now; past it they freeze and the device "has
+// lost track"; they reactivate, with hysteresis, when the coupling force
+// falls back, and the proxy then catches up at a bounded speed.
+#pragma once
+
+#include <cstdint>
+
+namespace fahr::contact {
+
+enum class TrackingState : std::uint8_t {
+  kTracking,    // tool constraints active, proxy in equilibrium
+  kLostTrack,   // tool constraints frozen, proxy held where it was
+  kCatchingUp,  // reactivated; the proxy moves to equilibrium at a bounded speed
+};
+
+struct ForceAwareSettings {
+  bool enabled = true;  // false: never freeze (naive mode, or a test of the solve alone)
+  // Constraints reactivate when the coupling force falls below
+  // (1 - hysteresis) x limit, [0, 0.9]. 0.1: a hand's force tremor is a few
+  // percent of a newton, so 10 % of ~2 N does not chatter.
+  double hysteresis = 0.1;
+  // Fastest proxy motion while catching up, m/s, > 0. The stylus force then
+  // changes by at most K_c x this x dt per tick beyond what the hand's own
+  // motion causes: 0.05 m/s x 400 N/m x 1 ms = 0.02 N per tick, 20 N/s,
+  // below the ~ 50 N/s at which a force step is felt as a click.
+  double catch_up_speed_mps = 0.05;
+};
+
+// Tissue reaction past the limit: freeze.
+inline bool should_freeze(const ForceAwareSettings& s, double tissue_reaction_n, double limit_n) {
+  return s.enabled && tissue_reaction_n > limit_n;
+}
+
+// Coupling force back below the hysteresis band: reactivate.
+inline bool should_release(const ForceAwareSettings& s, double coupling_force_n, double limit_n) {
+  return coupling_force_n < (1.0 - s.hysteresis) * limit_n;
+}
+
+}  // namespace fahr::contact

@@ -1,0 +1,241 @@
+// One haptic tick: coupling, contact solve, force-aware decision, proxy,
+// ForceCommand fields and the ContactSet for the FEM.
+#include "fahr/contact/contact_response.h"
+
+#include <cmath>
+
+namespace fahr::contact {
+namespace {
+
+// Secant steps of yield_to_limit; each is one pinned PGS solve, and the
+// reaction is nearly linear in the back-off, so 4 reach the tolerance.
+constexpr int kMaxYieldIterations = 4;
+// Relative band around the limit the back-off aims for: 0.1 %, far below
+// what the 5 % target allows and what a hand feels.
+constexpr double kYieldTolerance = 1e-3;
+
+}  // namespace
+
+ContactResponse::ContactResponse(const ResponseSettings& settings)
+    : settings_(settings),
+      solver_(settings.max_rows),
+      holds_(settings.max_holds),
+      contacts_(settings.max_contacts) {
+  if (settings_.mode == ResponseMode::kNaive) settings_.force_aware.enabled = false;
+}
+
+void ContactResponse::reset(const Eigen::Vector3d& position_m, const Eigen::Quaterniond& orientation) {
+  proxy_ = ToolProxy{position_m, orientation, Eigen::Vector3d::Zero()};
+  state_ = TrackingState::kTracking;
+  previous_reaction_n_ = 0.0;
+  hold_count_ = 0;
+  contact_count_ = 0;
+  solver_.clear_warm_start();
+  output_ = ForceOutput{};
+  report_ = TickReport{};
+}
+
+const ContactResponse::Hold* ContactResponse::find_hold(std::uint32_t sphere_id) const {
+  for (std::size_t h = 0; h < hold_count_; ++h) {
+    if (holds_[h].sphere_id == sphere_id) return &holds_[h];
+  }
+  return nullptr;
+}
+
+// Freezing holds each loaded sphere where the pinned solve says the tool
+// keeps it: c' = c_free + sum_j W_ij n_j lambda_j (the paper's c' = c, with
+// c the constrained centre, not the free one the rows carry).
+void ContactResponse::capture_holds(const TissueCompliance& compliance) {
+  hold_count_ = 0;
+  report_.holds_overflow = false;
+  for (std::size_t i = 0; i < solver_.size(); ++i) {
+    const ContactRow& row = solver_.row(i);
+    if (row.kind != RowKind::kTissue || !(solver_.lambda(i) > 0.0 || solver_.penetration(i) > 0.0)) continue;
+    if (hold_count_ == holds_.size()) {
+      report_.holds_overflow = true;
+      break;
+    }
+    holds_[hold_count_++] = Hold{row.id, row.other_point_m + solver_.predicted_motion(i, compliance),
+                                 row.tool_point_m, row.normal};
+  }
+}
+
+// A held tool whose tissue reaction exceeds the limit (the tissue state
+// changed under it, or the hand eased off slower than the tissue relaxes)
+// backs off along the reaction until the reaction is the limit: the tissue
+// never receives more than the device can render. The reaction falls
+// monotonically as the tool backs off; secant steps on the pinned solve.
+Eigen::Vector3d ContactResponse::yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n,
+                                                double guess_stiffness_npm) {
+  const Eigen::Vector3d reaction = solver_.resultant(RowKind::kTissue);
+  const double r0 = reaction.norm();
+  if (!(r0 > limit_n)) return offset_m;
+  const Eigen::Vector3d out = -reaction / r0;  // the tissue pushes the tool this way
+  double s0 = 0.0, f0 = r0 - limit_n;
+  double s1 = f0 / guess_stiffness_npm;
+  for (int iteration = 0; iteration < kMaxYieldIterations; ++iteration) {
+    solver_.solve_pinned(offset_m + s1 * out, settings_.pgs);
+    const double f1 = solver_.resultant(RowKind::kTissue).norm() - limit_n;
+    if (std::abs(f1) <= kYieldTolerance * limit_n || f1 == f0) break;
+    const double next = f1 < 0.0 && s1 > s0 ? s0 + (s1 - s0) * f0 / (f0 - f1) : s1 + (s1 - s0) * f1 / (f0 - f1);
+    s0 = s1;
+    f0 = f1;
+    s1 = std::max(0.0, next);
+  }
+  // Never leave the tissue above the limit: if the secant ended short,
+  // back off a little more (the reaction only falls).
+  if (solver_.resultant(RowKind::kTissue).norm() > limit_n) {
+    s1 *= 1.0 + kYieldTolerance;
+    solver_.solve_pinned(offset_m + s1 * out, settings_.pgs);
+  }
+  report_.yielded = true;
+  return offset_m + s1 * out;
+}
+
+Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const EffectiveCoupling& coupling) {
+  const DeviceSample& device = input.device;
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  const double limit = device.renderable_force_n;
+  if (state_ == TrackingState::kLostTrack) {
+    const double spring = coupling.stiffness_npm * (device.position_m - proxy_.position_m).norm();
+    if (!should_release(settings_.force_aware, spring, limit)) {
+      solver_.solve_pinned(zero, settings_.pgs);
+      const Eigen::Vector3d back = yield_to_limit(zero, limit, coupling.stiffness_npm);
+      if (back != zero) capture_holds(input.compliance);
+      return back;
+    }
+    state_ = TrackingState::kCatchingUp;
+  }
+  Eigen::Vector3d step = solver_.solve_coupled(coupling.effective_stiffness_npm,
+                                               coupling.target_m - proxy_.position_m, settings_.pgs);
+  if (state_ == TrackingState::kCatchingUp) {
+    // Reactivated: the equilibrium may be a few mm away (the tissue relaxed
+    // while the hand eased off); go there at a bounded speed so the force
+    // changes smoothly, holding the tool where the bound leaves it.
+    const double max_step = settings_.force_aware.catch_up_speed_mps * device.dt_s;
+    if (step.norm() > max_step) {
+      step *= max_step / step.norm();
+      solver_.solve_pinned(step, settings_.pgs);
+      step = yield_to_limit(step, limit, coupling.stiffness_npm);
+      report_.catch_up_limited = true;
+    } else {
+      state_ = TrackingState::kTracking;
+    }
+  }
+  const double reaction = solver_.resultant(RowKind::kTissue).norm();
+  // While catching up the tissue may still push at the frozen level (up to
+  // the limit and a little over); freeze again only if it grows, i.e. the
+  // hand pushes back in, so the two states cannot chatter.
+  const bool growing = state_ != TrackingState::kCatchingUp || reaction > previous_reaction_n_;
+  if (should_freeze(settings_.force_aware, reaction, limit) && growing) {
+    // The proxy stops where it was (the last tick's pose, whose reaction was
+    // within the limit) and the loaded spheres are held there.
+    state_ = TrackingState::kLostTrack;
+    solver_.solve_pinned(zero, settings_.pgs);
+    const Eigen::Vector3d back = yield_to_limit(zero, limit, coupling.stiffness_npm);
+    capture_holds(input.compliance);
+    return back;
+  }
+  return step;
+}
+
+void ContactResponse::push_contact(const fem::Contact& contact) {
+  if (contact_count_ == contacts_.size()) {
+    report_.contacts_overflow = true;
+    return;
+  }
+  contacts_[contact_count_++] = contact;
+}
+
+void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector3d& plane_shift_m) {
+  contact_count_ = 0;
+  const bool frozen = state_ == TrackingState::kLostTrack;
+  for (std::size_t i = 0; i < solver_.size(); ++i) {
+    const ContactRow& row = solver_.row(i);
+    if (row.kind != RowKind::kTissue) continue;
+    fem::Contact c;
+    c.sphere_id = row.id;
+    c.kind = fem::ContactKind::kTool;
+    c.normal = row.normal;
+    c.plane_point_m = row.tool_point_m + plane_shift_m;
+    c.penetration_m = solver_.penetration(i) + row.normal.dot(plane_shift_m);
+    c.force_n = solver_.lambda(i);
+    c.hold_centre_m = row.other_point_m;
+    const Hold* hold = frozen ? find_hold(row.id) : nullptr;
+    if (hold != nullptr) {
+      c.state = fem::ContactState::kFrozen;
+      c.hold_centre_m = hold->centre_m;
+    } else if (c.force_n > 0.0 || c.penetration_m > 0.0) {
+      c.state = fem::ContactState::kActive;
+    } else {
+      c.state = fem::ContactState::kCandidate;
+    }
+    push_contact(c);
+  }
+  if (frozen) {
+    // Held spheres the collision stage no longer reports stay held.
+    for (std::size_t h = 0; h < hold_count_; ++h) {
+      bool listed = false;
+      for (std::size_t i = 0; i < solver_.size() && !listed; ++i) {
+        listed = solver_.row(i).kind == RowKind::kTissue && solver_.row(i).id == holds_[h].sphere_id;
+      }
+      if (listed) continue;
+      fem::Contact c;
+      c.sphere_id = holds_[h].sphere_id;
+      c.state = fem::ContactState::kFrozen;
+      c.normal = holds_[h].normal;
+      c.plane_point_m = holds_[h].plane_point_m;
+      c.hold_centre_m = holds_[h].centre_m;
+      push_contact(c);
+    }
+  }
+  for (const fem::Contact& c : input.tissue_obstacle_contacts) push_contact(c);
+}
+
+const ForceOutput& ContactResponse::tick(const TickInput& input) {
+  const DeviceSample& device = input.device;
+  report_ = TickReport{};
+  const Eigen::Vector3d p0 = proxy_.position_m;
+  const EffectiveCoupling coupling = effective_coupling(settings_.coupling, device.max_stiffness_npm, device.dt_s,
+                                                        device.position_m, device.velocity_mps, p0);
+  report_.load = solver_.load(input.rows, input.compliance, settings_.fallback_compliance_mpn);
+  if (settings_.mode == ResponseMode::kNaive) solver_.make_rigid();
+  const Eigen::Vector3d step = move_proxy(input, coupling);
+  solver_.store_warm_start();
+  report_.pgs = solver_.last_report();
+  report_.state = state_;
+
+  proxy_.position_m = p0 + step;
+  proxy_.orientation = device.orientation;
+  proxy_.velocity_mps = step / device.dt_s;
+
+  ForceOutput& out = output_;
+  out.answered_pose_seq = device.pose_seq;
+  out.answered_position_m = device.position_m;
+  out.force_n = coupling.stiffness_npm * (proxy_.position_m - device.position_m) +
+                coupling.damping_nspm * (proxy_.velocity_mps - device.velocity_mps);
+  const bool pinned = state_ == TrackingState::kLostTrack || report_.catch_up_limited;
+  // A pinned proxy does not follow the device: the stylus feels the bare
+  // coupling spring. Otherwise the active set's stiffness, <= K_c.
+  out.stiffness_npm = pinned ? Eigen::Matrix3d(coupling.stiffness_npm * Eigen::Matrix3d::Identity())
+                             : solver_.local_stiffness(coupling.stiffness_npm);
+  out.proxy_position_m = proxy_.position_m;
+  out.proxy_orientation = proxy_.orientation;
+  out.lost_track = state_ == TrackingState::kLostTrack;
+  out.device_minus_proxy_m = device.position_m - proxy_.position_m;
+  out.tissue_reaction_n = solver_.resultant(RowKind::kTissue).norm();
+  report_.obstacle_reaction_n = solver_.resultant(RowKind::kObstacle).norm();
+  out.active_contacts = 0;
+  for (std::size_t i = 0; i < solver_.size(); ++i) out.active_contacts += solver_.lambda(i) > 0.0 ? 1u : 0u;
+  out.fem_step = input.compliance.fem_step;
+  previous_reaction_n_ = out.tissue_reaction_n;
+
+  // The FEM sees the tool where the proxy is; the naive loop's tool is the
+  // device itself (it has no tissue model to stop it).
+  const Eigen::Vector3d plane_shift =
+      settings_.mode == ResponseMode::kNaive ? Eigen::Vector3d(device.position_m - p0) : step;
+  write_contacts(input, plane_shift);
+  return out;
+}
+
+}  // namespace fahr::contact

@@ -1,0 +1,105 @@
+// The contact solve: PGS, the coupled and pinned problems, the local
+// stiffness, rigid obstacles and the warm start.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "fahr/contact/contact_solver.h"
+#include "fahr/contact/coupling.h"
+#include "fahr/contact/pgs.h"
+#include "synthetic.h"
+
+namespace fahr::contact {
+namespace {
+
+TEST(Pgs, SolvesAKnownComplementarityProblem) {
+  // S = [2 1; 1 2], b = [1, -1]: lambda_2 = 0 (separating), lambda_1 = 1/2.
+  const double s[4] = {2, 1, 1, 2};
+  const double b[2] = {1, -1};
+  double lambda[2] = {0, 0};
+  const PgsReport report = solve_pgs(s, 2, 2, b, lambda, PgsSettings{});
+  EXPECT_TRUE(report.converged);
+  EXPECT_NEAR(lambda[0], 0.5, 1e-9);
+  EXPECT_EQ(lambda[1], 0.0);
+}
+
+TEST(ContactSolver, OneRowBalancesTheCouplingAgainstTheTissue) {
+  test::SyntheticPatch patch = test::make_patch(1, -0.001, 0.004, 0.0);  // 1 mm penetration
+  ContactSolver solver(8);
+  solver.load(patch.rows, patch.compliance(), 1e-3);
+  const double k = 500.0;
+  const Eigen::Vector3d target(0, -0.002, 0);  // device 2 mm further down
+  const Eigen::Vector3d step = solver.solve_coupled(k, target, PgsSettings{});
+  // (A + 1/K) lambda = d + n . target
+  const double expected = (0.001 + 0.002) / (0.004 + 1.0 / k);
+  EXPECT_NEAR(solver.lambda(0), expected, 1e-6 * expected);
+  // Proxy equilibrium: K (x_t - p) = n lambda.
+  EXPECT_NEAR((k * (target - step)).y(), -expected, 1e-6 * expected);
+  // Stiffness along y: 1 / (A + 1/K), below K.
+  const Eigen::Matrix3d stiffness = solver.local_stiffness(k);
+  // W is float: relative 1e-6.
+  EXPECT_NEAR(stiffness(1, 1), 1.0 / (0.004 + 1.0 / k), 1e-6 * stiffness(1, 1));
+  EXPECT_NEAR(stiffness(0, 0), 0.0, 1e-9);
+}
+
+TEST(ContactSolver, LocalStiffnessIsSymmetricAndBoundedByTheCoupling) {
+  test::SyntheticPatch patch = test::make_patch(12, 0.002, 0.002, 0.0005);
+  // Tilt the normals so the active set spans several directions.
+  for (std::size_t i = 0; i < patch.rows.size(); ++i) {
+    const double angle = 0.3 * static_cast<double>(i) / 12.0;
+    patch.rows[i].normal = Eigen::Vector3d(std::sin(angle), -std::cos(angle), 0.1 * angle).normalized();
+  }
+  ContactSolver solver(16);
+  solver.load(patch.rows, patch.compliance(), 1e-3);
+  const double k = 1480.0;
+  solver.solve_coupled(k, Eigen::Vector3d(0.001, -0.003, 0), PgsSettings{});
+  const Eigen::Matrix3d stiffness = solver.local_stiffness(k);
+  EXPECT_LT((stiffness - stiffness.transpose()).norm(), 1e-9 * k);
+  const Eigen::Vector3d eigen = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(stiffness).eigenvalues();
+  EXPECT_GE(eigen.minCoeff(), -1e-9);
+  EXPECT_LE(eigen.maxCoeff(), k * (1 + 1e-12));
+}
+
+TEST(ContactSolver, RigidObstacleStopsTheProxy) {
+  ContactRow wall;
+  wall.kind = RowKind::kObstacle;
+  wall.id = 3;
+  wall.normal = Eigen::Vector3d(1, 0, 0);            // the obstacle lies in +x of the tool
+  wall.tool_point_m = Eigen::Vector3d(0, 0, 0);
+  wall.other_point_m = Eigen::Vector3d(0.0005, 0, 0);  // 0.5 mm gap
+  ContactSolver solver(4);
+  solver.load({&wall, 1}, TissueCompliance{}, 1e-3);
+  const double k = 400.0;
+  const Eigen::Vector3d step = solver.solve_coupled(k, Eigen::Vector3d(0.01, 0, 0), PgsSettings{});
+  EXPECT_NEAR(step.x(), 0.0005, 1e-9);  // touches, does not enter
+  EXPECT_NEAR(solver.lambda(0), k * (0.01 - 0.0005), 1e-6);
+}
+
+TEST(ContactSolver, WarmStartConvergesInAFewSweeps) {
+  // Weakly coupled so the cold solve converges within the budget.
+  test::SyntheticPatch patch = test::make_patch(30, -0.002, 0.002, 0.0001);
+  ContactSolver solver(32);
+  PgsSettings settings;
+  solver.load(patch.rows, patch.compliance(), 1e-3);
+  solver.solve_coupled(1000.0, Eigen::Vector3d(0, -0.001, 0), settings);
+  const int cold = solver.last_report().sweeps;
+  EXPECT_TRUE(solver.last_report().converged);
+  solver.store_warm_start();
+  solver.load(patch.rows, patch.compliance(), 1e-3);
+  solver.solve_coupled(1000.0, Eigen::Vector3d(0, -0.001, 0), settings);
+  EXPECT_LE(solver.last_report().sweeps, 2);
+  EXPECT_GT(cold, 2);
+}
+
+TEST(Coupling, IsClampedToTheDevice) {
+  CouplingSettings settings;
+  settings.stiffness_npm = 5000.0;
+  settings.damping_nspm = 10.0;
+  const EffectiveCoupling c = effective_coupling(settings, 1480.0, 0.001, Eigen::Vector3d::Zero(),
+                                                 Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  EXPECT_EQ(c.stiffness_npm, 1480.0);
+  EXPECT_EQ(c.damping_nspm, settings.max_damping_nspm);
+}
+
+}  // namespace
+}  // namespace fahr::contact
