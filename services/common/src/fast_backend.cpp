@@ -56,6 +56,11 @@ void apply_profile(const QosProfile& profile, std::uint32_t max_sample_bytes, Qo
     qos.liveliness().announcement_period = to_duration(profile.liveliness_lease / 3);
   }
   if (profile.lifespan.count() > 0) qos.lifespan().duration = to_duration(profile.lifespan);
+  // Data sharing only ever applies to unkeyed types (SimClock is the only
+  // one): off, so every topic takes the same path, and because
+  // with it transient-local samples to a fresh reader went missing in about
+  // one run in three (test_interop, SimClock, Fast DDS both ends).
+  qos.data_sharing().off();
   if (max_sample_bytes > kPreallocateLimitBytes) {
     qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
   }

@@ -27,7 +27,9 @@ class LatestSample {
     slot.info = info;
     const std::uint8_t previous = shared_.exchange(producer_index_ | kFresh, std::memory_order_acq_rel);
     producer_index_ = previous & kIndexMask;
-    published_.fetch_add(1, std::memory_order_release);
+    // seq_cst: Subscriber pairs this with its waiter count (a Dekker-style
+    // handshake), so a waiter either sees the sample or is seen and woken.
+    published_.fetch_add(1, std::memory_order_seq_cst);
   }
 
   // Consumer side: true if a sample newer than the one held has arrived; it
@@ -44,7 +46,7 @@ class LatestSample {
   const T& value() const { return slots_[consumer_index_].value; }
   const SampleInfo& info() const { return slots_[consumer_index_].info; }
   // Samples published since construction (any thread may read it).
-  std::uint64_t published() const { return published_.load(std::memory_order_acquire); }
+  std::uint64_t published() const { return published_.load(std::memory_order_seq_cst); }
 
  private:
   struct Slot {
