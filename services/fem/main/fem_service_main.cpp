@@ -1,0 +1,232 @@
+// fahr_fem_service: the FEM deformation service. Steps the scene's
+// deformable body at the scene's FEM rate, applies the newest ContactSet
+// (Algorithm 1 projection), publishes DeformationState with the contact
+// compliance of the spheres the haptic service is working with, and reports
+// its step time and QoS events. Real time or lockstep, as the scene says.
+//
+//   fahr_fem_service --scene FILE [--dds V] [--domain N] [--dds-profile F]
+//                    [--duration-s S] [--mode realtime|lockstep]
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <thread>
+
+#include "contact_conversion.h"
+#include "contact_step.h"
+#include "fahr/common/config_error.h"
+#include "fahr/common/lockstep.h"
+#include "fahr/common/service_reporter.h"
+#include "fahr/scene/load_scene.h"
+#include "fahr/scene/plan.h"
+#include "fahr/scene/scene_error.h"
+#include "fem_body_setup.h"
+
+namespace fahr::fem_service {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+// What one FEM step needs, allocated once.
+struct StepContext {
+  FemBodySetup& setup;
+  ContactStep contact_step;
+  fem::ContactSet contacts;
+  bool have_contacts = false;
+  std::uint64_t applied_contact_seq = 0;
+  msg::DeformationState state;
+  fem::StepReport last_report;
+  std::uint64_t inverted_max = 0;
+  std::uint64_t stale_sets = 0;
+  double step_ms_max = 0.0;
+
+  explicit StepContext(FemBodySetup& s)
+      : setup(s), contact_step(*s.body, s.links, s.settings.max_compliance_spheres) {
+    const std::size_t cap = s.settings.max_compliance_spheres;
+    contacts.contacts.reserve(msg::MAX_CONTACTS);
+    state.positions_m().reserve(3 * s.mesh.node_count());
+    state.velocities_mps().reserve(3 * s.mesh.node_count());
+    state.compliance_sphere_ids().reserve(cap);
+    state.compliance_mpn().reserve(9 * cap * cap);
+    state.compliance_free_centres_m().reserve(3 * cap);
+  }
+
+  // One FEM step and the DeformationState that reports it.
+  void step() {
+    // A set older than the body allows is ignored and counted (stale).
+    const bool usable = have_contacts && setup.body->step_index() <= contacts.state_step +
+                                                                        setup.settings.max_contact_age_steps;
+    if (have_contacts && !usable) ++stale_sets;
+    last_report = contact_step.step(usable ? &contacts : nullptr);
+    inverted_max = std::max<std::uint64_t>(inverted_max, static_cast<std::uint64_t>(last_report.inverted_elements));
+    fill_state(*setup.body, setup.scene_body->id, state);
+    state.stale_contact_sets(static_cast<std::uint32_t>(stale_sets));
+    state.applied_contact_seq(usable ? applied_contact_seq : 0);
+    const auto& ids = contact_step.compliance_spheres();
+    state.compliance_sphere_ids().assign(ids.begin(), ids.end());
+    state.compliance_mpn().assign(contact_step.compliance().begin(), contact_step.compliance().end());
+    state.compliance_free_centres_m().assign(contact_step.free_centres().begin(), contact_step.free_centres().end());
+  }
+
+  void take(const msg::ContactSet& wire, std::uint64_t seq) {
+    to_fem(wire, contacts);
+    have_contacts = true;
+    applied_contact_seq = seq;
+  }
+
+  void metrics(std::vector<std::pair<std::string, double>>& out) const {
+    out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets));
+    out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max));
+    out.emplace_back("projection_sweeps_last", static_cast<double>(last_report.projection.sweeps));
+    out.emplace_back("solver_iterations_last", static_cast<double>(last_report.solver_iterations));
+    out.emplace_back("asleep", setup.body->asleep() ? 1.0 : 0.0);
+    out.emplace_back("nodes", static_cast<double>(setup.mesh.node_count()));
+    out.emplace_back("tets", static_cast<double>(setup.mesh.tet_count()));
+    out.emplace_back("spheres", static_cast<double>(setup.links.size()));
+  }
+};
+
+void record(common::TickRecorder& recorder, std::uint64_t tick, std::int64_t start_ns, std::int64_t cpu_start_ns) {
+  recorder.push({tick, start_ns, common::monotonic_now_ns() - start_ns, common::thread_cpu_now_ns() - cpu_start_ns});
+}
+
+int run_realtime(common::Participant& participant, StepContext& ctx, const scene::Scene& scene,
+                 common::TickRecorder& recorder, double duration_s) {
+  common::QosProfile out_qos = common::QosProfile::for_role(common::TopicRole::kStateStream);
+  out_qos.deadline = 3 * scene.rates.fem_period();  // a late step is expected now and then; three are not
+  common::Publisher<msg::DeformationState> out(participant, out_qos);
+  common::Subscriber<msg::ContactSet> in(participant);
+  const auto period = scene.rates.fem_period();
+  const auto start = Clock::now();
+  auto next = start;
+  for (std::uint64_t tick = 0;; ++tick) {
+    next += period;
+    std::this_thread::sleep_until(next);
+    if (duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(duration_s)) break;
+    const std::int64_t t0 = common::monotonic_now_ns();
+    const std::int64_t c0 = common::thread_cpu_now_ns();
+    if (in.fetch_newest()) ctx.take(in.newest(), in.newest_info().seq);
+    ctx.step();
+    ctx.state.header().sim_step(ctx.setup.body->step_index());
+    ctx.state.header().sim_time_ns(static_cast<std::int64_t>(ctx.last_report.time_s * 1e9));
+    out.write(ctx.state);
+    record(recorder, tick, t0, c0);
+  }
+  return 0;
+}
+
+int run_lockstep(common::Participant& participant, StepContext& ctx, const scene::Scene& scene,
+                 common::TickRecorder& recorder) {
+  common::Publisher<msg::DeformationState> out(participant,
+                                               common::lockstep_output_qos<msg::DeformationState>());
+  common::StepInput<msg::ContactSet> in(participant);
+  common::LockstepClient client(participant, "fem");
+  client.join();
+  const auto base = scene.run.base_period;
+  const auto fem_steps = static_cast<std::uint64_t>(scene.rates.fem_period() / base);
+  const auto haptic_steps = static_cast<std::uint64_t>(scene.rates.haptic_period() / base);
+  common::OutputHash hash;
+  for (std::uint64_t k = 0; client.wait_for_grant(k, 60s); k += fem_steps) {
+    const std::int64_t t0 = common::monotonic_now_ns();
+    const std::int64_t c0 = common::thread_cpu_now_ns();
+    if (auto s = common::producer_step_for(k, haptic_steps)) {
+      const msg::ContactSet* set = in.wait(*s, 60s);
+      if (set == nullptr) {
+        std::fprintf(stderr, "fahr_fem_service: ContactSet of haptic step %llu never came\n",
+                     static_cast<unsigned long long>(*s));
+        return 1;
+      }
+      ctx.take(*set, set->header().seq());
+    }
+    ctx.step();
+    ctx.state.header().sim_step(k);
+    ctx.state.header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+    out.write(ctx.state);
+    hash.add(ctx.state);
+    record(recorder, k, t0, c0);
+    client.complete_through(k + fem_steps - 1, hash.value());
+  }
+  return 0;
+}
+
+// The vendor and domain: flag, else environment, else the scene.
+common::TransportConfig transport(const std::string& dds, const std::string& domain, const std::string& profile,
+                                  const scene::Scene& scene) {
+  std::string vendor = dds;
+  if (vendor.empty() && std::getenv("FAHR_DDS") == nullptr) {
+    vendor = scene.dds.vendor == scene::DdsVendor::kFastDds ? "fastdds" : "cyclonedds";
+  }
+  std::string domain_id = domain;
+  if (domain_id.empty() && std::getenv("FAHR_DOMAIN_ID") == nullptr) domain_id = std::to_string(scene.dds.domain_id);
+  return common::transport_config_from(vendor, domain_id, profile, "fem");
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"fahr FEM deformation service"};
+  std::string scene_path, dds, domain, profile, mode;
+  double duration_s = -1;
+  app.add_option("--scene", scene_path, "scene file")->required();
+  app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds, inprocess");
+  app.add_option("--domain", domain, "DDS domain id 0-230");
+  app.add_option("--dds-profile", profile, "vendor XML configuration");
+  app.add_option("--duration-s", duration_s, "stop after this long (default: the scene's run.duration_s)");
+  app.add_option("--mode", mode, "realtime or lockstep (default: the scene's run.mode)")
+      ->check(CLI::IsMember({"realtime", "lockstep"}));
+  CLI11_PARSE(app, argc, argv);
+
+  const auto scene = scene::load_scene(scene_path);
+  const auto plan = scene::derive_plan(*scene);
+  if (!plan.run_fem) {
+    std::printf("fahr_fem_service: scene '%s' has no deformable body; nothing to do\n", scene->name.c_str());
+    return 0;
+  }
+  if (plan.fem_bodies.size() != 1) {
+    std::fprintf(stderr, "fahr_fem_service: scene '%s' has %zu deformable bodies; this service steps one\n",
+                 scene->name.c_str(), plan.fem_bodies.size());
+    return 2;
+  }
+  const bool lockstep = mode.empty() ? scene->run.mode == scene::RunMode::kLockstep : mode == "lockstep";
+  if (duration_s < 0) duration_s = std::chrono::duration<double>(scene->run.duration).count();
+
+  FemBodySetup setup = set_up_body(*scene, scene->bodies[plan.fem_bodies.front()]);
+  StepContext ctx(setup);
+  common::Participant participant(transport(dds, domain, profile, *scene));
+  common::TickRecorder recorder;
+  common::ServiceReporter reporter(participant, {"fem", scene->rates.fem_hz, scene->rates.status_period() > 0ns ?
+                                                 std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period()) : 250ms},
+                                   recorder, [&](auto& metrics) { ctx.metrics(metrics); });
+  std::printf("fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres), %.0f Hz, %s\n",
+              std::string(common::vendor_name(participant.vendor())).c_str(), setup.scene_body->name.c_str(),
+              setup.mesh.node_count(), setup.mesh.tet_count(), setup.fixed_nodes.size(), setup.links.size(),
+              scene->rates.fem_hz, lockstep ? "lockstep" : "realtime");
+  reporter.set_state(msg::SERVICE_RUNNING);
+  const int status = lockstep ? run_lockstep(participant, ctx, *scene, recorder)
+                              : run_realtime(participant, ctx, *scene, recorder, duration_s);
+  reporter.set_state(msg::SERVICE_STOPPING);
+  reporter.report();
+  std::printf("fahr_fem_service: %llu steps, stale contact sets %llu, max inverted elements %llu\n",
+              static_cast<unsigned long long>(setup.body->step_index()),
+              static_cast<unsigned long long>(ctx.stale_sets),
+              static_cast<unsigned long long>(ctx.inverted_max));
+  return status;
+}
+
+}  // namespace
+}  // namespace fahr::fem_service
+
+int main(int argc, char** argv) {
+  try {
+    return fahr::fem_service::run(argc, argv);
+  } catch (const fahr::scene::SceneError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  } catch (const fahr::common::ConfigError& e) {
+    std::fprintf(stderr, "fahr_fem_service: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fahr_fem_service: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,61 @@
+// Contacts of spheres against rigid bodies in a buffer whose capacity is
+// fixed at construction. A full buffer drops further contacts and raises a
+// flag: overflow is reported, never a crash or an allocation.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace fahr::haptic {
+
+struct SphereContact {
+  std::uint32_t sphere_id = 0;  // index into the SphereLayout
+  std::uint32_t body_id = 0;    // RigidBody::id
+  // Nearest point of the rigid surface, m, world frame.
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+  // Unit normal from that surface toward the sphere centre before penetration
+  // (world frame): n = (c - q) / |c - q|.
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
+  // Penetration depth r - (c - q) . n, m: > 0 for a contact, in
+  // (-candidate_margin_m, 0] for a candidate (then minus the gap).
+  double depth_m = 0.0;
+  bool candidate = false;  // near, not touching
+  // True when the centre was inside the body and no pre-penetration centre
+  // was remembered: the normal is the field's, which can point the wrong way
+  // through a thin plate.
+  bool normal_without_history = false;
+};
+
+class ContactBuffer {
+ public:
+  explicit ContactBuffer(std::size_t capacity) { contacts_.resize(capacity); }
+
+  void clear() noexcept {
+    size_ = 0;
+    overflowed_ = false;
+  }
+  // False (and the overflow flag set) when full.
+  bool push(const SphereContact& contact) noexcept {
+    if (size_ == contacts_.size()) {
+      overflowed_ = true;
+      return false;
+    }
+    contacts_[size_++] = contact;
+    return true;
+  }
+  std::size_t size() const { return size_; }
+  std::size_t capacity() const { return contacts_.size(); }
+  bool overflowed() const { return overflowed_; }
+  const SphereContact& operator[](std::size_t i) const { return contacts_[i]; }
+  const SphereContact* begin() const { return contacts_.data(); }
+  const SphereContact* end() const { return contacts_.data() + size_; }
+
+ private:
+  std::vector<SphereContact> contacts_;
+  std::size_t size_ = 0;
+  bool overflowed_ = false;
+};
+
+}  // namespace fahr::haptic

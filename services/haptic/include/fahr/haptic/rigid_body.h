@@ -1,0 +1,19 @@
+// A rigid body the spheres collide with: its signed distance field (in its
+// own frame) and its pose. The field is borrowed: it must outlive the body.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+
+#include "fahr/geometry/signed_distance_field.h"
+
+namespace fahr::haptic {
+
+struct RigidBody {
+  std::uint32_t id = 0;  // reported in contacts
+  const geometry::SignedDistanceField* sdf = nullptr;
+  // Pose: world_from_body maps body-frame points (m) to the world frame.
+  Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace fahr::haptic

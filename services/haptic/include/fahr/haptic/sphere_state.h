@@ -1,0 +1,50 @@
+// The per-FEM-state part of the sphere tree: current centres and radii,
+// recomputed from deformed node positions. Capacity fixed at construction;
+// update() allocates nothing.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fahr/haptic/sphere_layout.h"
+
+namespace fahr::haptic {
+
+class SphereState {
+ public:
+  SphereState() = default;
+  explicit SphereState(const SphereLayout& layout);
+
+  // positions_m: 3 per node (x, y, z), m, the FEM's flat layout. Centres are
+  // c = sum w_i x_i; radii r = r0 cbrt(V / V0) over the linked tets, so a
+  // compressed region's spheres shrink with it. A linked volume that collapsed
+  // or inverted (V <= 0) keeps kMinVolumeScale of the rest radius rather than
+  // vanishing, and a stretch beyond kMaxVolumeScale is capped. Returns false (state unchanged past the first bad node) if a
+  // position is not finite or the span is too short.
+  bool update(const SphereLayout& layout, std::span<const double> positions_m);
+
+  // The rest state (same as update() with the rest positions).
+  void reset_to_rest(const SphereLayout& layout);
+
+  const std::vector<Eigen::Vector3d>& centres_m() const { return centres_m_; }
+  const std::vector<double>& radii_m() const { return radii_m_; }
+  std::uint64_t version() const { return version_; }  // bumped by every update
+
+  // The radius scale of a sphere whose linked tets are inverted or flat: a
+  // sphere still has to collide, and a tiny radius is a safe under-estimate.
+  static constexpr double kMinVolumeScale = 0.25;
+  // The largest radius scale: a sphere grown past its tets' surroundings
+  // (large stretch, or a solver blow-up) would report contacts far from the
+  // tissue; 1.5 is a volume stretch of 3.4, beyond soft tissue's range.
+  static constexpr double kMaxVolumeScale = 1.5;
+
+ private:
+  std::vector<Eigen::Vector3d> centres_m_;
+  std::vector<double> radii_m_;
+  std::vector<double> six_volume_m3_;  // per tet, scratch of update()
+  std::uint64_t version_ = 0;
+};
+
+}  // namespace fahr::haptic

@@ -1,0 +1,56 @@
+// Bounding hierarchy over the spheres, separate from the spheres themselves
+// (an inner sphere does not bound its children): a binary tree of axis-aligned
+// boxes built once on the rest layout and refitted bottom-up for every FEM
+// state. The topology never changes, so the structure is never rebuilt; a
+// counter lets tests prove it.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "fahr/haptic/sphere_layout.h"
+#include "fahr/haptic/sphere_state.h"
+
+namespace fahr::haptic {
+
+struct SphereTreeNode {
+  Eigen::Vector3d box_min_m = Eigen::Vector3d::Zero();  // m
+  Eigen::Vector3d box_max_m = Eigen::Vector3d::Zero();  // m
+  // Leaf: first sphere slot in order() and the count; inner: left child index
+  // (right = left + 1) and count 0. Children always follow their parent, so a
+  // reverse sweep refits bottom-up.
+  std::int32_t first = 0;
+  std::int32_t count = 0;
+};
+
+class SphereTree {
+ public:
+  static constexpr int kLeafSize = 4;    // spheres per leaf
+  static constexpr int kMaxDepth = 64;   // traversal stack; median splits keep depth ~log2(n/4)+1
+
+  SphereTree() = default;
+  explicit SphereTree(const SphereLayout& layout);
+
+  // Boxes of every node from the state's centres and radii. Allocation-free.
+  void refit(const SphereState& state);
+
+  const std::vector<SphereTreeNode>& nodes() const { return nodes_; }
+  const std::vector<std::uint32_t>& order() const { return order_; }  // sphere ids, leaf order
+  int depth() const { return depth_; }
+  std::uint64_t refit_count() const { return refits_; }
+  // Builds after construction. Nothing in the library rebuilds, so this stays 0.
+  std::uint64_t rebuild_count() const { return builds_ - 1; }
+
+ private:
+  void build(std::int32_t node, std::int32_t begin, std::int32_t end, int depth,
+             const SphereLayout& layout);
+
+  std::vector<SphereTreeNode> nodes_;
+  std::vector<std::uint32_t> order_;
+  int depth_ = 0;
+  std::uint64_t builds_ = 1;
+  std::uint64_t refits_ = 0;
+};
+
+}  // namespace fahr::haptic

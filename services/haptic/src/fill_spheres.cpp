@@ -1,0 +1,94 @@
+// fill_spheres: grid, octree, hugging closure, then links (see fill_spheres.h).
+#include "fahr/haptic/fill_spheres.h"
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "fahr/geometry/signed_distance_field.h"
+#include "octree_fill.h"
+#include "surface_hugging.h"
+#include "tet_links.h"
+
+namespace fahr::haptic {
+namespace {
+
+// The boundary field is queried exactly almost everywhere; its grid only
+// speeds up the far field, so a coarse one (half a coarse radius) is enough.
+constexpr double kSdfCellPerCoarseRadius = 0.5;
+
+geometry::SurfaceMesh checked_boundary(const geometry::TetMesh& mesh) {
+  if (mesh.tet_count() == 0 || mesh.node_count() == 0) {
+    throw std::invalid_argument("sphere filling: the tet mesh is empty (0 tets); nothing to fill");
+  }
+  geometry::SurfaceMesh surface = mesh.boundary_surface();
+  const auto& topo = surface.topology();
+  if (!surface.is_closed() || !surface.is_manifold()) {
+    std::ostringstream message;
+    message << "sphere filling: the tet mesh's boundary is not a closed manifold surface ("
+            << topo.boundary_edge_count << " open edges, " << topo.non_manifold_edge_count
+            << " non-manifold edges, " << topo.non_manifold_vertex_count
+            << " non-manifold vertices); inside and outside are undefined";
+    throw std::invalid_argument(message.str());
+  }
+  return surface;
+}
+
+}  // namespace
+
+SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& settings) {
+  validate_fill_settings(settings);
+  const geometry::SurfaceMesh boundary = checked_boundary(mesh);
+
+  double mean_volume = 0.0;
+  for (const auto& r : mesh.rest_data()) mean_volume += r.volume_m3;
+  mean_volume /= static_cast<double>(mesh.tet_count());
+  const double coarse_radius =
+      std::cbrt(3.0 * settings.volume_ratio * mean_volume / (4.0 * std::numbers::pi));
+
+  geometry::SdfOptions sdf_options;
+  sdf_options.cell_size_m = kSdfCellPerCoarseRadius * coarse_radius;
+  const geometry::SignedDistanceField sdf(boundary, sdf_options);
+
+  std::vector<detail::CandidateSphere> candidates = detail::octree_fill(
+      sdf, boundary.bounds_min(), boundary.bounds_max(), coarse_radius, settings);
+  if (settings.surface_hugging) {
+    const double finest = coarse_radius / std::ldexp(1.0, settings.refinement_levels);
+    detail::add_surface_hugging_spheres(candidates, boundary, sdf,
+                                        settings.hugging_radius_fraction * finest, settings);
+  }
+  if (candidates.empty()) {
+    throw std::invalid_argument(
+        "sphere filling: no sphere fits in the mesh; lower volume_ratio or raise refinement_levels");
+  }
+
+  detail::TetLinker linker(mesh, settings.max_linked_tets);
+  std::vector<SphereRecord> records;
+  std::vector<std::uint32_t> nodes, tets;
+  std::vector<double> weights;
+  records.reserve(candidates.size());
+  for (const auto& c : candidates) {
+    const double spread =
+        c.origin == SphereOrigin::kHugging ? settings.hugging_weight_spread : settings.weight_spread;
+    const detail::SphereLink link = linker.link(c.centre_m, c.radius_m, spread);
+    SphereRecord r;
+    r.rest_centre_m = link.centre_m;
+    r.rest_radius_m = c.radius_m;
+    r.level = c.level;
+    r.origin = c.origin;
+    r.first_link = static_cast<std::uint32_t>(nodes.size());
+    r.link_count = static_cast<std::uint32_t>(link.nodes.size());
+    r.first_tet = static_cast<std::uint32_t>(tets.size());
+    r.tet_count = static_cast<std::uint32_t>(link.tets.size());
+    for (const std::uint32_t t : link.tets) r.rest_linked_volume_m3 += mesh.rest_data()[t].volume_m3;
+    nodes.insert(nodes.end(), link.nodes.begin(), link.nodes.end());
+    weights.insert(weights.end(), link.weights.begin(), link.weights.end());
+    tets.insert(tets.end(), link.tets.begin(), link.tets.end());
+    records.push_back(r);
+  }
+  return SphereLayout(std::move(records), std::move(nodes), std::move(weights), std::move(tets),
+                      mesh.tets(), mesh.node_count(), settings.refinement_levels, coarse_radius);
+}
+
+}  // namespace fahr::haptic

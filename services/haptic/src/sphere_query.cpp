@@ -1,0 +1,159 @@
+// Spheres against a rigid body's signed distance field (see sphere_query.h).
+#include "fahr/haptic/sphere_query.h"
+
+#include <array>
+#include <cmath>
+
+namespace fahr::haptic {
+namespace {
+
+// Bound of |grid - true distance| in cells. The grid value is a convex
+// combination of exact corner distances, each within |x_i - p| of the true
+// distance at p (a distance is 1-Lipschitz), so the error is at most
+// sum_i w_i |x_i - p| <= sqrt(sum_i w_i |x_i - p|^2) = h sqrt(sum_axes f (1 - f))
+// <= h sqrt(3) / 2, with f the fractional position per axis.
+constexpr double kGridErrorCells = 0.8660254037844386;
+// Below this |c - q| (m) the direction is numerically meaningless: the
+// field's own normal is used instead.
+constexpr double kMinNormalLength = 1e-9;
+
+struct Frame {
+  Eigen::Matrix3d body_from_world_rotation;
+  Eigen::Vector3d body_from_world_translation;
+  Eigen::Vector3d to_body(const Eigen::Vector3d& p) const {
+    return body_from_world_rotation * p + body_from_world_translation;
+  }
+};
+
+// The field's grid alone: trilinear distance, gradient by central
+// differences over half a cell, nearest point along it.
+geometry::SdfSample grid_sample(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& p,
+                                double distance) noexcept {
+  geometry::SdfSample s;
+  s.distance_m = distance;
+  const double h = 0.5 * sdf.cell_size_m();
+  Eigen::Vector3d gradient;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(axis);
+    gradient[axis] = sdf.grid_distance(p + step) - sdf.grid_distance(p - step);
+  }
+  const double norm = gradient.norm();
+  s.normal = norm > 0.0 ? Eigen::Vector3d(gradient / norm) : Eigen::Vector3d::UnitZ();
+  s.closest_point_m = p - distance * s.normal;
+  return s;
+}
+
+geometry::SdfSample sample(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& p, double grid,
+                           double exact_reach, bool exact) noexcept {
+  if (!exact) return grid_sample(sdf, p, grid);
+  return std::abs(grid) <= exact_reach ? sdf.query(p) : sdf.query_exact(p);
+}
+
+// The contact of one sphere whose exact sample at its centre is `s`.
+bool narrow_phase(const geometry::SignedDistanceField& sdf, double exact_reach, bool exact, double margin,
+                  const Eigen::Vector3d& centre_body,
+                  double radius, const geometry::SdfSample& s, const QuerySettings& settings,
+                  const PrePenetrationMemory& memory, std::uint32_t sphere, std::uint64_t query,
+                  Eigen::Vector3d& q, Eigen::Vector3d& n, double& depth, bool& no_history) noexcept {
+  no_history = false;
+  if (s.distance_m > 0.0) {
+    // The centre is outside: it is its own pre-penetration centre.
+    q = s.closest_point_m;
+    const Eigen::Vector3d d = centre_body - q;
+    const double len = d.norm();
+    n = len > kMinNormalLength ? Eigen::Vector3d(d / len) : s.normal;
+    depth = radius - s.distance_m;
+    return depth > -margin;
+  }
+  Eigen::Vector3d before;
+  if (memory.recall(sphere, query, settings.max_memory_age, before)) {
+    const geometry::SdfSample b = sample(sdf, before, sdf.grid_distance(before), exact_reach, exact);
+    q = b.closest_point_m;
+    const Eigen::Vector3d d = before - q;
+    const double len = d.norm();
+    n = len > kMinNormalLength ? Eigen::Vector3d(d / len) : b.normal;
+    depth = radius - (centre_body - q).dot(n);
+    return depth > -margin;
+  }
+  no_history = true;
+  q = s.closest_point_m;
+  n = s.normal;
+  depth = radius - s.distance_m;
+  return depth > -margin;
+}
+
+}  // namespace
+
+QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const RigidBody& body,
+                         const QuerySettings& settings, PrePenetrationMemory& memory,
+                         ContactBuffer& out) noexcept {
+  QueryStats stats;
+  const auto& nodes = tree.nodes();
+  if (nodes.empty() || tree.order().empty() || body.sdf == nullptr) return stats;
+  const geometry::SignedDistanceField& sdf = *body.sdf;
+  const double grid_error = kGridErrorCells * sdf.cell_size_m();
+  const double exact_reach = sdf.band_m() + grid_error;
+  const Eigen::Isometry3d body_from_world = body.world_from_body.inverse();
+  const Frame frame{body_from_world.linear(), body_from_world.translation()};
+  const Eigen::Matrix3d world_rotation = body.world_from_body.linear();
+  const std::uint64_t query = memory.next_query();
+  const auto& centres = state.centres_m();
+  const auto& radii = state.radii_m();
+  const auto& order = tree.order();
+
+  std::array<std::int32_t, SphereTree::kMaxDepth + 1> stack{};
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const SphereTreeNode& node = nodes[stack[--top]];
+    ++stats.nodes_visited;
+    const Eigen::Vector3d centre = 0.5 * (node.box_min_m + node.box_max_m);
+    const double half_diagonal =
+        0.5 * (node.box_max_m - node.box_min_m).norm() + settings.contact_skin_m + settings.candidate_margin_m;
+    // Lower bound of the distance from any point of the box to the body.
+    const double bound = sdf.grid_distance(frame.to_body(centre)) - grid_error - half_diagonal;
+    if (!(bound <= settings.approach_margin_m)) {  // NaN-safe: a NaN pose touches nothing
+      if (&node == &nodes[0]) stats.body_skipped = true;
+      continue;
+    }
+    if (node.count == 0) {
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1;
+      continue;
+    }
+    for (std::int32_t k = 0; k < node.count; ++k) {
+      const std::uint32_t sphere = order[node.first + k];
+      const Eigen::Vector3d p = frame.to_body(centres[sphere]);
+      const double r = radii[sphere] + settings.contact_skin_m;
+      ++stats.spheres_tested;
+      const double grid = sdf.grid_distance(p);
+      if (grid - grid_error > r + settings.candidate_margin_m) {
+        if (grid - grid_error > 0.0) memory.remember(sphere, p, query);
+        continue;
+      }
+      ++stats.exact_queries;
+      const geometry::SdfSample s = sample(sdf, p, grid, exact_reach, settings.exact_narrow_phase);
+      if (s.distance_m > 0.0) memory.remember(sphere, p, query);
+      Eigen::Vector3d q, n;
+      double depth = 0.0;
+      bool no_history = false;
+      if (!narrow_phase(sdf, exact_reach, settings.exact_narrow_phase, settings.candidate_margin_m, p, r, s,
+                        settings, memory, sphere, query, q, n, depth, no_history)) {
+        continue;
+      }
+      ++stats.contacts;
+      SphereContact contact;
+      contact.sphere_id = sphere;
+      contact.body_id = body.id;
+      contact.point_m = body.world_from_body * q;
+      contact.normal = world_rotation * n;
+      contact.depth_m = depth;
+      contact.normal_without_history = no_history;
+      contact.candidate = depth <= 0.0;
+      if (!out.push(contact)) stats.overflowed = true;
+    }
+  }
+  return stats;
+}
+
+}  // namespace fahr::haptic

@@ -1,0 +1,61 @@
+// The tick path allocates nothing: state update, refit and queries.
+#include <gtest/gtest.h>
+
+#include "allocation_counter.h"
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/haptic/sphere_query.h"
+#include "fahr/haptic/sphere_tree.h"
+#include "test_meshes.h"
+
+namespace fahr::haptic {
+namespace {
+
+TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
+  const auto& mesh = test::neonatal_tongue();
+  const SphereLayout& layout = test::neonatal_layout();
+  SphereState state(layout);
+  SphereTree tree(layout);
+  geometry::SdfOptions options;
+  options.cell_size_m = 1e-3;
+  const geometry::SignedDistanceField slab(test::box_surface({-0.06, -0.04, -0.02}, {0.0, -0.005, 0.02}), options);
+  RigidBody body{0, &slab, Eigen::Isometry3d::Identity()};
+  PrePenetrationMemory memory(layout.size());
+  ContactBuffer buffer(256);  // small on purpose: overflow must not allocate either
+  std::vector<double> x;
+  for (const auto& p : mesh.rest_positions()) {
+    for (int a = 0; a < 3; ++a) x.push_back(p[a]);
+  }
+
+  // Both narrow phases, with candidates and a skin: every branch of the path.
+  QuerySettings exact, grid;
+  grid.exact_narrow_phase = false;
+  grid.candidate_margin_m = 0.25e-3;
+  grid.contact_skin_m = 0.1e-3;
+  std::size_t contacts = 0;
+  test::arm_allocation_counter();
+  for (int tick = 0; tick < 50; ++tick) {
+    x[1] -= 1e-5;  // a node moves: a new FEM state every tick
+    state.update(layout, x);
+    tree.refit(state);
+    body.world_from_body.translation().y() = 1e-4 * tick;
+    buffer.clear();
+    query_spheres(tree, state, body, tick % 2 == 0 ? exact : grid, memory, buffer);
+    contacts += buffer.size();
+  }
+  const std::size_t allocations = test::disarm_allocation_counter();
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_GT(contacts, 0u) << "the slab touches the tongue: the narrow phase ran";
+  EXPECT_EQ(tree.rebuild_count(), 0u);
+}
+
+TEST(Allocation, CounterSeesAnAllocation) {
+  test::arm_allocation_counter();
+  // A direct call: a new-expression may be elided by the optimiser.
+  void* p = ::operator new(16);
+  const std::size_t allocations = test::disarm_allocation_counter();
+  ::operator delete(p);
+  EXPECT_EQ(allocations, 1u);
+}
+
+}  // namespace
+}  // namespace fahr::haptic

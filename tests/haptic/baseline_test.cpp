@@ -1,0 +1,55 @@
+// The triangle baseline: contacts of a block's boundary with a slab, refit
+// (never rebuild) after deformation, bad input.
+#include <gtest/gtest.h>
+
+#include "fahr/haptic/triangle_baseline.h"
+#include "test_meshes.h"
+
+namespace fahr::haptic {
+namespace {
+
+TEST(TriangleBaseline, BlockOnASlabAfterDeformation) {
+  const auto mesh = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 4);
+  std::vector<geometry::Index> surface_to_node;
+  const geometry::SurfaceMesh tissue = mesh.boundary_surface(&surface_to_node);
+  const geometry::SurfaceMesh slab = test::box_surface({-0.01, -0.01, -0.01}, {0.02, 0.0, 0.02});
+  TriangleBaseline baseline(tissue, surface_to_node, slab);
+  std::vector<TriangleContact> contacts;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+
+  // Deform: every node with y == 0 sinks 0.3 mm into the slab.
+  std::vector<double> x;
+  std::size_t sunk = 0;
+  for (const auto& p : mesh.rest_positions()) {
+    const bool bottom = p.y() < 1e-12;
+    sunk += bottom && surface_to_node.end() != std::find(surface_to_node.begin(), surface_to_node.end(),
+                                                         static_cast<geometry::Index>(&p - &mesh.rest_positions()[0]))
+                ? 1
+                : 0;
+    x.push_back(p.x());
+    x.push_back(bottom ? -0.3e-3 : p.y());
+    x.push_back(p.z());
+  }
+  baseline.update(x);
+  baseline.collide(pose, contacts);
+  EXPECT_EQ(baseline.rebuild_count(), 0u);
+  EXPECT_EQ(baseline.refit_count(), 1u);
+  std::size_t tissue_contacts = 0;
+  for (const auto& c : contacts) {
+    if (c.tissue_vertex < 0) continue;
+    ++tissue_contacts;
+    EXPECT_NEAR(c.depth_m, 0.3e-3, 1e-12);
+    EXPECT_NEAR(c.normal.y(), 1.0, 1e-12);
+    EXPECT_NEAR(c.point_m.y(), 0.0, 1e-12);
+  }
+  EXPECT_EQ(tissue_contacts, sunk);
+}
+
+TEST(TriangleBaseline, EmptyOrMismatchedInputIsRefused) {
+  const geometry::SurfaceMesh box = test::box_surface({0, 0, 0}, {0.01, 0.01, 0.01});
+  EXPECT_THROW(TriangleBaseline(geometry::SurfaceMesh{}, {}, box), std::invalid_argument);
+  EXPECT_THROW(TriangleBaseline(box, {0, 1}, box), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fahr::haptic

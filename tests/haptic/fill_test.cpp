@@ -1,0 +1,205 @@
+// Sphere filling: weights, determinism, coverage on the neonatal tongue, bad input.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <limits>
+
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/haptic/coverage.h"
+#include "fahr/haptic/fill_spheres.h"
+#include "fahr/haptic/sphere_state.h"
+#include "test_meshes.h"
+
+namespace fahr::haptic {
+namespace {
+
+// Weights are formed from a handful of terms in double precision: the centre
+// they give matches the stored one to rounding of millimetre coordinates.
+constexpr double kCentreToleranceM = 1e-12;
+// The coverage target on the ~40 mm neonatal tongue.
+constexpr double kCoverageTargetM = 0.5e-3;
+
+void expect_weights_valid(const SphereLayout& layout, const geometry::TetMesh& mesh) {
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    double sum = 0.0;
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    const auto nodes = layout.nodes(i);
+    const auto weights = layout.weights(i);
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      ASSERT_GE(weights[k], 0.0) << "sphere " << i;
+      sum += weights[k];
+      c += weights[k] * mesh.rest_positions()[nodes[k]];
+    }
+    ASSERT_NEAR(sum, 1.0, kWeightSumTolerance) << "sphere " << i;
+    ASSERT_LT((c - layout.sphere(i).rest_centre_m).norm(), kCentreToleranceM) << "sphere " << i;
+    ASSERT_GE(layout.tets_of(i).size(), 1u);
+    ASSERT_LE(layout.tets_of(i).size(), 10u);
+  }
+}
+
+TEST(Fill, WeightsSumToOneAndReproduceTheCentreOnABlock) {
+  const auto mesh = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 6);
+  FillSettings settings;
+  settings.hugging_sample_spacing_m = 0.4e-3;
+  const SphereLayout layout = fill_spheres(mesh, settings);
+  ASSERT_GT(layout.size(), 20u);
+  expect_weights_valid(layout, mesh);
+}
+
+TEST(Fill, WeightsSumToOneAndReproduceTheCentreOnTheTongue) {
+  const SphereLayout& layout = test::neonatal_layout();
+  expect_weights_valid(layout, test::neonatal_tongue());
+  // The weights of most grid spheres spread over more than one tet's four nodes.
+  std::size_t spread = 0, grid = 0;
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    if (layout.sphere(i).origin != SphereOrigin::kGrid) continue;
+    ++grid;
+    spread += layout.nodes(i).size() > 4 ? 1 : 0;
+  }
+  EXPECT_GT(spread, grid / 2);
+}
+
+TEST(Fill, RestStateCentresFollowTheNodes) {
+  // A rigid translation of every node moves every centre by the same amount
+  // and keeps every radius.
+  const auto& mesh = test::neonatal_tongue();
+  const SphereLayout& layout = test::neonatal_layout();
+  const Eigen::Vector3d shift(0.002, -0.001, 0.0005);
+  std::vector<double> x;
+  for (const auto& p : mesh.rest_positions()) {
+    for (int a = 0; a < 3; ++a) x.push_back(p[a] + shift[a]);
+  }
+  SphereState state(layout);
+  ASSERT_TRUE(state.update(layout, x));
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    ASSERT_LT((state.centres_m()[i] - layout.sphere(i).rest_centre_m - shift).norm(), 1e-12);
+    ASSERT_NEAR(state.radii_m()[i], layout.sphere(i).rest_radius_m, 1e-12);
+  }
+  x[0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(state.update(layout, x)) << "a NaN position is refused";
+}
+
+TEST(Fill, IsDeterministic) {
+  const auto& mesh = test::neonatal_tongue();
+  const SphereLayout again = fill_spheres(mesh, FillSettings{});
+  EXPECT_EQ(again.size(), test::neonatal_layout().size());
+  EXPECT_EQ(again.fingerprint(), test::neonatal_layout().fingerprint());
+}
+
+TEST(Fill, CoverageOnTheNeonatalTongueIsBelowTarget) {
+  const auto& mesh = test::neonatal_tongue();
+  const SphereLayout& layout = test::neonatal_layout();
+  const geometry::SurfaceMesh boundary = mesh.boundary_surface();
+  geometry::SdfOptions options;
+  options.cell_size_m = 1e-3;
+  const geometry::SignedDistanceField sdf(boundary, options);
+  const SphereState rest(layout);
+  CoverageSettings coverage;
+  coverage.sample_spacing_m = 0.2e-3;  // finer than the closure's own samples
+  coverage.voxel_size_m = 0.2e-3;
+  const CoverageReport report = measure_coverage(rest.centres_m(), rest.radii_m(), boundary, sdf, coverage);
+  std::cout << "neonatal tongue: " << layout.size() << " spheres, boundary->union "
+            << report.boundary_to_union_max_m * 1e3 << " mm, union->boundary "
+            << report.union_to_boundary_max_m * 1e3 << " mm\n";
+  EXPECT_LT(report.hausdorff_m(), kCoverageTargetM);
+  EXPECT_GT(report.boundary_samples, 10000u);
+  EXPECT_GT(report.union_samples, 10000u);
+}
+
+TEST(Fill, WithoutHuggingTheCoverageGapIsLarge) {
+  // The paper's limitation (4.3), measured: grid and octree alone leave the
+  // surface uncovered by far more than the target.
+  const auto& mesh = test::neonatal_tongue();
+  FillSettings settings;
+  settings.surface_hugging = false;
+  const SphereLayout layout = fill_spheres(mesh, settings);
+  const geometry::SurfaceMesh boundary = mesh.boundary_surface();
+  const geometry::SignedDistanceField sdf(boundary, geometry::SdfOptions{});
+  const SphereState rest(layout);
+  const CoverageReport report = measure_coverage(rest.centres_m(), rest.radii_m(), boundary, sdf, CoverageSettings{});
+  EXPECT_GT(report.hausdorff_m(), 2.0 * kCoverageTargetM);
+}
+
+TEST(FillErrors, EmptyMesh) {
+  try {
+    fill_spheres(geometry::TetMesh{}, FillSettings{});
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("empty"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FillErrors, SettingsOutOfRangeNameTheField) {
+  const auto mesh = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 3);
+  auto expect_field = [&](FillSettings s, const char* field) {
+    try {
+      fill_spheres(mesh, s);
+      FAIL() << "no exception for " << field;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  FillSettings s;
+  s.volume_ratio = std::numeric_limits<double>::quiet_NaN();
+  expect_field(s, "volume_ratio");
+  s = {};
+  s.refinement_levels = 9;
+  expect_field(s, "refinement_levels");
+  s = {};
+  s.weight_spread = 1.0;
+  expect_field(s, "weight_spread");
+  s = {};
+  s.hugging_tolerance_m = -1.0;
+  expect_field(s, "hugging_tolerance_m");
+}
+
+TEST(FillErrors, BeyondTheBudget) {
+  const auto mesh = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 4);
+  FillSettings s;
+  s.max_spheres = 50;
+  s.refinement_levels = 3;
+  try {
+    fill_spheres(mesh, s);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_spheres = 50"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FillErrors, NonManifoldBoundary) {
+  // Two cubes' tets sharing a single edge: a tet mesh whose boundary is not a
+  // manifold, so inside and outside are ambiguous along that edge.
+  auto a = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 1);
+  auto b = test::block_tet_mesh({0.01, 0.01, 0}, {0.02, 0.02, 0.01}, 1);
+  std::vector<Eigen::Vector3d> x = a.rest_positions();
+  std::vector<geometry::Tet> t = a.tets();
+  // Merge b, welding the shared edge's nodes (x = y = 0.01).
+  std::vector<geometry::Index> map;
+  for (const auto& p : b.rest_positions()) {
+    geometry::Index found = -1;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      if ((x[i] - p).norm() < 1e-12) found = static_cast<geometry::Index>(i);
+    }
+    if (found < 0) {
+      x.push_back(p);
+      found = static_cast<geometry::Index>(x.size() - 1);
+    }
+    map.push_back(found);
+  }
+  for (auto tet : b.tets()) {
+    for (auto& n : tet) n = map[static_cast<std::size_t>(n)];
+    t.push_back(tet);
+  }
+  const geometry::TetMesh mesh(std::move(x), std::move(t));
+  try {
+    fill_spheres(mesh, FillSettings{});
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("not a closed manifold"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace fahr::haptic

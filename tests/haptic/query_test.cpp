@@ -1,0 +1,222 @@
+// Sphere-tree refit and queries against analytic fields (a plane, a sphere, a thin plate).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/haptic/fill_spheres.h"
+#include "fahr/haptic/sphere_query.h"
+#include "fahr/haptic/sphere_tree.h"
+#include "test_meshes.h"
+
+namespace fahr::haptic {
+namespace {
+
+// Exact queries of a flat face are exact to rounding.
+constexpr double kPlaneToleranceM = 1e-9;
+// A 5-times subdivided icosphere of radius 5 mm lies within R (1 - cos(a/2))
+// ~ 2 um of the true sphere (a ~ 1.1 degrees between vertices) radially; the
+// nearest point on a facet can sit up to about an edge length squared over R
+// (~ 20 um) aside from the analytic one.
+constexpr double kIcosphereToleranceM = 5e-6;
+constexpr double kIcospherePointToleranceM = 25e-6;
+
+struct Block {
+  geometry::TetMesh mesh = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 5);
+  SphereLayout layout;
+  SphereState state;
+  SphereTree tree;
+  Block() {
+    FillSettings s;
+    s.hugging_sample_spacing_m = 0.4e-3;
+    layout = fill_spheres(mesh, s);
+    state = SphereState(layout);
+    tree = SphereTree(layout);
+  }
+};
+
+Block& block() {
+  static Block b;
+  return b;
+}
+
+geometry::SignedDistanceField field(const geometry::SurfaceMesh& surface) {
+  geometry::SdfOptions options;
+  options.cell_size_m = 0.5e-3;
+  return geometry::SignedDistanceField(surface, options);
+}
+
+TEST(SphereTree, BoxesBoundTheirSpheresAndRefitNeverRebuilds) {
+  Block& b = block();
+  EXPECT_EQ(b.tree.rebuild_count(), 0u);
+  std::vector<double> x;
+  for (const auto& p : b.mesh.rest_positions()) {
+    // A smooth shear and squash, as a deformation.
+    x.push_back(p.x() + 0.2 * p.y());
+    x.push_back(0.8 * p.y());
+    x.push_back(p.z() + 0.1 * p.x());
+  }
+  for (int step = 0; step < 10; ++step) {
+    ASSERT_TRUE(b.state.update(b.layout, x));
+    b.tree.refit(b.state);
+  }
+  EXPECT_EQ(b.tree.rebuild_count(), 0u);
+  EXPECT_EQ(b.tree.refit_count(), 10u);
+  for (const auto& node : b.tree.nodes()) {
+    if (node.count == 0) continue;
+    for (std::int32_t k = 0; k < node.count; ++k) {
+      const auto s = b.tree.order()[static_cast<std::size_t>(node.first + k)];
+      const Eigen::Vector3d r = Eigen::Vector3d::Constant(b.state.radii_m()[s]);
+      EXPECT_TRUE(((b.state.centres_m()[s] - r).array() >= node.box_min_m.array() - 1e-15).all());
+      EXPECT_TRUE(((b.state.centres_m()[s] + r).array() <= node.box_max_m.array() + 1e-15).all());
+    }
+  }
+  b.state.reset_to_rest(b.layout);
+  b.tree.refit(b.state);
+}
+
+TEST(Query, PlaneContactsAreExact) {
+  Block& b = block();
+  // A slab occupying y < 0.5 mm: its top face is the plane y = h.
+  const double h = 0.5e-3;
+  const auto slab = field(test::box_surface({-0.01, -0.01, -0.01}, {0.02, h, 0.02}));
+  RigidBody body{7, &slab, Eigen::Isometry3d::Identity()};
+  PrePenetrationMemory memory(b.layout.size());
+  ContactBuffer buffer(4096);
+  query_spheres(b.tree, b.state, body, QuerySettings{}, memory, buffer);
+  ASSERT_FALSE(buffer.overflowed());
+  std::size_t expected = 0;
+  for (std::size_t i = 0; i < b.layout.size(); ++i) {
+    expected += b.state.centres_m()[i].y() - b.state.radii_m()[i] < h - kPlaneToleranceM ? 1 : 0;
+  }
+  EXPECT_EQ(buffer.size(), expected);
+  ASSERT_GT(buffer.size(), 10u);
+  for (const SphereContact& c : buffer) {
+    const Eigen::Vector3d centre = b.state.centres_m()[c.sphere_id];
+    EXPECT_EQ(c.body_id, 7u);
+    EXPECT_NEAR(c.depth_m, b.state.radii_m()[c.sphere_id] - (centre.y() - h), kPlaneToleranceM);
+    EXPECT_NEAR(c.normal.y(), 1.0, kPlaneToleranceM);
+    EXPECT_NEAR((c.point_m - Eigen::Vector3d(centre.x(), h, centre.z())).norm(), 0.0, kPlaneToleranceM);
+  }
+}
+
+TEST(Query, CandidatesAndGridNarrowPhaseOnAPlane) {
+  Block& b = block();
+  const double h = 0.5e-3;
+  const auto slab = field(test::box_surface({-0.01, -0.01, -0.01}, {0.02, h, 0.02}));
+  RigidBody body{7, &slab, Eigen::Isometry3d::Identity()};
+  PrePenetrationMemory memory(b.layout.size());
+  ContactBuffer buffer(4096);
+  QuerySettings settings;
+  settings.exact_narrow_phase = false;  // a flat face: the grid is exact there too
+  settings.candidate_margin_m = 0.3e-3;
+  query_spheres(b.tree, b.state, body, settings, memory, buffer);
+  std::size_t candidates = 0;
+  for (const SphereContact& c : buffer) {
+    const Eigen::Vector3d centre = b.state.centres_m()[c.sphere_id];
+    const double depth = b.state.radii_m()[c.sphere_id] - (centre.y() - h);
+    EXPECT_NEAR(c.depth_m, depth, 1e-9);
+    EXPECT_EQ(c.candidate, depth <= 0.0);
+    EXPECT_GT(c.depth_m, -settings.candidate_margin_m);
+    EXPECT_NEAR(c.normal.y(), 1.0, 1e-9);
+    candidates += c.candidate ? 1 : 0;
+  }
+  EXPECT_GT(candidates, 0u);
+}
+
+TEST(Query, SphereContactsMatchTheAnalyticDistance) {
+  Block& b = block();
+  const Eigen::Vector3d o(0.005, 0.005, -0.0049);  // the ball reaches 0.1 mm into the block
+  const double radius = 5e-3;
+  const auto ball = field(test::icosphere(Eigen::Vector3d::Zero(), radius, 5));
+  RigidBody body{1, &ball, Eigen::Isometry3d::Identity()};
+  body.world_from_body.translation() = o;
+  PrePenetrationMemory memory(b.layout.size());
+  ContactBuffer buffer(4096);
+  query_spheres(b.tree, b.state, body, QuerySettings{}, memory, buffer);
+  ASSERT_GT(buffer.size(), 5u);
+  for (const SphereContact& c : buffer) {
+    const Eigen::Vector3d centre = b.state.centres_m()[c.sphere_id];
+    const double d = (centre - o).norm() - radius;
+    ASSERT_GT(d, 0.0) << "no centre is inside the ball in this case";
+    EXPECT_NEAR(c.depth_m, b.state.radii_m()[c.sphere_id] - d, kIcosphereToleranceM);
+    EXPECT_NEAR(c.normal.dot((centre - o).normalized()), 1.0, 1e-3);
+    EXPECT_NEAR((c.point_m - (o + radius * (centre - o).normalized())).norm(), 0.0, kIcospherePointToleranceM);
+  }
+  // Every sphere that overlaps the ball by more than the tessellation error is reported.
+  std::size_t expected = 0;
+  for (std::size_t i = 0; i < b.layout.size(); ++i) {
+    const double d = (b.state.centres_m()[i] - o).norm() - radius;
+    expected += b.state.radii_m()[i] - d > kIcosphereToleranceM ? 1 : 0;
+  }
+  EXPECT_GE(buffer.size(), expected);
+}
+
+TEST(Query, NormalComesFromThePrePenetrationCentreThroughAThinPlate) {
+  Block& b = block();
+  // A 1 mm plate below the block, rising through it in 0.1 mm steps: once a
+  // centre is past the plate's mid-plane, the field's normal points down, but
+  // the remembered centre above keeps the contact normal up (+y).
+  const auto plate = field(test::box_surface({-0.01, -0.0005, -0.01}, {0.02, 0.0005, 0.02}));
+  RigidBody body{2, &plate, Eigen::Isometry3d::Identity()};
+  PrePenetrationMemory memory(b.layout.size());
+  ContactBuffer buffer(4096);
+  std::size_t deep = 0;
+  for (int step = 0; step <= 26; ++step) {  // the plate's bottom stays above the lowest centres
+    body.world_from_body.translation() = Eigen::Vector3d(0, -0.002 + 1e-4 * step, 0);
+    buffer.clear();
+    query_spheres(b.tree, b.state, body, QuerySettings{}, memory, buffer);
+    for (const SphereContact& c : buffer) {
+      EXPECT_FALSE(c.normal_without_history);
+      EXPECT_GT(c.normal.y(), 0.99) << "step " << step << " sphere " << c.sphere_id;
+      const double plate_top = body.world_from_body.translation().y() + 0.0005;
+      deep += b.state.centres_m()[c.sphere_id].y() < plate_top - 0.0005 ? 1 : 0;
+      EXPECT_NEAR(c.depth_m, b.state.radii_m()[c.sphere_id] - (b.state.centres_m()[c.sphere_id].y() - plate_top),
+                  kPlaneToleranceM);
+    }
+  }
+  EXPECT_GT(deep, 0u) << "some centres passed the mid-plane";
+}
+
+TEST(Query, OverflowIsAFlagAndANanPoseTouchesNothing) {
+  Block& b = block();
+  const auto slab = field(test::box_surface({-0.01, -0.01, -0.01}, {0.02, 0.005, 0.02}));
+  RigidBody body{3, &slab, Eigen::Isometry3d::Identity()};
+  PrePenetrationMemory memory(b.layout.size());
+  ContactBuffer small(4);
+  const QueryStats stats = query_spheres(b.tree, b.state, body, QuerySettings{}, memory, small);
+  EXPECT_TRUE(stats.overflowed);
+  EXPECT_TRUE(small.overflowed());
+  EXPECT_EQ(small.size(), 4u);
+  EXPECT_GT(stats.contacts, 4u);
+
+  body.world_from_body.translation().x() = std::numeric_limits<double>::quiet_NaN();
+  ContactBuffer buffer(64);
+  const QueryStats nan_stats = query_spheres(b.tree, b.state, body, QuerySettings{}, memory, buffer);
+  EXPECT_EQ(buffer.size(), 0u);
+  EXPECT_TRUE(nan_stats.body_skipped);
+}
+
+TEST(Query, FarBodyIsSkippedAtTheRoot) {
+  Block& b = block();
+  const auto ball = field(test::icosphere(Eigen::Vector3d::Zero(), 0.003, 2));
+  RigidBody body{4, &ball, Eigen::Isometry3d::Identity()};
+  body.world_from_body.translation() = Eigen::Vector3d(0.1, 0, 0);
+  PrePenetrationMemory memory(b.layout.size());
+  ContactBuffer buffer(64);
+  const QueryStats stats = query_spheres(b.tree, b.state, body, QuerySettings{}, memory, buffer);
+  EXPECT_TRUE(stats.body_skipped);
+  EXPECT_EQ(stats.nodes_visited, 1u);
+  EXPECT_EQ(stats.spheres_tested, 0u);
+}
+
+TEST(Query, OpenToolSurfaceIsRefusedByTheField) {
+  auto box = test::box_surface({0, 0, 0}, {0.01, 0.01, 0.01});
+  std::vector<geometry::Triangle> open(box.triangles().begin(), box.triangles().end() - 1);
+  const geometry::SurfaceMesh surface(box.vertices(), open);
+  EXPECT_THROW(geometry::SignedDistanceField(surface, geometry::SdfOptions{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fahr::haptic

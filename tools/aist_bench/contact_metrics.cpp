@@ -1,0 +1,155 @@
+// Contact recall and depth error (see contact_metrics.h).
+#include "contact_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "stats.h"
+
+namespace fahr::aist_bench {
+
+ContactMetrics::ContactMetrics(const Scene& scene) : scene_(scene) {}
+
+namespace {
+
+// Generalised winding number of a closed triangle surface at p (Jacobson et
+// al. 2013, from van Oosterom and Strackee's solid angle): about 1 inside, 0 outside.
+double winding_number(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& v,
+                      const std::vector<geometry::Triangle>& triangles) {
+  double sum = 0.0;
+  for (const auto& t : triangles) {
+    const Eigen::Vector3d a = v[t[0]] - p, b = v[t[1]] - p, c = v[t[2]] - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double numerator = a.dot(b.cross(c));
+    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    sum += 2.0 * std::atan2(numerator, denominator);
+  }
+  return sum / (4.0 * 3.14159265358979323846);
+}
+
+}  // namespace
+
+void ContactMetrics::add_tick(const haptic::ContactBuffer& aist, const haptic::SphereState& state,
+                              const std::vector<haptic::TriangleContact>& base,
+                              const Eigen::Isometry3d& world_from_blade, std::span<const double> positions_m) {
+  std::vector<Eigen::Vector3d> deformed;
+  bool have_deformed = false;
+  auto inside_tongue = [&](const Eigen::Vector3d& p) {
+    if (!have_deformed) {
+      for (const auto node : scene_.surface_to_node) {
+        const auto n = static_cast<std::size_t>(node);
+        deformed.emplace_back(positions_m[3 * n], positions_m[3 * n + 1], positions_m[3 * n + 2]);
+      }
+      have_deformed = true;
+    }
+    return winding_number(p, deformed, scene_.boundary.triangles()) > 0.5;
+  };
+  const auto& centres = state.centres_m();
+  const auto& radii = state.radii_m();
+  auto in_region = [&](const haptic::SphereContact& a, const Eigen::Vector3d& p) {
+    return (p - centres[a.sphere_id]).norm() <= radii[a.sphere_id] + kRegionSlackM;
+  };
+  const Eigen::Isometry3d blade_from_world = world_from_blade.inverse();
+  for (const auto& b : base) {
+    // The tissue-side point: the penetrating tongue vertex, or the blade
+    // vertex that is inside the tongue.
+    const Eigen::Vector3d p = b.tissue_vertex >= 0 ? Eigen::Vector3d(b.point_m - b.depth_m * b.normal) : b.point_m;
+    // Verified against exact geometry: a tongue vertex must be inside the
+    // blade (its exact field), a blade vertex inside the deformed tongue (its
+    // winding number); a vertex merely behind a face is a false contact.
+    double exact = b.depth_m;
+    if (b.tissue_vertex >= 0) {
+      exact = -scene_.blade_sdf.query_exact(blade_from_world * p).distance_m;
+      if (exact <= 0.0) {
+        ++base_false_;
+        continue;
+      }
+    } else if (!inside_tongue(p)) {
+      ++base_false_;
+      continue;
+    }
+    ++base_total_;
+    bool recalled = false, near = false;
+    double aist_depth = 0.0;
+    for (const auto& a : aist) {
+      if (!in_region(a, p)) continue;
+      near = true;
+      if (a.candidate) continue;
+      recalled = true;
+      aist_depth = std::max(aist_depth, a.depth_m);
+    }
+    base_recalled_ += recalled ? 1 : 0;
+    base_recalled_near_ += near ? 1 : 0;
+    if (exact >= kDeepM) {
+      ++deep_total_;
+      deep_recalled_ += recalled ? 1 : 0;
+    }
+    if (exact >= kDeeperM) {
+      ++deeper_total_;
+      deeper_recalled_ += recalled ? 1 : 0;
+      deeper_recalled_near_ += near ? 1 : 0;
+    }
+    if (b.tissue_vertex >= 0) {
+      exact_depth_m_.push_back(exact);
+      aist_depth_error_m_.push_back(std::abs(aist_depth - exact));
+      base_depth_error_m_.push_back(std::abs(b.depth_m - exact));
+    }
+  }
+  for (const auto& a : aist) {
+    if (a.candidate) continue;
+    ++aist_total_;
+    bool matched = false;
+    for (const auto& b : base) {
+      const Eigen::Vector3d p = b.tissue_vertex >= 0 ? Eigen::Vector3d(b.point_m - b.depth_m * b.normal) : b.point_m;
+      matched = matched || in_region(a, p);
+    }
+    aist_unmatched_ += matched ? 0 : 1;
+  }
+  contact_ticks_ += (aist.size() > 0 || !base.empty()) ? 1 : 0;
+  ticks_both_ += (aist.size() > 0 && !base.empty()) ? 1 : 0;
+}
+
+double ContactMetrics::recall() const {
+  return base_total_ > 0 ? static_cast<double>(base_recalled_) / static_cast<double>(base_total_) : 1.0;
+}
+
+double ContactMetrics::recall_near() const {
+  return base_total_ > 0 ? static_cast<double>(base_recalled_near_) / static_cast<double>(base_total_) : 1.0;
+}
+
+double ContactMetrics::recall_deeper() const {
+  return deeper_total_ > 0 ? static_cast<double>(deeper_recalled_) / static_cast<double>(deeper_total_) : 1.0;
+}
+
+double ContactMetrics::depth_error_p99_m() const { return percentile(aist_depth_error_m_, 99); }
+
+void ContactMetrics::print() const {
+  auto ratio = [](std::size_t a, std::size_t b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 100.0; };
+  std::printf("\nRecall: a baseline contact's tissue-side point (the tongue vertex inside the blade, or the blade vertex "
+              "inside the tongue) is recalled when it lies in the region of an AIST sphere that reports contact: within "
+              "its radius + %.1f mm (the coverage target). \"with candidates\": an AIST sphere within the candidate margin (not touching) counts as well. Baseline tongue-vertex contacts that the exact blade field puts "
+              "outside the blade are the baseline's false contacts and are left out. Ticks with contacts: %zu (both: %zu).\n\n",
+              kRegionSlackM * 1e3, contact_ticks_, ticks_both_);
+  std::printf("| baseline contacts (verified) | recall | with candidates | deeper than %.2f mm | recall | deeper than %.2f mm | recall | with candidates | baseline false contacts | AIST contacts | AIST with no baseline contact in region |\n",
+              kDeepM * 1e3, kDeeperM * 1e3);
+  std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+  std::printf("| %zu | %.2f%% | %.2f%% | %zu | %.2f%% | %zu | %.2f%% | %.2f%% | %zu | %zu | %zu (%.1f%%) |\n", base_total_,
+              ratio(base_recalled_, base_total_), ratio(base_recalled_near_, base_total_), deep_total_,
+              ratio(deep_recalled_, deep_total_), deeper_total_, ratio(deeper_recalled_, deeper_total_),
+              ratio(deeper_recalled_near_, deeper_total_), base_false_, aist_total_, aist_unmatched_,
+              ratio(aist_unmatched_, aist_total_));
+  std::printf("\nDepth error at each baseline tongue-vertex contact (%zu): the exact penetration of that vertex into the "
+              "blade (-sdf, exact query; median %.3f mm, max %.3f mm) against the deepest AIST contact whose region holds "
+              "the vertex, and against the baseline's own face depth.\n\n",
+              exact_depth_m_.size(), percentile(exact_depth_m_, 50) * 1e3, percentile(exact_depth_m_, 100) * 1e3);
+  std::printf("| method | median (mm) | p95 (mm) | p99 (mm) | max (mm) |\n| --- | --- | --- | --- | --- |\n");
+  std::printf("| AIST | %.3f | %.3f | %.3f | %.3f |\n", percentile(aist_depth_error_m_, 50) * 1e3,
+              percentile(aist_depth_error_m_, 95) * 1e3, percentile(aist_depth_error_m_, 99) * 1e3,
+              percentile(aist_depth_error_m_, 100) * 1e3);
+  std::printf("| baseline | %.3f | %.3f | %.3f | %.3f |\n", percentile(base_depth_error_m_, 50) * 1e3,
+              percentile(base_depth_error_m_, 95) * 1e3, percentile(base_depth_error_m_, 99) * 1e3,
+              percentile(base_depth_error_m_, 100) * 1e3);
+}
+
+}  // namespace fahr::aist_bench

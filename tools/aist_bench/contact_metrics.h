@@ -1,0 +1,52 @@
+// Recall of the AIST contacts against the baseline's and the depth error of
+// both against an exact reference (see the definitions in print()).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <span>
+#include <vector>
+
+#include "fahr/haptic/contact_buffer.h"
+#include "fahr/haptic/sphere_state.h"
+#include "fahr/haptic/triangle_baseline.h"
+#include "scene.h"
+
+namespace fahr::aist_bench {
+
+class ContactMetrics {
+ public:
+  explicit ContactMetrics(const Scene& scene);
+  // One tick's contacts; with_reference computes the exact depth reference
+  // (dense samples of the deformed boundary against the blade's field).
+  void add_tick(const haptic::ContactBuffer& aist, const haptic::SphereState& state,
+                const std::vector<haptic::TriangleContact>& base, const Eigen::Isometry3d& world_from_blade,
+                std::span<const double> positions_m);
+  void print() const;
+  double recall() const;
+  double recall_deeper() const;
+  double recall_near() const;  // counting candidate spheres too  // over verified contacts deeper than kDeeperM
+  double depth_error_p99_m() const;
+
+  // Baseline contacts shallower than this are also counted apart: the sphere
+  // union may lie up to the coverage (about 0.4 mm) inside the surface, so a
+  // graze of a few micrometres is below what it resolves, m.
+  static constexpr double kDeepM = 0.1e-3;
+  // A baseline contact point lies in an AIST sphere's region when it is
+  // within the sphere grown by this: the coverage target, the distance by
+  // which the boundary may stand off the sphere union, m.
+  static constexpr double kRegionSlackM = 0.5e-3;
+  // The second depth class: the closure's tolerance, below which the sphere
+  // union may stand inside the surface by construction, m.
+  static constexpr double kDeeperM = 0.25e-3;
+
+ private:
+  const Scene& scene_;
+  std::size_t base_total_ = 0, base_recalled_ = 0, base_recalled_near_ = 0, base_false_ = 0;
+  std::size_t deeper_recalled_near_ = 0;
+  std::size_t deep_total_ = 0, deep_recalled_ = 0, deeper_total_ = 0, deeper_recalled_ = 0;
+  std::size_t aist_total_ = 0, aist_unmatched_ = 0;
+  std::size_t contact_ticks_ = 0, ticks_both_ = 0;
+  std::vector<double> aist_depth_error_m_, base_depth_error_m_, exact_depth_m_;
+};
+
+}  // namespace fahr::aist_bench

@@ -1,0 +1,41 @@
+// aist_bench: prints Markdown tables. Sections: coverage, trajectory, sweep
+// (default: all). Usage: aist_bench [coverage|trajectory|sweep|all] [--ticks N] [--skin-mm S] [--spread W] [--sweep-steps N]
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "sections.h"
+
+int main(int argc, char** argv) {
+  using namespace fahr::aist_bench;
+  std::string section = "all";
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--ticks") == 0 && i + 1 < argc) {
+      options.ticks = std::stoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--spread") == 0 && i + 1 < argc) {
+      options.weight_spread = std::stod(argv[++i]);
+    } else if (std::strcmp(argv[i], "--skin-mm") == 0 && i + 1 < argc) {
+      options.skin_m = 1e-3 * std::stod(argv[++i]);
+    } else if (std::strcmp(argv[i], "--sweep-steps") == 0 && i + 1 < argc) {
+      options.sweep_steps = std::stoi(argv[++i]);
+    } else {
+      section = argv[i];
+    }
+  }
+  try {
+    const auto scene = load_scene(0.5e-3);
+    std::printf("# AIST benchmark (neonatal scene, Miller 1 blade)\n\n");
+    std::printf("tongue: %zu nodes, %zu tets, %zu boundary triangles (mean edge %.2f mm); blade: %zu triangles\n",
+                scene->tongue.node_count(), scene->tongue.tet_count(), scene->boundary.triangle_count(),
+                scene->mean_boundary_edge_m * 1e3, scene->blade.triangle_count());
+    if (section == "coverage" || section == "all") coverage_table(*scene);
+    if (section == "trajectory" || section == "all") trajectory_table(*scene, options);
+    if (section == "sweep" || section == "all") sweep_table(*scene, options);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "aist_bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
