@@ -116,7 +116,17 @@ int main(int argc, char** argv) {
           t.late_periods = s.late_periods();
           t.worst_cpu_p99_ns = std::max(t.worst_cpu_p99_ns, s.tick_cpu().p99_ns());
           t.worst_period_max_ns = std::max(t.worst_period_max_ns, s.period().max_ns());
-          for (const auto& m : s.metrics()) t.metrics[m.name().to_string()] = m.value();
+          // A report window with no samples of a windowed figure (the
+          // gateway's final report after its last in-loop one) would hide
+          // the run's values: keep the newest window that has samples.
+          bool empty_window = false;
+          for (const auto& m : s.metrics()) {
+            const std::string name = m.name().to_string();
+            if (name.size() > 6 && name.compare(name.size() - 6, 6, "_count") == 0 && m.value() == 0) empty_window = true;
+          }
+          if (!empty_window || t.metrics.empty()) {
+            for (const auto& m : s.metrics()) t.metrics[m.name().to_string()] = m.value();
+          }
         });
     common::Subscriber<msg::ServiceEvents> events(
         participant, reports, common::TopicTraits<msg::ServiceEvents>::kName,

@@ -8,7 +8,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -16,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/common/stop_signal.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/config_error.h"
 #include "fahr/common/lockstep.h"
@@ -39,8 +39,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop = true; }
 
 // The remote-input topic (the browser's mouse device publishes DevicePose there).
 constexpr std::string_view kRemoteInputTopic = "fahr/RemoteInput";
@@ -175,7 +173,7 @@ int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& par
   std::int64_t last_start_ns = start_ns;
   std::int64_t window_start_ns = start_ns;
   std::uint64_t window_start_tick = 0;
-  for (std::uint64_t tick = 0; !g_stop && (total_ticks == 0 || tick < total_ticks); ++tick) {
+  for (std::uint64_t tick = 0; !common::stop_requested() && (total_ticks == 0 || tick < total_ticks); ++tick) {
     // --- the servo tick: no allocation, blocking or logging from here ...
     const std::int64_t tick_start_ns = common::monotonic_now_ns();
     const std::int64_t cpu_start_ns = common::thread_cpu_now_ns();
@@ -233,7 +231,7 @@ int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& par
   device::ForceCommandSample command;
   std::uint64_t last_command_seq = 0;
   const auto total_ticks = static_cast<std::uint64_t>(setup.duration_s * 1000.0);
-  for (std::uint64_t k = 0; !g_stop && (total_ticks == 0 || k < total_ticks) && client.wait_for_grant(k, 20s); ++k) {
+  for (std::uint64_t k = 0; !common::stop_requested() && (total_ticks == 0 || k < total_ticks) && client.wait_for_grant(k, 20s); ++k) {
     const device::ForceCommandSample* incoming = nullptr;
     if (input) {
       if (const auto step = common::producer_step_for(k, o.force_input_period)) {
@@ -276,8 +274,7 @@ int run(int argc, char** argv) {
   if (!options) return 2;
   auto setup = make_setup(*options);
   if (!setup) return 2;
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  common::install_stop_handlers();
   common::Participant participant(
       common::transport_config_from(options->dds, options->domain, options->profile, "device_gateway"));
   StatusReporter reporter(participant, options->status_hz, 1000.0, options->backend);

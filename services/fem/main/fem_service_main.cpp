@@ -18,6 +18,7 @@
 #include "fahr/common/config_error.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/service_reporter.h"
+#include "fahr/common/stop_signal.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/scene/plan.h"
 #include "fahr/scene/scene_error.h"
@@ -101,7 +102,7 @@ int run_realtime(common::Participant& participant, StepContext& ctx, const scene
   const auto period = scene.rates.fem_period();
   const auto start = Clock::now();
   auto next = start;
-  for (std::uint64_t tick = 0;; ++tick) {
+  for (std::uint64_t tick = 0; !common::stop_requested(); ++tick) {
     next += period;
     std::this_thread::sleep_until(next);
     if (duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(duration_s)) break;
@@ -128,7 +129,7 @@ int run_lockstep(common::Participant& participant, StepContext& ctx, const scene
   const auto fem_steps = static_cast<std::uint64_t>(scene.rates.fem_period() / base);
   const auto haptic_steps = static_cast<std::uint64_t>(scene.rates.haptic_period() / base);
   common::OutputHash hash;
-  for (std::uint64_t k = 0; client.wait_for_grant(k, 60s); k += fem_steps) {
+  for (std::uint64_t k = 0; !common::stop_requested() && client.wait_for_grant(k, 60s); k += fem_steps) {
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
     if (auto s = common::producer_step_for(k, haptic_steps)) {
@@ -190,6 +191,7 @@ int run(int argc, char** argv) {
   const bool lockstep = mode.empty() ? scene->run.mode == scene::RunMode::kLockstep : mode == "lockstep";
   if (duration_s < 0) duration_s = std::chrono::duration<double>(scene->run.duration).count();
 
+  common::install_stop_handlers();
   FemBodySetup setup = set_up_body(*scene, scene->bodies[plan.fem_bodies.front()]);
   StepContext ctx(setup);
   common::Participant participant(transport(dds, domain, profile, *scene));
@@ -197,6 +199,7 @@ int run(int argc, char** argv) {
   common::ServiceReporter reporter(participant, {"fem", scene->rates.fem_hz, scene->rates.status_period() > 0ns ?
                                                  std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period()) : 250ms},
                                    recorder, [&](auto& metrics) { ctx.metrics(metrics); });
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // launchers wait for the start line
   std::printf("fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres), %.0f Hz, %s\n",
               std::string(common::vendor_name(participant.vendor())).c_str(), setup.scene_body->name.c_str(),
               setup.mesh.node_count(), setup.mesh.tet_count(), setup.fixed_nodes.size(), setup.links.size(),

@@ -1,0 +1,146 @@
+#!/usr/bin/env bash
+# The first end-to-end run (issue 7, part 6): the device gateway (simulated
+# hand on the scripted intubation), the FEM service and the haptic service as
+# separate processes on one DDS vendor and domain, with fahr_run_summary
+# listening for the run's duration; then stops them and prints the summary.
+#
+#   deployment/run_local.sh [BUILD_DIR] [--dds cyclonedds|fastdds] [--domain N]
+#                           [--duration-s S] [--scene FILE] [--script intubation|overshoot]
+#
+# BUILD_DIR defaults to $FAHR_BUILD_DIR, else build/. As root the whole run
+# happens inside tests/run_in_netns.sh (a loopback-only network namespace);
+# otherwise every participant gets the loopback profile of deployment/dds.
+# Logs of each process go to $FAHR_RUN_LOG_DIR (default: a fresh temporary
+# folder, printed at the end). Exit status: 0 if every service ran and the
+# summary printed, non-zero otherwise.
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+
+build="${FAHR_BUILD_DIR:-$repo/build}"
+dds=cyclonedds
+domain=42
+duration_s=20
+scene="$repo/deployment/scenes/neonatal_intubation.yaml"
+script=intubation
+args=("$@")
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --dds) dds="$2"; shift 2 ;;
+    --domain) domain="$2"; shift 2 ;;
+    --duration-s) duration_s="$2"; shift 2 ;;
+    --scene) scene="$2"; shift 2 ;;
+    --script) script="$2"; shift 2 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
+    *) build="$1"; shift ;;
+  esac
+done
+case "$dds" in cyclonedds|fastdds) ;; *) echo "run_local: --dds must be cyclonedds or fastdds, not '$dds'" >&2; exit 2 ;; esac
+
+# As root: re-enter inside a loopback-only namespace, so the run never
+# touches a real network (and concurrent runs on the host cannot meet it).
+if [ "$(id -u)" -eq 0 ] && [ -z "${FAHR_RUN_LOCAL_IN_NETNS:-}" ]; then
+  FAHR_RUN_LOCAL_IN_NETNS=1 exec "$repo/tests/run_in_netns.sh" bash "$0" "${args[@]}"
+fi
+
+gateway="$build/services/device_gateway/fahr_device_gateway"
+fem="$build/services/fem/main/fahr_fem_service"
+haptic="$build/services/haptic/main/fahr_haptic_service"
+summary="$build/tools/run_summary/fahr_run_summary"
+for exe in "$gateway" "$fem" "$haptic" "$summary"; do
+  if [ ! -x "$exe" ]; then
+    echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway_service fahr_fem_service fahr_haptic_service fahr_run_summary" >&2
+    exit 2
+  fi
+done
+
+profile_flags=()
+gateway_profile=()
+if [ -z "${FAHR_RUN_LOCAL_IN_NETNS:-}" ]; then
+  profile="$repo/deployment/dds/${dds}_loopback.xml"
+  profile_flags=(--dds-profile "$profile")
+  gateway_profile=(--profile "$profile")
+fi
+common=(--dds "$dds" --domain "$domain")
+
+logs="${FAHR_RUN_LOG_DIR:-$(mktemp -d /tmp/fahr-run-XXXXXX)}"
+mkdir -p "$logs"
+pids=()
+
+# Stops one process: SIGINT, then SIGTERM, then SIGKILL, a few seconds apart.
+stop() {
+  local pid=$1
+  kill -0 "$pid" 2>/dev/null || return 0
+  for signal in INT TERM; do
+    kill -s "$signal" "$pid" 2>/dev/null || true
+    for _ in $(seq 50); do
+      kill -0 "$pid" 2>/dev/null || return 0
+      sleep 0.1
+    done
+  done
+  echo "run_local: process $pid ignored SIGINT and SIGTERM; killing it" >&2
+  kill -s KILL "$pid" 2>/dev/null || true
+}
+cleanup() {
+  for pid in "${pids[@]}"; do stop "$pid"; done
+  wait 2>/dev/null || true
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+# Waits until a log shows a line, or the process died, or time ran out.
+wait_for_line() {
+  local log=$1 pattern=$2 pid=$3 timeout_s=$4
+  for _ in $(seq $((timeout_s * 10))); do
+    grep -q "$pattern" "$log" 2>/dev/null && return 0
+    kill -0 "$pid" 2>/dev/null || { echo "run_local: $(basename "$log" .log) exited during set-up:" >&2; tail -n 20 "$log" >&2; return 1; }
+    sleep 0.1
+  done
+  echo "run_local: $(basename "$log" .log) not ready after ${timeout_s} s" >&2
+  return 1
+}
+
+echo "run_local: $dds, domain $domain, ${duration_s} s of the '$script' script, logs in $logs"
+stdbuf -oL "$fem" --scene "$scene" "${common[@]}" "${profile_flags[@]}" --mode realtime --duration-s 0 >"$logs/fem.log" 2>&1 &
+fem_pid=$!; pids+=("$fem_pid")
+"$haptic" --scene "$scene" "${common[@]}" "${profile_flags[@]}" --duration-s 0 >"$logs/haptic.log" 2>&1 &
+haptic_pid=$!; pids+=("$haptic_pid")
+# (stdbuf: the services print their start line with printf; line buffering
+# gets it into the log while they run.)
+# The gateway's script starts with its first tick: start it only when both
+# services have built their meshes, spheres and fields.
+wait_for_line "$logs/fem.log" "^fahr_fem_service: " "$fem_pid" 60
+wait_for_line "$logs/haptic.log" "ready" "$haptic_pid" 60
+
+# The summary listens a little longer than the gateway runs, so it sees the
+# services' last reports.
+"$summary" --duration-s "$(awk "BEGIN { print $duration_s + 2 }")" "${common[@]}" "${profile_flags[@]}" \
+  >"$logs/summary.md" 2>"$logs/summary.err" &
+summary_pid=$!; pids+=("$summary_pid")
+sleep 0.5  # the summary's readers match before the first DevicePose
+stdbuf -oL "$gateway" "${common[@]}" "${gateway_profile[@]}" --backend simulated --script "$script" \
+  --duration-s "$duration_s" >"$logs/gateway.log" 2>&1 &
+gateway_pid=$!; pids+=("$gateway_pid")
+
+status=0
+wait "$gateway_pid" || { status=$?; echo "run_local: the gateway exited with $status" >&2; tail -n 20 "$logs/gateway.log" >&2; }
+wait "$summary_pid" || { status=$?; echo "run_local: the summary exited with $status" >&2; cat "$logs/summary.err" >&2; }
+for name in haptic fem; do
+  pid_var="${name}_pid"
+  pid=${!pid_var}
+  if ! kill -0 "$pid" 2>/dev/null; then
+    echo "run_local: $name died during the run:" >&2
+    tail -n 20 "$logs/$name.log" >&2
+    status=1
+  fi
+  stop "$pid"
+  wait "$pid" 2>/dev/null || true
+done
+pids=()
+
+cat "$logs/summary.md"
+echo
+echo "run_local: service logs:"
+for name in gateway fem haptic; do tail -n 2 "$logs/$name.log" | sed "s/^/  [$name] /"; done
+echo "run_local: logs in $logs"
+exit "$status"
