@@ -6,7 +6,10 @@
 #
 #   deployment/run_local.sh [BUILD_DIR] [--dds cyclonedds|fastdds] [--domain N]
 #                           [--duration-s S] [--scene FILE] [--script intubation|overshoot]
+#                           [--dds-gateway V] [--dds-fem V] [--dds-haptic V]
 #
+# --dds-<service> puts one service on another vendor (a mixed-vendor run);
+# the summary listens with --dds.
 # BUILD_DIR defaults to $FAHR_BUILD_DIR, else build/. As root the whole run
 # happens inside tests/run_in_netns.sh (a loopback-only network namespace);
 # otherwise every participant gets the loopback profile of deployment/dds.
@@ -22,6 +25,9 @@ domain=42
 duration_s=20
 scene="$repo/deployment/scenes/neonatal_intubation.yaml"
 script=intubation
+dds_gateway=""
+dds_fem=""
+dds_haptic=""
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -30,12 +36,20 @@ while [ $# -gt 0 ]; do
     --duration-s) duration_s="$2"; shift 2 ;;
     --scene) scene="$2"; shift 2 ;;
     --script) script="$2"; shift 2 ;;
+    --dds-gateway) dds_gateway="$2"; shift 2 ;;
+    --dds-fem) dds_fem="$2"; shift 2 ;;
+    --dds-haptic) dds_haptic="$2"; shift 2 ;;
     -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
 done
-case "$dds" in cyclonedds|fastdds) ;; *) echo "run_local: --dds must be cyclonedds or fastdds, not '$dds'" >&2; exit 2 ;; esac
+dds_gateway="${dds_gateway:-$dds}"
+dds_fem="${dds_fem:-$dds}"
+dds_haptic="${dds_haptic:-$dds}"
+for v in "$dds" "$dds_gateway" "$dds_fem" "$dds_haptic"; do
+  case "$v" in cyclonedds|fastdds) ;; *) echo "run_local: a DDS vendor must be cyclonedds or fastdds, not '$v'" >&2; exit 2 ;; esac
+done
 
 # As root: re-enter inside a loopback-only namespace, so the run never
 # touches a real network (and concurrent runs on the host cannot meet it).
@@ -54,14 +68,19 @@ for exe in "$gateway" "$fem" "$haptic" "$summary"; do
   fi
 done
 
-profile_flags=()
-gateway_profile=()
-if [ -z "${FAHR_RUN_LOCAL_IN_NETNS:-}" ]; then
-  profile="$repo/deployment/dds/${dds}_loopback.xml"
-  profile_flags=(--dds-profile "$profile")
-  gateway_profile=(--profile "$profile")
-fi
-common=(--dds "$dds" --domain "$domain")
+# The transport flags of a participant on vendor $1: outside a namespace,
+# with the vendor's loopback profile.
+transport_flags() {
+  local vendor=$1
+  printf '%s\n' --dds "$vendor" --domain "$domain"
+  if [ -z "${FAHR_RUN_LOCAL_IN_NETNS:-}" ]; then
+    printf '%s\n' --dds-profile "$repo/deployment/dds/${vendor}_loopback.xml"
+  fi
+}
+mapfile -t common < <(transport_flags "$dds")
+mapfile -t gateway_flags < <(transport_flags "$dds_gateway")
+mapfile -t fem_flags < <(transport_flags "$dds_fem")
+mapfile -t haptic_flags < <(transport_flags "$dds_haptic")
 
 logs="${FAHR_RUN_LOG_DIR:-$(mktemp -d /tmp/fahr-run-XXXXXX)}"
 mkdir -p "$logs"
@@ -100,10 +119,10 @@ wait_for_line() {
   return 1
 }
 
-echo "run_local: $dds, domain $domain, ${duration_s} s of the '$script' script, logs in $logs"
-stdbuf -oL "$fem" --scene "$scene" "${common[@]}" "${profile_flags[@]}" --mode realtime --duration-s 0 >"$logs/fem.log" 2>&1 &
+echo "run_local: gateway $dds_gateway, fem $dds_fem, haptic $dds_haptic, domain $domain, ${duration_s} s of the '$script' script, logs in $logs"
+stdbuf -oL "$fem" --scene "$scene" "${fem_flags[@]}" --mode realtime --duration-s 0 >"$logs/fem.log" 2>&1 &
 fem_pid=$!; pids+=("$fem_pid")
-"$haptic" --scene "$scene" "${common[@]}" "${profile_flags[@]}" --duration-s 0 >"$logs/haptic.log" 2>&1 &
+"$haptic" --scene "$scene" "${haptic_flags[@]}" --duration-s 0 >"$logs/haptic.log" 2>&1 &
 haptic_pid=$!; pids+=("$haptic_pid")
 # (stdbuf: the services print their start line with printf; line buffering
 # gets it into the log while they run.)
@@ -114,11 +133,11 @@ wait_for_line "$logs/haptic.log" "ready" "$haptic_pid" 60
 
 # The summary listens a little longer than the gateway runs, so it sees the
 # services' last reports.
-"$summary" --duration-s "$(awk "BEGIN { print $duration_s + 2 }")" "${common[@]}" "${profile_flags[@]}" \
+"$summary" --duration-s "$(awk "BEGIN { print $duration_s + 2 }")" "${common[@]}" \
   >"$logs/summary.md" 2>"$logs/summary.err" &
 summary_pid=$!; pids+=("$summary_pid")
 sleep 0.5  # the summary's readers match before the first DevicePose
-stdbuf -oL "$gateway" "${common[@]}" "${gateway_profile[@]}" --backend simulated --script "$script" \
+stdbuf -oL "$gateway" "${gateway_flags[@]}" --backend simulated --script "$script" \
   --duration-s "$duration_s" >"$logs/gateway.log" 2>&1 &
 gateway_pid=$!; pids+=("$gateway_pid")
 

@@ -11,7 +11,7 @@ namespace fahr::device_main {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: fahr_device_gateway [--dds fastdds|cyclonedds|inprocess] [--domain N] [--profile FILE]\n"
+    "usage: fahr_device_gateway [--dds fastdds|cyclonedds|inprocess] [--domain N] [--dds-profile FILE]\n"
     "         [--mode realtime|lockstep] [--backend simulated|replay|remote|openhaptics]\n"
     "         [--script intubation|overshoot] [--model touch_x|touch] [--duration-s S]\n"
     "         [--replay-file FILE] [--record-file FILE] [--device-id N] [--rt-priority 1-99]\n"
@@ -54,7 +54,7 @@ std::optional<GatewayOptions> parse_options(int argc, char** argv) {
     bool ok = true;
     if (flag == "--dds") o.dds = value;
     else if (flag == "--domain") o.domain = value;
-    else if (flag == "--profile") o.profile = value;
+    else if (flag == "--dds-profile" || flag == "--profile") o.profile = value;
     else if (flag == "--mode") o.mode = value;
     else if (flag == "--backend") o.backend = value;
     else if (flag == "--script") o.script = value;

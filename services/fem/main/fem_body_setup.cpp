@@ -5,19 +5,11 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "fahr/geometry/tet_mesh_loader.h"
 #include "fahr/haptic/fill_spheres.h"
+#include "fahr/runtime/scene_bodies.h"
 
 namespace fahr::fem_service {
 namespace {
-
-geometry::TetMesh world_mesh(const scene::Body& body) {
-  const geometry::TetMesh local = geometry::load_tet_mesh(body.mesh_path, body.mesh_scale);
-  std::vector<Eigen::Vector3d> world;
-  world.reserve(local.node_count());
-  for (const auto& p : local.rest_positions()) world.push_back(body.pose.position_m + body.pose.orientation * p);
-  return geometry::TetMesh(std::move(world), local.tets());
-}
 
 std::vector<std::uint32_t> fixed_nodes(const scene::Body& body, const geometry::TetMesh& mesh) {
   const auto& fixed = body.deformable->fixed;
@@ -63,25 +55,15 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
   return s;
 }
 
-haptic::FillSettings fill_settings(const scene::Body& body) {
-  haptic::FillSettings f;
-  const auto& a = body.deformable->aist;
-  f.volume_ratio = a.sphere_tet_volume_ratio;
-  f.refinement_levels = a.refinement_levels;
-  f.surface_hugging = a.surface_spheres;
-  f.max_spheres = static_cast<std::size_t>(a.sphere_budget);
-  return f;
-}
-
 }  // namespace
 
 FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body) {
   FemBodySetup setup;
   setup.scene_body = &body;
-  setup.mesh = world_mesh(body);
+  setup.mesh = runtime::world_tet_mesh(body);
   setup.fixed_nodes = fixed_nodes(body, setup.mesh);
   setup.settings = body_settings(scene, body);
-  const haptic::SphereLayout layout = haptic::fill_spheres(setup.mesh, fill_settings(body));
+  const haptic::SphereLayout layout = haptic::fill_spheres(setup.mesh, runtime::fill_settings_for(body));
   for (std::size_t i = 0; i < layout.size(); ++i) {
     const std::string error = setup.links.add_sphere(layout.nodes(i), layout.weights(i), layout.sphere(i).rest_radius_m);
     if (!error.empty()) throw std::runtime_error("body '" + body.name + "': " + error);

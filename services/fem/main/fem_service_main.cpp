@@ -10,18 +10,17 @@
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <thread>
 
 #include "contact_conversion.h"
 #include "contact_step.h"
-#include "fahr/common/config_error.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/scene/load_scene.h"
+#include "fahr/runtime/scene_transport.h"
+#include "fahr/runtime/service_main.h"
 #include "fahr/scene/plan.h"
-#include "fahr/scene/scene_error.h"
 #include "fem_body_setup.h"
 
 namespace fahr::fem_service {
@@ -152,17 +151,7 @@ int run_lockstep(common::Participant& participant, StepContext& ctx, const scene
   return 0;
 }
 
-// The vendor and domain: flag, else environment, else the scene.
-common::TransportConfig transport(const std::string& dds, const std::string& domain, const std::string& profile,
-                                  const scene::Scene& scene) {
-  std::string vendor = dds;
-  if (vendor.empty() && std::getenv("FAHR_DDS") == nullptr) {
-    vendor = scene.dds.vendor == scene::DdsVendor::kFastDds ? "fastdds" : "cyclonedds";
-  }
-  std::string domain_id = domain;
-  if (domain_id.empty() && std::getenv("FAHR_DOMAIN_ID") == nullptr) domain_id = std::to_string(scene.dds.domain_id);
-  return common::transport_config_from(vendor, domain_id, profile, "fem");
-}
+}  // namespace
 
 int run(int argc, char** argv) {
   CLI::App app{"fahr FEM deformation service"};
@@ -194,7 +183,7 @@ int run(int argc, char** argv) {
   common::install_stop_handlers();
   FemBodySetup setup = set_up_body(*scene, scene->bodies[plan.fem_bodies.front()]);
   StepContext ctx(setup);
-  common::Participant participant(transport(dds, domain, profile, *scene));
+  common::Participant participant(runtime::transport_for(*scene, dds, domain, profile, "fem"));
   common::TickRecorder recorder;
   common::ServiceReporter reporter(participant, {"fem", scene->rates.fem_hz, scene->rates.status_period() > 0ns ?
                                                  std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period()) : 250ms},
@@ -216,20 +205,8 @@ int run(int argc, char** argv) {
   return status;
 }
 
-}  // namespace
 }  // namespace fahr::fem_service
 
 int main(int argc, char** argv) {
-  try {
-    return fahr::fem_service::run(argc, argv);
-  } catch (const fahr::scene::SceneError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  } catch (const fahr::common::ConfigError& e) {
-    std::fprintf(stderr, "fahr_fem_service: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "fahr_fem_service: %s\n", e.what());
-    return 1;
-  }
+  return fahr::runtime::run_service_main("fahr_fem_service", fahr::fem_service::run, argc, argv);
 }

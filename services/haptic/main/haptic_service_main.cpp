@@ -13,13 +13,13 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "fahr/common/stop_signal.h"
-#include "fahr/common/config_error.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/service_reporter.h"
+#include "fahr/common/stop_signal.h"
 #include "fahr/common/subscriber.h"
+#include "fahr/runtime/scene_transport.h"
+#include "fahr/runtime/service_main.h"
 #include "fahr/scene/load_scene.h"
-#include "fahr/scene/scene_error.h"
 #include "haptic_loop.h"
 #include "haptic_setup.h"
 #include "scene_publication.h"
@@ -33,16 +33,6 @@ using namespace std::chrono_literals;
 
 // The vendor and domain: flag, else environment, else the scene (as the FEM
 // service does, so both join the same domain from the same scene).
-common::TransportConfig transport(const std::string& dds, const std::string& domain, const std::string& profile,
-                                  const scene::Scene& scene) {
-  std::string vendor = dds;
-  if (vendor.empty() && std::getenv("FAHR_DDS") == nullptr) {
-    vendor = scene.dds.vendor == scene::DdsVendor::kFastDds ? "fastdds" : "cyclonedds";
-  }
-  std::string domain_id = domain;
-  if (domain_id.empty() && std::getenv("FAHR_DOMAIN_ID") == nullptr) domain_id = std::to_string(scene.dds.domain_id);
-  return common::transport_config_from(vendor, domain_id, profile, "haptic");
-}
 
 // Ticks until the duration has passed or a signal asks to stop. Blocks only
 // between ticks, waiting for the next DevicePose.
@@ -100,7 +90,7 @@ int run(int argc, char** argv) {
   HapticLoop loop(setup);
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
 
-  common::Participant participant(transport(dds, domain, profile, *scene));
+  common::Participant participant(runtime::transport_for(*scene, dds, domain, profile, "haptic"));
   common::TickRecorder recorder;
   const auto status_period = std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period());
   common::ServiceReporter reporter(participant,
@@ -134,16 +124,5 @@ int run(int argc, char** argv) {
 }  // namespace fahr::haptic_service
 
 int main(int argc, char** argv) {
-  try {
-    return fahr::haptic_service::run(argc, argv);
-  } catch (const fahr::scene::SceneError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  } catch (const fahr::common::ConfigError& e) {
-    std::fprintf(stderr, "fahr_haptic_service: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "fahr_haptic_service: %s\n", e.what());
-    return 1;
-  }
+  return fahr::runtime::run_service_main("fahr_haptic_service", fahr::haptic_service::run, argc, argv);
 }

@@ -5,20 +5,12 @@
 #include <string>
 
 #include "fahr/geometry/surface_loader.h"
-#include "fahr/geometry/tet_mesh_loader.h"
 #include "fahr/haptic/fill_spheres.h"
+#include "fahr/runtime/scene_bodies.h"
 #include "fahr/scene/plan.h"
 
 namespace fahr::haptic_service {
 namespace {
-
-geometry::TetMesh world_mesh(const scene::Body& body) {
-  const geometry::TetMesh local = geometry::load_tet_mesh(body.mesh_path, body.mesh_scale);
-  std::vector<Eigen::Vector3d> world;
-  world.reserve(local.node_count());
-  for (const auto& p : local.rest_positions()) world.push_back(body.pose.position_m + body.pose.orientation * p);
-  return geometry::TetMesh(std::move(world), local.tets());
-}
 
 std::unique_ptr<RigidField> rigid_field(const scene::Body& body) {
   auto field = std::make_unique<RigidField>();
@@ -56,16 +48,6 @@ contact::ResponseSettings response_settings(const scene::Scene& scene) {
 
 }  // namespace
 
-haptic::FillSettings fill_settings(const scene::Body& body) {
-  haptic::FillSettings f;
-  const auto& a = body.deformable->aist;
-  f.volume_ratio = a.sphere_tet_volume_ratio;
-  f.refinement_levels = a.refinement_levels;
-  f.surface_hugging = a.surface_spheres;
-  f.max_spheres = static_cast<std::size_t>(a.sphere_budget);
-  return f;
-}
-
 HapticSetup set_up(const scene::Scene& scene) {
   const scene::ServicePlan plan = scene::derive_plan(scene);
   if (!plan.tool_body) throw std::runtime_error("scene '" + scene.name + "' has no tool: nothing for the haptic service");
@@ -76,9 +58,9 @@ HapticSetup set_up(const scene::Scene& scene) {
   HapticSetup setup;
   setup.scene = &scene;
   setup.deformable = &scene.bodies[plan.fem_bodies.front()];
-  setup.mesh = world_mesh(*setup.deformable);
+  setup.mesh = runtime::world_tet_mesh(*setup.deformable);
   try {
-    setup.layout = haptic::fill_spheres(setup.mesh, fill_settings(*setup.deformable));
+    setup.layout = haptic::fill_spheres(setup.mesh, runtime::fill_settings_for(*setup.deformable));
   } catch (const std::exception& e) {
     throw std::runtime_error("body '" + setup.deformable->name + "': AIST: " + e.what());
   }

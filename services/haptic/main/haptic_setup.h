@@ -40,7 +40,6 @@ struct HapticSetup {
 
 // The FEM service's mapping of the scene's aist block (kept identical: a
 // different mapping would give different sphere ids on the two sides).
-haptic::FillSettings fill_settings(const scene::Body& body);
 
 // Throws std::runtime_error naming the body and what is wrong.
 HapticSetup set_up(const scene::Scene& scene);

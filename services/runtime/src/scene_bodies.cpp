@@ -1,0 +1,28 @@
+// World-frame meshes and AIST settings of scene bodies.
+#include "fahr/runtime/scene_bodies.h"
+
+#include <vector>
+
+#include "fahr/geometry/tet_mesh_loader.h"
+
+namespace fahr::runtime {
+
+geometry::TetMesh world_tet_mesh(const scene::Body& body) {
+  const geometry::TetMesh local = geometry::load_tet_mesh(body.mesh_path, body.mesh_scale);
+  std::vector<Eigen::Vector3d> world;
+  world.reserve(local.node_count());
+  for (const auto& p : local.rest_positions()) world.push_back(body.pose.position_m + body.pose.orientation * p);
+  return geometry::TetMesh(std::move(world), local.tets());
+}
+
+haptic::FillSettings fill_settings_for(const scene::Body& body) {
+  haptic::FillSettings f;
+  const auto& a = body.deformable->aist;
+  f.volume_ratio = a.sphere_tet_volume_ratio;
+  f.refinement_levels = a.refinement_levels;
+  f.surface_hugging = a.surface_spheres;
+  f.max_spheres = static_cast<std::size_t>(a.sphere_budget);
+  return f;
+}
+
+}  // namespace fahr::runtime
