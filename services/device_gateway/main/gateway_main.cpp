@@ -32,6 +32,7 @@
 #endif
 #include "gateway_options.h"
 #include "msg_conversion.h"
+#include "fahr/common/service_reporter.h"
 #include "status_reporter.h"
 
 namespace fahr::device_main {
@@ -151,7 +152,7 @@ void after_tick(const device::DevicePoseSample& pose, std::uint64_t written_seq,
   if (state.recording && state.recorded.size() < state.recorded.capacity()) state.recorded.push_back(pose);
 }
 
-int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& participant, StatusReporter& reporter,
+int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& participant, GatewayMetrics& metrics, common::TickRecorder& recorder,
                  LoopState& state) {
   device::ServoCore core(setup.config, *setup.backend);
   common::Publisher<msg::DevicePose> pose_pub(participant);
@@ -170,18 +171,10 @@ int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& par
   const auto total_ticks = static_cast<std::uint64_t>(setup.duration_s * 1000.0);
   const std::int64_t start_ns = common::monotonic_now_ns();
   std::int64_t deadline_ns = start_ns;
-  std::int64_t last_start_ns = start_ns;
-  std::int64_t window_start_ns = start_ns;
-  std::uint64_t window_start_tick = 0;
   for (std::uint64_t tick = 0; !common::stop_requested() && (total_ticks == 0 || tick < total_ticks); ++tick) {
     // --- the servo tick: no allocation, blocking or logging from here ...
     const std::int64_t tick_start_ns = common::monotonic_now_ns();
     const std::int64_t cpu_start_ns = common::thread_cpu_now_ns();
-    if (tick > 0) {
-      state.snapshot.period.record(std::chrono::nanoseconds(tick_start_ns - last_start_ns));
-      if (2 * (tick_start_ns - last_start_ns) > 3 * period_ns) ++state.snapshot.late_periods;
-    }
-    last_start_ns = tick_start_ns;
     const device::ForceCommandSample* incoming = nullptr;
     if (command_sub.fetch_newest()) {
       from_msg(command_sub.newest(), command);
@@ -197,28 +190,23 @@ int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& par
     pose_msg.header().sim_time_ns(pose.device_time_ns);
     pose_pub.write(pose_msg);
     after_tick(pose, pose_pub.last_seq(), state);
-    state.snapshot.tick_cpu.record(std::chrono::nanoseconds(common::thread_cpu_now_ns() - cpu_start_ns));
+    recorder.push({tick, tick_start_ns, common::monotonic_now_ns() - tick_start_ns,
+                   common::thread_cpu_now_ns() - cpu_start_ns});
     // --- ... to here.
     if ((tick + 1) % report_every == 0) {
       fill_snapshot(core, setup, state);
-      state.snapshot.window_s = 1e-9 * static_cast<double>(tick_start_ns - window_start_ns);
-      state.snapshot.window_ticks = tick + 1 - window_start_tick;
-      window_start_ns = tick_start_ns;
-      window_start_tick = tick + 1;
-      reporter.offer(state.snapshot);
+      metrics.offer(state.snapshot);
       core.latency().reset();
-      state.snapshot.period.reset();
-      state.snapshot.tick_cpu.reset();
     }
     deadline_ns += period_ns;
     wait_until(deadline_ns, static_cast<std::int64_t>(o.spin_us) * 1000);
   }
   fill_snapshot(core, setup, state);
-  reporter.offer(state.snapshot);
+  metrics.offer(state.snapshot);
   return 0;
 }
 
-int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& participant, StatusReporter& reporter,
+int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& participant, GatewayMetrics& metrics, common::TickRecorder& recorder,
                  LoopState& state) {
   device::ServoCore core(setup.config, *setup.backend);
   common::Publisher<msg::DevicePose> pose_pub(participant, common::lockstep_output_qos<msg::DevicePose>());
@@ -232,6 +220,8 @@ int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& par
   std::uint64_t last_command_seq = 0;
   const auto total_ticks = static_cast<std::uint64_t>(setup.duration_s * 1000.0);
   for (std::uint64_t k = 0; !common::stop_requested() && (total_ticks == 0 || k < total_ticks) && client.wait_for_grant(k, 20s); ++k) {
+    const std::int64_t tick_start_ns = common::monotonic_now_ns();
+    const std::int64_t cpu_start_ns = common::thread_cpu_now_ns();
     const device::ForceCommandSample* incoming = nullptr;
     if (input) {
       if (const auto step = common::producer_step_for(k, o.force_input_period)) {
@@ -257,13 +247,15 @@ int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& par
     hash.add(pose_msg);
     after_tick(pose, pose_pub.last_seq(), state);
     client.complete_through(k, hash.value());
+    recorder.push({k, tick_start_ns, common::monotonic_now_ns() - tick_start_ns,
+                   common::thread_cpu_now_ns() - cpu_start_ns});
     if ((k + 1) % 250 == 0) {
       fill_snapshot(core, setup, state);
-      reporter.offer(state.snapshot);
+      metrics.offer(state.snapshot);
     }
   }
   fill_snapshot(core, setup, state);
-  reporter.offer(state.snapshot);
+  metrics.offer(state.snapshot);
   std::printf("lockstep: %llu steps, DevicePose hash %016llx\n", static_cast<unsigned long long>(core.ticks()),
               static_cast<unsigned long long>(hash.value()));
   return 0;
@@ -277,7 +269,12 @@ int run(int argc, char** argv) {
   common::install_stop_handlers();
   common::Participant participant(
       common::transport_config_from(options->dds, options->domain, options->profile, "device_gateway"));
-  StatusReporter reporter(participant, options->status_hz, 1000.0, options->backend);
+  common::TickRecorder recorder;
+  GatewayMetrics metrics;
+  common::ServiceReporter reporter(
+      participant,
+      {"device_gateway", 1000.0, std::chrono::milliseconds(static_cast<long>(1000.0 / options->status_hz))}, recorder,
+      [&metrics](auto& figures) { metrics.fill(figures); });
   LoopState state;
   if (!options->record_file.empty()) {
     const double seconds = setup->duration_s > 0.0 ? setup->duration_s : kMaxRecordedSeconds;
@@ -287,10 +284,13 @@ int run(int argc, char** argv) {
   std::fprintf(stderr, "fahr_device_gateway: %s, backend %s, model %s, %s, %.1f s\n",
                std::string(common::vendor_name(participant.vendor())).c_str(), options->backend.c_str(),
                setup->config.model.name.c_str(), options->mode.c_str(), setup->duration_s);
-  const int code = options->mode == "lockstep" ? run_lockstep(*options, *setup, participant, reporter, state)
-                                               : run_realtime(*options, *setup, participant, reporter, state);
-  reporter.publish_now();
-  std::printf("device_gateway: %s\n", reporter.summary().c_str());
+  reporter.set_state(msg::SERVICE_RUNNING);
+  const int code = options->mode == "lockstep"
+                       ? run_lockstep(*options, *setup, participant, metrics, recorder, state)
+                       : run_realtime(*options, *setup, participant, metrics, recorder, state);
+  reporter.set_state(msg::SERVICE_STOPPING);
+  reporter.report();
+  std::printf("device_gateway: %s\n", metrics.summary(reporter.late_periods()).c_str());
   if (state.seq_mismatches > 0) {
     std::fprintf(stderr, "fahr_device_gateway: %llu DevicePose seq mismatches (pose seq != writer seq)\n",
                  static_cast<unsigned long long>(state.seq_mismatches));

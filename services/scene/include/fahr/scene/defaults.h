@@ -68,8 +68,12 @@ inline constexpr int kDefaultProjectionMaxIterations = 20;
 // 1 micrometre: two orders below the 0.2 mm depth accuracy asked of contacts.
 inline constexpr double kDefaultProjectionToleranceM = 1.0e-6;
 inline constexpr int kDefaultMaxCandidateContacts = 64;
-// A ContactSet older than this is ignored: 5 haptic periods of slack at 1 kHz.
-inline constexpr std::chrono::milliseconds kDefaultMaxContactAge{5};
+// A ContactSet computed on a FEM state older than this is ignored. The FEM
+// service measures the age in its own steps: 20 ms is 4 steps at 200 Hz,
+// room for a haptic service that takes a few ms to digest a new state (5 ms
+// made a third of the sets stale in the end-to-end run) while a set whose
+// planes lag the tool by more is dropped.
+inline constexpr std::chrono::milliseconds kDefaultMaxContactAge{20};
 // Below this node speed, untouched, a body sleeps (no solve).
 inline constexpr double kDefaultSleepSpeedMps = 1.0e-4;
 
