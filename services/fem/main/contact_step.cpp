@@ -20,6 +20,7 @@ ContactStep::ContactStep(fem::Body& body, const fem::SphereLinks& links, std::si
   lambda_n_.reserve(capacity_);
   normals_.reserve(capacity_);
   compliance_.reserve(9 * capacity_ * capacity_);
+  compliance_of_.reserve(capacity_);
   free_centres_.reserve(3 * capacity_);
 }
 
@@ -45,7 +46,7 @@ void ContactStep::apply_forces(const fem::ContactSet* contacts) {
   }
 }
 
-void ContactStep::compute_compliance(const fem::ContactSet* contacts) {
+void ContactStep::compute_compliance(const fem::ContactSet* contacts, bool refactorised) {
   spheres_.clear();
   lambda_n_.clear();
   normals_.clear();
@@ -60,14 +61,23 @@ void ContactStep::compute_compliance(const fem::ContactSet* contacts) {
     }
   }
   const std::size_t k = spheres_.size();
-  compliance_.resize(9 * k * k);
   free_centres_.resize(3 * k);
-  if (k == 0) return;
-  if (!body_.compliance(spheres_, links_, compliance_)) {
-    spheres_.clear();
+  if (k == 0) {
     compliance_.clear();
-    free_centres_.clear();
     return;
+  }
+  if (compliance_valid_ && !refactorised && spheres_ == compliance_of_) {
+    ++compliance_reuses_;
+  } else {
+    compliance_.resize(9 * k * k);
+    compliance_valid_ = body_.compliance(spheres_, links_, compliance_);
+    compliance_of_ = spheres_;
+    if (!compliance_valid_) {
+      spheres_.clear();
+      compliance_.clear();
+      free_centres_.clear();
+      return;
+    }
   }
   const double* x = body_.positions_m().data();
   for (std::size_t s = 0; s < k; ++s) {
@@ -105,7 +115,7 @@ void ContactStep::project(const fem::ContactSet& contacts) {
 fem::StepReport ContactStep::step(const fem::ContactSet* contacts) {
   apply_forces(contacts);
   fem::StepReport report = body_.step(nullptr, nullptr);
-  compute_compliance(contacts);
+  compute_compliance(contacts, report.refactorised);
   projection_ = {};
   if (contacts != nullptr && !contacts->contacts.empty()) project(*contacts);
   report.projection = projection_;

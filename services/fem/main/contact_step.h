@@ -36,10 +36,12 @@ class ContactStep {
   const std::vector<float>& compliance() const { return compliance_; }
   const std::vector<float>& free_centres() const { return free_centres_; }
   const fem::ProjectionReport& projection() const { return projection_; }
+  // Steps that reused the previous compliance block instead of solving.
+  std::uint64_t compliance_reuses() const { return compliance_reuses_; }
 
  private:
   void apply_forces(const fem::ContactSet* contacts);
-  void compute_compliance(const fem::ContactSet* contacts);
+  void compute_compliance(const fem::ContactSet* contacts, bool refactorised);
   void project(const fem::ContactSet& contacts);
 
   fem::Body& body_;
@@ -52,6 +54,11 @@ class ContactStep {
   std::vector<double> lambda_n_;   // lambda applied per compliance sphere, N
   std::vector<Eigen::Vector3d> normals_;
   std::vector<float> compliance_;
+  // W depends only on the factorisation: with the same spheres and no
+  // refactorisation since, the last block is still exact and is reused.
+  std::vector<std::uint32_t> compliance_of_;
+  bool compliance_valid_ = false;
+  std::uint64_t compliance_reuses_ = 0;
   std::vector<float> free_centres_;
   fem::ProjectionReport projection_;
 };

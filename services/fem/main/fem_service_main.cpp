@@ -78,6 +78,7 @@ struct StepContext {
 
   void metrics(std::vector<std::pair<std::string, double>>& out) const {
     out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets));
+    out.emplace_back("compliance_reuses", static_cast<double>(contact_step.compliance_reuses()));
     out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max));
     out.emplace_back("projection_sweeps_last", static_cast<double>(last_report.projection.sweeps));
     out.emplace_back("solver_iterations_last", static_cast<double>(last_report.solver_iterations));
