@@ -8,15 +8,22 @@ namespace {
 double ms(std::chrono::nanoseconds d) { return static_cast<double>(d.count()) * 1e-6; }
 }  // namespace
 
+void GatewayMetrics::take_newest() {
+  if (!latest_.fetch()) return;
+  last_ = latest_.value();
+  if (last_.motion_to_force.count() > 0) last_latency_ = last_.motion_to_force;
+}
+
 void GatewayMetrics::fill(std::vector<std::pair<std::string, double>>& metrics) {
   std::lock_guard lock(last_mutex_);
-  if (latest_.fetch()) last_ = latest_.value();
+  take_newest();
   const StatusSnapshot& s = last_;
-  metrics.emplace_back("motion_to_force_count", static_cast<double>(s.motion_to_force.count()));
-  metrics.emplace_back("motion_to_force_p50_ms", ms(s.motion_to_force.percentile(0.5)));
-  metrics.emplace_back("motion_to_force_p99_ms", ms(s.motion_to_force.percentile(0.99)));
-  metrics.emplace_back("motion_to_force_p999_ms", ms(s.motion_to_force.percentile(0.999)));
-  metrics.emplace_back("motion_to_force_max_ms", ms(s.motion_to_force.max()));
+  const device::LatencyHistogram& latency = last_latency_;
+  metrics.emplace_back("motion_to_force_count", static_cast<double>(latency.count()));
+  metrics.emplace_back("motion_to_force_p50_ms", ms(latency.percentile(0.5)));
+  metrics.emplace_back("motion_to_force_p99_ms", ms(latency.percentile(0.99)));
+  metrics.emplace_back("motion_to_force_p999_ms", ms(latency.percentile(0.999)));
+  metrics.emplace_back("motion_to_force_max_ms", ms(latency.max()));
   metrics.emplace_back("safety_state", static_cast<double>(s.safety_state));
   metrics.emplace_back("renderable_force_n", s.renderable_force_n);
   metrics.emplace_back("peak_force_n", s.peak_force_n);
@@ -37,16 +44,17 @@ void GatewayMetrics::fill(std::vector<std::pair<std::string, double>>& metrics) 
 
 std::string GatewayMetrics::summary(std::uint64_t late_periods) {
   std::lock_guard lock(last_mutex_);
-  if (latest_.fetch()) last_ = latest_.value();
+  take_newest();
   const StatusSnapshot& s = last_;
+  const device::LatencyHistogram& latency = last_latency_;
   char line[512];
   std::snprintf(line, sizeof(line),
-                "ticks %llu, late periods %llu, motion-to-force (last window) n=%llu p50 %.3f ms p99 %.3f ms, "
+                "ticks %llu, late periods %llu, motion-to-force (last window with commands) n=%llu p50 %.3f ms p99 %.3f ms, "
                 "peak force %.3f N, renderable %.3f N, commands accepted %llu, rejected nan %llu stale %llu, "
                 "silences %llu, PC removed %.3f mJ",
                 static_cast<unsigned long long>(s.ticks), static_cast<unsigned long long>(late_periods),
-                static_cast<unsigned long long>(s.motion_to_force.count()), ms(s.motion_to_force.percentile(0.5)),
-                ms(s.motion_to_force.percentile(0.99)), s.peak_force_n, s.renderable_force_n,
+                static_cast<unsigned long long>(latency.count()), ms(latency.percentile(0.5)),
+                ms(latency.percentile(0.99)), s.peak_force_n, s.renderable_force_n,
                 static_cast<unsigned long long>(s.safety.accepted),
                 static_cast<unsigned long long>(s.safety.rejected_non_finite),
                 static_cast<unsigned long long>(s.safety.rejected_stale),

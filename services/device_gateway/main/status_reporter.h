@@ -43,8 +43,13 @@ class GatewayMetrics {
 
  private:
   common::LatestSample<StatusSnapshot> latest_;
+  void take_newest();  // last_mutex_ held
+
   std::mutex last_mutex_;
   StatusSnapshot last_;
+  // The newest window that had ForceCommands: a run's final snapshot often
+  // covers only the few ticks after the last report, and must not hide it.
+  device::LatencyHistogram last_latency_;
 };
 
 }  // namespace fahr::device_main
