@@ -19,11 +19,18 @@ function(fahr_sanitize target)
   endif()
 endfunction()
 
-# fahr_library(<name> SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...])
-# Creates fahr_<name> with alias fahr::<name>; headers live in include/ of the folder.
+# fahr_library(<name> [STATIC] SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...])
+# Creates fahr_<name> with alias fahr::<name>; headers live in include/ of the
+# folder (include/fahr/<namespace>/). STATIC forces a static archive whatever
+# BUILD_SHARED_LIBS says: a service's core, linked into its own main and into
+# the tests and tools that step it in one process.
 function(fahr_library name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
-  add_library(fahr_${name} ${ARG_SOURCES})
+  cmake_parse_arguments(ARG "STATIC" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  if(ARG_STATIC)
+    add_library(fahr_${name} STATIC ${ARG_SOURCES})
+  else()
+    add_library(fahr_${name} ${ARG_SOURCES})
+  endif()
   add_library(fahr::${name} ALIAS fahr_${name})
   set_target_properties(fahr_${name} PROPERTIES EXPORT_NAME ${name} POSITION_INDEPENDENT_CODE ON)
   target_include_directories(fahr_${name} PUBLIC
@@ -45,15 +52,31 @@ function(fahr_executable name)
   fahr_sanitize(${name})
 endfunction()
 
-# fahr_test(<name> SOURCES ... [DEPS ...] [LABELS ...] [TIMEOUT s])
+# fahr_test(<name> SOURCES ... [DEPS ...] [LABELS ...] [TIMEOUT s] [SHARDS n]
+#           [ENVIRONMENT ...])
 # A GoogleTest executable registered with CTest, one CTest entry per binary so
-# multi-process tests keep their own process tree.
+# multi-process tests keep their own process tree. SHARDS n > 1 registers n
+# entries <name>_0 .. <name>_<n-1>, each running its share of the tests
+# (GoogleTest's GTEST_TOTAL_SHARDS / GTEST_SHARD_INDEX), so ctest -j runs a
+# long suite on several cores.
 function(fahr_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;SHARDS" "SOURCES;DEPS;LABELS;ENVIRONMENT" ${ARGN})
   fahr_executable(${name} SOURCES ${ARG_SOURCES} DEPS ${ARG_DEPS} GTest::gtest GTest::gtest_main)
-  add_test(NAME ${name} COMMAND ${name})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
-  set_tests_properties(${name} PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}")
+  if(NOT ARG_SHARDS OR ARG_SHARDS LESS 2)
+    add_test(NAME ${name} COMMAND ${name})
+    set_tests_properties(${name} PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}")
+    if(ARG_ENVIRONMENT)
+      set_tests_properties(${name} PROPERTIES ENVIRONMENT "${ARG_ENVIRONMENT}")
+    endif()
+    return()
+  endif()
+  math(EXPR last "${ARG_SHARDS} - 1")
+  foreach(shard RANGE ${last})
+    add_test(NAME ${name}_${shard} COMMAND ${name})
+    set_tests_properties(${name}_${shard} PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}"
+      ENVIRONMENT "GTEST_TOTAL_SHARDS=${ARG_SHARDS};GTEST_SHARD_INDEX=${shard};${ARG_ENVIRONMENT}")
+  endforeach()
 endfunction()

@@ -7,6 +7,15 @@
 #   deployment/run_local.sh [BUILD_DIR] [--dds cyclonedds|fastdds] [--domain N]
 #                           [--duration-s S] [--scene FILE] [--script intubation|overshoot]
 #                           [--dds-gateway V] [--dds-fem V] [--dds-haptic V]
+#                           [--mode realtime|lockstep] [--haptic-collision aist|triangle]
+#
+# --haptic-collision triangle: the haptic service finds the blade's contacts
+# with the tongue by the triangle-level baseline instead of the AIST.
+# --mode lockstep: the services advance together in simulated time under
+# fahr_lockstep_clock (duration-s of simulated time, as fast as the machine
+# allows); the clock prints each service's output hash, the same on every
+# run and every vendor mix. No run summary then (wall-clock rates mean
+# nothing in lockstep); each service prints its own figures at the end.
 #
 # --dds-<service> puts one service on another vendor (a mixed-vendor run);
 # the summary listens with --dds.
@@ -28,6 +37,8 @@ script=intubation
 dds_gateway=""
 dds_fem=""
 dds_haptic=""
+mode=realtime
+haptic_collision=aist
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -39,7 +50,9 @@ while [ $# -gt 0 ]; do
     --dds-gateway) dds_gateway="$2"; shift 2 ;;
     --dds-fem) dds_fem="$2"; shift 2 ;;
     --dds-haptic) dds_haptic="$2"; shift 2 ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    --mode) mode="$2"; shift 2 ;;
+    --haptic-collision) haptic_collision="$2"; shift 2 ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
@@ -47,6 +60,7 @@ done
 dds_gateway="${dds_gateway:-$dds}"
 dds_fem="${dds_fem:-$dds}"
 dds_haptic="${dds_haptic:-$dds}"
+case "$mode" in realtime|lockstep) ;; *) echo "run_local: --mode must be realtime or lockstep, not '$mode'" >&2; exit 2 ;; esac
 for v in "$dds" "$dds_gateway" "$dds_fem" "$dds_haptic"; do
   case "$v" in cyclonedds|fastdds) ;; *) echo "run_local: a DDS vendor must be cyclonedds or fastdds, not '$v'" >&2; exit 2 ;; esac
 done
@@ -61,9 +75,10 @@ gateway="$build/services/device_gateway/fahr_device_gateway"
 fem="$build/services/fem/main/fahr_fem_service"
 haptic="$build/services/haptic/main/fahr_haptic_service"
 summary="$build/tools/run_summary/fahr_run_summary"
-for exe in "$gateway" "$fem" "$haptic" "$summary"; do
+clock="$build/tools/lockstep_clock/fahr_lockstep_clock"
+for exe in "$gateway" "$fem" "$haptic" "$summary" "$clock"; do
   if [ ! -x "$exe" ]; then
-    echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway_service fahr_fem_service fahr_haptic_service fahr_run_summary" >&2
+    echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway_service fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock" >&2
     exit 2
   fi
 done
@@ -119,10 +134,11 @@ wait_for_line() {
   return 1
 }
 
-echo "run_local: gateway $dds_gateway, fem $dds_fem, haptic $dds_haptic, domain $domain, ${duration_s} s of the '$script' script, logs in $logs"
-stdbuf -oL "$fem" --scene "$scene" "${fem_flags[@]}" --mode realtime --duration-s 0 >"$logs/fem.log" 2>&1 &
+echo "run_local: gateway $dds_gateway, fem $dds_fem, haptic $dds_haptic, domain $domain, ${duration_s} s of the '$script' script, $mode, logs in $logs"
+stdbuf -oL "$fem" --scene "$scene" "${fem_flags[@]}" --mode "$mode" --duration-s 0 >"$logs/fem.log" 2>&1 &
 fem_pid=$!; pids+=("$fem_pid")
-"$haptic" --scene "$scene" "${haptic_flags[@]}" --duration-s 0 >"$logs/haptic.log" 2>&1 &
+"$haptic" --scene "$scene" "${haptic_flags[@]}" --mode "$mode" --collision "$haptic_collision" --duration-s 0 \
+  >"$logs/haptic.log" 2>&1 &
 haptic_pid=$!; pids+=("$haptic_pid")
 # (stdbuf: the services print their start line with printf; line buffering
 # gets it into the log while they run.)
@@ -130,6 +146,27 @@ haptic_pid=$!; pids+=("$haptic_pid")
 # services have built their meshes, spheres and fields.
 wait_for_line "$logs/fem.log" "^fahr_fem_service: " "$fem_pid" 60
 wait_for_line "$logs/haptic.log" "ready" "$haptic_pid" 60
+
+if [ "$mode" = lockstep ]; then
+  stdbuf -oL "$gateway" "${gateway_flags[@]}" --mode lockstep --force-input-period 1 --backend simulated \
+    --script "$script" --duration-s 0 >"$logs/gateway.log" 2>&1 &
+  gateway_pid=$!; pids+=("$gateway_pid")
+  steps=$(awk "BEGIN { printf \"%d\", $duration_s * 1000 }")
+  status=0
+  "$clock" --participants device_gateway,fem,haptic --steps "$steps" "${common[@]}" | tee "$logs/clock.log" || status=$?
+  for name in gateway haptic fem; do
+    pid_var="${name}_pid"
+    # The clock told them to stop; give them a moment to print their figures.
+    for _ in $(seq 50); do kill -0 "${!pid_var}" 2>/dev/null || break; sleep 0.1; done
+    stop "${!pid_var}"
+    wait "${!pid_var}" 2>/dev/null || true
+  done
+  pids=()
+  echo "run_local: service logs:"
+  for name in gateway fem haptic; do tail -n 3 "$logs/$name.log" | sed "s/^/  [$name] /"; done
+  echo "run_local: logs in $logs"
+  exit "$status"
+fi
 
 # The summary listens a little longer than the gateway runs, so it sees the
 # services' last reports.
@@ -160,6 +197,6 @@ pids=()
 cat "$logs/summary.md"
 echo
 echo "run_local: service logs:"
-for name in gateway fem haptic; do tail -n 2 "$logs/$name.log" | sed "s/^/  [$name] /"; done
+for name in gateway fem haptic; do tail -n 3 "$logs/$name.log" | sed "s/^/  [$name] /"; done
 echo "run_local: logs in $logs"
 exit "$status"

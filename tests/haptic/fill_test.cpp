@@ -61,6 +61,49 @@ TEST(Fill, WeightsSumToOneAndReproduceTheCentreOnTheTongue) {
   EXPECT_GT(spread, grid / 2);
 }
 
+// The share of a sphere's weight on boundary nodes.
+double surface_share(const SphereLayout& layout, std::size_t sphere, const std::vector<bool>& on_boundary) {
+  double share = 0.0;
+  const auto nodes = layout.nodes(sphere);
+  const auto weights = layout.weights(sphere);
+  for (std::size_t k = 0; k < nodes.size(); ++k) share += on_boundary[nodes[k]] ? weights[k] : 0.0;
+  return share;
+}
+
+TEST(Fill, HuggingSpheresAreCarriedByTheSurfaceNodes) {
+  // With hugging_anchor_depth_factor k the tangent face's nodes carry 1 - 1/k
+  // of a hugging sphere's weight (less only where the deeper point leaves the
+  // body and k is lowered); with k = 1 the sphere hangs on the tet holding its
+  // centre, often an inner one.
+  const auto& mesh = test::neonatal_tongue();
+  std::vector<geometry::Index> surface_to_node;
+  mesh.boundary_surface(&surface_to_node);
+  std::vector<bool> on_boundary(mesh.node_count(), false);
+  for (const auto n : surface_to_node) on_boundary[static_cast<std::size_t>(n)] = true;
+  const SphereLayout& anchored = test::neonatal_layout();
+  ASSERT_GT(FillSettings{}.hugging_anchor_depth_factor, 2.0);
+  const double full = 1.0 - 1.0 / FillSettings{}.hugging_anchor_depth_factor;
+  std::size_t hugging = 0, carried = 0;
+  for (std::size_t i = 0; i < anchored.size(); ++i) {
+    if (anchored.sphere(i).origin != SphereOrigin::kHugging) continue;
+    ++hugging;
+    carried += surface_share(anchored, i, on_boundary) >= full - 1e-9 ? 1 : 0;
+  }
+  ASSERT_GT(hugging, 1000u);
+  EXPECT_GT(carried, hugging * 9 / 10) << carried << " of " << hugging;
+
+  FillSettings plain;
+  plain.hugging_anchor_depth_factor = 1.0;
+  const SphereLayout unanchored = fill_spheres(mesh, plain);
+  std::size_t plain_carried = 0, plain_hugging = 0;
+  for (std::size_t i = 0; i < unanchored.size(); ++i) {
+    if (unanchored.sphere(i).origin != SphereOrigin::kHugging) continue;
+    ++plain_hugging;
+    plain_carried += surface_share(unanchored, i, on_boundary) >= full - 1e-9 ? 1 : 0;
+  }
+  EXPECT_LT(plain_carried, plain_hugging / 2) << plain_carried << " of " << plain_hugging;
+}
+
 TEST(Fill, RestStateCentresFollowTheNodes) {
   // A rigid translation of every node moves every centre by the same amount
   // and keeps every radius.
@@ -153,6 +196,12 @@ TEST(FillErrors, SettingsOutOfRangeNameTheField) {
   s = {};
   s.hugging_tolerance_m = -1.0;
   expect_field(s, "hugging_tolerance_m");
+  s = {};
+  s.hugging_anchor_depth_factor = 0.5;
+  expect_field(s, "hugging_anchor_depth_factor");
+  s = {};
+  s.hugging_anchor_depth_factor = 9.0;
+  expect_field(s, "hugging_anchor_depth_factor");
 }
 
 TEST(FillErrors, BeyondTheBudget) {

@@ -179,6 +179,82 @@ TEST(Query, NormalComesFromThePrePenetrationCentreThroughAThinPlate) {
   EXPECT_GT(deep, 0u) << "some centres passed the mid-plane";
 }
 
+// The narrow phase's triangle search, bounded by the sphere's last nearest
+// point (kept in the memory), gives the answer of an unbounded search (a
+// fresh memory every query); the grid shortcut for flat fields
+// (flat_gradient_tolerance) stays within its stated error. Contacts whose
+// centre lies inside the body are left out: their normal depends on the
+// memory's pre-penetration centre, which a fresh memory does not have.
+void expect_same_contacts(const RigidBody& body, const Eigen::Vector3d& step, int steps, double flat_tolerance,
+                          double tolerance_m, double point_tolerance_m,
+                          bool (*centre_inside)(const RigidBody&, const Eigen::Vector3d&)) {
+  Block& b = block();
+  QuerySettings hinted;
+  hinted.flat_gradient_tolerance = flat_tolerance;
+  PrePenetrationMemory memory(b.layout.size());
+  ContactBuffer plain_buffer(4096), buffer(4096);
+  RigidBody moving = body;
+  std::size_t compared = 0;
+  for (int k = 0; k < steps; ++k) {
+    moving.world_from_body.translation() = body.world_from_body.translation() + k * step;
+    PrePenetrationMemory fresh(b.layout.size());
+    plain_buffer.clear();
+    buffer.clear();
+    query_spheres(b.tree, b.state, moving, QuerySettings{}, fresh, plain_buffer);
+    query_spheres(b.tree, b.state, moving, hinted, memory, buffer);
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < plain_buffer.size(); ++i) {
+      const SphereContact& plain = plain_buffer[i];
+      while (j < buffer.size() && buffer[j].sphere_id != plain.sphere_id) ++j;
+      if (centre_inside(moving, b.state.centres_m()[plain.sphere_id])) continue;
+      if (j == buffer.size()) {
+        // Only the grid shortcut may drop a contact, and only a graze.
+        EXPECT_GT(flat_tolerance, 0.0) << "step " << k << " sphere " << plain.sphere_id;
+        EXPECT_LT(std::abs(plain.depth_m), tolerance_m);
+        j = 0;
+        continue;
+      }
+      EXPECT_NEAR(buffer[j].depth_m, plain.depth_m, tolerance_m) << "step " << k;
+      EXPECT_LT((buffer[j].point_m - plain.point_m).norm(), point_tolerance_m) << "step " << k;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 20u);
+}
+
+bool inside_plate(const RigidBody& body, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d p = body.world_from_body.inverse() * c;
+  return std::abs(p.x()) < 0.004 && std::abs(p.y()) < 0.0005 && std::abs(p.z()) < 0.004;
+}
+
+bool inside_ball(const RigidBody& body, const Eigen::Vector3d& c) {
+  return (c - body.world_from_body.translation()).norm() < 5e-3;
+}
+
+TEST(Query, BoundedSearchGivesTheUnboundedAnswerOnAPlate) {
+  // A 1 mm plate rising into the block: faces, edges and the mid-plane ridge.
+  const auto plate = field(test::box_surface({-0.004, -0.0005, -0.004}, {0.004, 0.0005, 0.004}));
+  RigidBody body{2, &plate, Eigen::Isometry3d::Identity()};
+  body.world_from_body.translation() = Eigen::Vector3d(0.003, -0.002, 0.005);
+  expect_same_contacts(body, Eigen::Vector3d(0.0, 1e-4, 1e-5), 25, 0.0, 1e-12, 1e-12, inside_plate);
+}
+
+TEST(Query, BoundedSearchGivesTheUnboundedAnswerOnABall) {
+  const auto ball = field(test::icosphere(Eigen::Vector3d::Zero(), 5e-3, 5));
+  RigidBody body{1, &ball, Eigen::Isometry3d::Identity()};
+  body.world_from_body.translation() = Eigen::Vector3d(0.005, 0.005, -0.0052);
+  expect_same_contacts(body, Eigen::Vector3d(0.0, 0.0, 2e-5), 25, 0.0, 1e-12, 1e-12, inside_ball);
+}
+
+TEST(Query, FlatGridShortcutStaysWithinItsErrorOnABall) {
+  // Depth: h^2 / (8 rho) with h = 0.5 mm, rho >= 5 mm, about 6 um. The point
+  // p - d n also carries the grid normal's angle error times d (1-2 mm).
+  const auto ball = field(test::icosphere(Eigen::Vector3d::Zero(), 5e-3, 5));
+  RigidBody body{1, &ball, Eigen::Isometry3d::Identity()};
+  body.world_from_body.translation() = Eigen::Vector3d(0.005, 0.005, -0.0052);
+  expect_same_contacts(body, Eigen::Vector3d(0.0, 0.0, 2e-5), 25, 1e-3, 6e-6, 50e-6, inside_ball);
+}
+
 TEST(Query, OverflowIsAFlagAndANanPoseTouchesNothing) {
   Block& b = block();
   const auto slab = field(test::box_surface({-0.01, -0.01, -0.01}, {0.02, 0.005, 0.02}));

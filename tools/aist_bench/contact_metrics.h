@@ -43,6 +43,7 @@ class ContactMetrics {
   const Scene& scene_;
   std::size_t base_total_ = 0, base_recalled_ = 0, base_recalled_near_ = 0, base_false_ = 0;
   std::size_t deeper_recalled_near_ = 0;
+  std::size_t miss_candidate_ = 0, miss_standoff_ = 0, miss_detached_ = 0;  // see print()
   std::size_t deep_total_ = 0, deep_recalled_ = 0, deeper_total_ = 0, deeper_recalled_ = 0;
   std::size_t aist_total_ = 0, aist_unmatched_ = 0;
   std::size_t contact_ticks_ = 0, ticks_both_ = 0;

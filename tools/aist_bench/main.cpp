@@ -18,6 +18,14 @@ int main(int argc, char** argv) {
       options.weight_spread = std::stod(argv[++i]);
     } else if (std::strcmp(argv[i], "--skin-mm") == 0 && i + 1 < argc) {
       options.skin_m = 1e-3 * std::stod(argv[++i]);
+    } else if (std::strcmp(argv[i], "--hugging-tolerance-mm") == 0 && i + 1 < argc) {
+      options.hugging_tolerance_m = 1e-3 * std::stod(argv[++i]);
+    } else if (std::strcmp(argv[i], "--hugging-radius") == 0 && i + 1 < argc) {
+      options.hugging_radius_fraction = std::stod(argv[++i]);
+    } else if (std::strcmp(argv[i], "--approach-mm") == 0 && i + 1 < argc) {
+      options.approach_margin_m = 1e-3 * std::stod(argv[++i]);
+    } else if (std::strcmp(argv[i], "--anchor") == 0 && i + 1 < argc) {
+      options.anchor_depth_factor = std::stod(argv[++i]);
     } else if (std::strcmp(argv[i], "--sweep-steps") == 0 && i + 1 < argc) {
       options.sweep_steps = std::stoi(argv[++i]);
     } else {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "fahr/haptic/fill_settings.h"
+#include "fahr/haptic/sphere_query.h"
 #include "scene.h"
 
 namespace fahr::aist_bench {
@@ -13,6 +14,11 @@ struct Options {
   int sweep_steps = 200;       // FEM steps per sweep configuration
   double skin_m = 0.0;         // AIST contact skin (QuerySettings::contact_skin_m)
   double weight_spread = haptic::FillSettings{}.weight_spread;  // FillSettings::weight_spread of the trajectory layout
+  // FillSettings of the trajectory layout (defaults: the library's).
+  double hugging_tolerance_m = haptic::FillSettings{}.hugging_tolerance_m;
+  double hugging_radius_fraction = haptic::FillSettings{}.hugging_radius_fraction;
+  double approach_margin_m = haptic::QuerySettings{}.approach_margin_m;  // QuerySettings of the trajectory
+  double anchor_depth_factor = haptic::FillSettings{}.hugging_anchor_depth_factor;
 };
 
 // Candidate margin of the benchmark's queries, m: the closure's tolerance,

@@ -24,7 +24,7 @@ struct Row {
   double ratio = 0.0;
   int levels = 0;
   std::size_t spheres = 0;
-  double hausdorff_mm = 0.0, query_median_us = 0.0, query_p99_us = 0.0, recall = 0.0, recall_near = 0.0, recall_deeper = 0.0;
+  double hausdorff_mm = 0.0, query_median_us = 0.0, query_p99_us = 0.0, cpu_median_us = 0.0, recall = 0.0, recall_near = 0.0, recall_deeper = 0.0;
   double rms_mm = 0.0, max_mm = 0.0;
   bool refused = false;
 };
@@ -110,16 +110,18 @@ Row run(const Scene& scene, const Options& options, double ratio, int levels, co
   std::vector<haptic::TriangleContact> base_contacts;
   ContactMetrics metrics(scene);
   fem::ContactSet set;
-  std::vector<double> times;
+  std::vector<double> times, cpu_times;
   for (int step = 0; step < options.sweep_steps; ++step) {
     blade.world_from_body = blade_pose(scene, static_cast<double>(step) / (options.sweep_steps - 1), options.lever_depth_m);
     const auto x = body->positions_m();
     state.update(layout, x);
     tree.refit(state);
     buffer.clear();
+    const double cpu_start = thread_cpu_us();
     const auto start = Clock::now();
     haptic::query_spheres(tree, state, blade, query, memory, buffer);
     times.push_back(elapsed_us(start));
+    cpu_times.push_back(thread_cpu_us() - cpu_start);
     if (step % 5 == 0) {
       baseline.update(x);
       baseline.collide(blade.world_from_body, base_contacts);
@@ -139,6 +141,7 @@ Row run(const Scene& scene, const Options& options, double ratio, int levels, co
   }
   row.query_median_us = percentile(times, 50);
   row.query_p99_us = percentile(times, 99);
+  row.cpu_median_us = percentile(cpu_times, 50);
   row.recall = metrics.recall();
   row.recall_deeper = metrics.recall_deeper();
   row.recall_near = metrics.recall_near();
@@ -175,22 +178,23 @@ void sweep_table(const Scene& scene, const Options& options) {
   std::printf("Deformation error: node positions at the end against the reference run, the same FEM driven by "
               "node contacts (every boundary node projected out of the blade's exact field; largest node "
               "displacement in the reference %.2f mm). Recall as in the trajectory table, every 5th step. "
-              "Pareto: not beaten on both query p99 and RMS error by another row.\n\n", moved * 1e3);
-  std::printf("| ratio | levels | spheres | Hausdorff (mm) | query median (us) | query p99 (us) | recall | with candidates | recall >= 0.25 mm | deformation RMS (mm) | max (mm) | Pareto |\n");
-  std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+              "Pareto: not beaten on both query thread-CPU median and deformation RMS error by another row (CPU time, "
+              "not wall time: on a shared machine the wall p99 is other processes' preemption).\n\n", moved * 1e3);
+  std::printf("| ratio | levels | spheres | Hausdorff (mm) | query median (us) | query p99 (us) | query CPU median (us) | recall | with candidates | recall >= 0.25 mm | deformation RMS (mm) | max (mm) | Pareto |\n");
+  std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const Row& r : rows) {
     if (r.refused) {
-      std::printf("| %.0f | %d | over the 30,000 budget | | | | | | | | | |\n", r.ratio, r.levels);
+      std::printf("| %.0f | %d | over the 30,000 budget | | | | | | | | | | |\n", r.ratio, r.levels);
       continue;
     }
     bool dominated = false;
     for (const Row& o : rows) {
       if (o.refused || &o == &r) continue;
-      dominated = dominated || (o.query_p99_us <= r.query_p99_us && o.rms_mm <= r.rms_mm &&
-                                (o.query_p99_us < r.query_p99_us || o.rms_mm < r.rms_mm));
+      dominated = dominated || (o.cpu_median_us <= r.cpu_median_us && o.rms_mm <= r.rms_mm &&
+                                (o.cpu_median_us < r.cpu_median_us || o.rms_mm < r.rms_mm));
     }
-    std::printf("| %.0f | %d | %zu | %.3f | %.1f | %.1f | %.2f%% | %.2f%% | %.2f%% | %.3f | %.3f | %s |\n", r.ratio, r.levels,
-                r.spheres, r.hausdorff_mm, r.query_median_us, r.query_p99_us, 100.0 * r.recall, 100.0 * r.recall_near,
+    std::printf("| %.0f | %d | %zu | %.3f | %.1f | %.1f | %.1f | %.2f%% | %.2f%% | %.2f%% | %.3f | %.3f | %s |\n", r.ratio, r.levels,
+                r.spheres, r.hausdorff_mm, r.query_median_us, r.query_p99_us, r.cpu_median_us, 100.0 * r.recall, 100.0 * r.recall_near,
                 100.0 * r.recall_deeper, r.rms_mm,
                 r.max_mm, dominated ? "" : "**front**");
   }

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "fahr/fem/projection.h"
 
 namespace fahr::contact::sim {
 
@@ -38,108 +37,53 @@ std::unique_ptr<FemDriver> FemDriver::create(const FemDriverSettings& settings, 
   driver->radii_.resize(spheres);
   for (std::size_t s = 0; s < spheres; ++s) driver->radii_[s] = driver->links_.radius_m(s);
   driver->compliance_index_.assign(spheres, kNoCompliance);
-  driver->compliance_spheres_.assign(compliance_spheres.begin(), compliance_spheres.end());
   for (std::size_t i = 0; i < compliance_spheres.size(); ++i) {
     driver->compliance_index_[compliance_spheres[i]] = static_cast<std::int32_t>(i);
   }
-  const std::size_t rows = 3 * compliance_spheres.size();
-  driver->compliance_.assign(rows * rows, 0.0f);
-  driver->projected_.assign(3 * mesh.nodes_m.size(), 0.0);
-  driver->carry_n_.assign(3 * mesh.nodes_m.size(), 0.0);
-  driver->applied_lambda_.assign(compliance_spheres.size(), 0.0);
-  driver->applied_normal_.assign(compliance_spheres.size(), Eigen::Vector3d::Zero());
-  driver->update_centres(driver->free_centres_);
-  driver->centres_ = driver->free_centres_;
-  if (!driver->body_->compliance(driver->compliance_spheres_, driver->links_, driver->compliance_)) {
+  const fem::ContactStepSettings step{.apply_contact_forces = settings.apply_contact_forces,
+                                      .max_compliance_spheres = driver->settings_.body.max_compliance_spheres};
+  driver->contact_step_ = std::make_unique<fem::ContactStep>(*driver->body_, driver->links_, step);
+  if (!driver->contact_step_->fix_compliance_spheres(compliance_spheres)) {
     error = "compliance of the candidate spheres failed";
     return nullptr;
   }
-  driver->compliance_ready_ = true;
+  driver->update_centres();
   return driver;
 }
 
-void FemDriver::update_centres(std::vector<Eigen::Vector3d>& out) const {
-  out.resize(links_.size());
+bool FemDriver::reset() {
+  const bool ok = body_->reset_to_rest() && contact_step_->reset();
+  update_centres();
+  return ok;
+}
+
+// Free-motion centres: the compliance spheres' from ContactStep (without
+// this step's contact forces); the others', which no solve reads through W,
+// of the motion after the implicit step.
+void FemDriver::update_centres() {
+  const std::size_t spheres = links_.size();
+  free_centres_.resize(spheres);
+  centres_.resize(spheres);
+  const double* x_free = contact_step_->free_positions_m().data();
   const double* x = body_->positions_m().data();
-  for (std::size_t s = 0; s < links_.size(); ++s) out[s] = links_.centre(s, x);
+  for (std::size_t s = 0; s < spheres; ++s) {
+    free_centres_[s] = links_.centre(s, x_free);
+    centres_[s] = links_.centre(s, x);
+  }
+  const auto ids = contact_step_->compliance_spheres();
+  const auto free = contact_step_->free_centres();
+  for (std::size_t i = 0; i < ids.size(); ++i) free_centres_[ids[i]] = free[i];
 }
 
 FemStepReport FemDriver::step(const fem::ContactSet* contacts, std::span<const double> external_forces_n) {
-  fem::Body& body = *body_;
-  const std::size_t nodes = body.node_count();
-  // The haptic solve's contact forces on tool contacts, J^T n lambda, join
-  // the carried Algorithm 1 velocity correction and the caller's forces.
-  std::fill(applied_lambda_.begin(), applied_lambda_.end(), 0.0);
-  if (settings_.apply_contact_forces && contacts != nullptr) {
-    for (const fem::Contact& c : contacts->contacts) {
-      if (c.kind != fem::ContactKind::kTool || c.state == fem::ContactState::kCandidate || !(c.force_n > 0.0)) continue;
-      if (c.sphere_id >= links_.size()) continue;
-      const auto sphere_nodes = links_.nodes(c.sphere_id);
-      const auto weights = links_.weights(c.sphere_id);
-      for (std::size_t m = 0; m < sphere_nodes.size(); ++m) {
-        for (std::size_t d = 0; d < 3; ++d) {
-          carry_n_[3 * std::size_t{sphere_nodes[m]} + d] += weights[m] * c.force_n * c.normal[static_cast<Eigen::Index>(d)];
-        }
-      }
-      const std::int32_t index = compliance_index_[c.sphere_id];
-      if (index != kNoCompliance) applied_lambda_[static_cast<std::size_t>(index)] = c.force_n;
-      if (index != kNoCompliance) applied_normal_[static_cast<std::size_t>(index)] = c.normal;
-    }
-  }
-  body.clear_external_forces();
-  for (std::size_t n = 0; n < nodes; ++n) {
-    Eigen::Vector3d f(carry_n_[3 * n], carry_n_[3 * n + 1], carry_n_[3 * n + 2]);
-    if (!external_forces_n.empty()) {
-      f += Eigen::Vector3d(external_forces_n[3 * n], external_forces_n[3 * n + 1], external_forces_n[3 * n + 2]);
-    }
-    if (f.squaredNorm() > 0.0) body.set_external_force(static_cast<std::uint32_t>(n), f);
-  }
-  std::fill(carry_n_.begin(), carry_n_.end(), 0.0);
-
   FemStepReport report;
-  const fem::StepReport step = body.step(nullptr, nullptr);
+  const fem::StepReport step = contact_step_->step(contacts, external_forces_n);
   report.inverted_elements = step.inverted_elements;
   report.solve_failed = step.solve_failed;
-  update_centres(free_centres_);
-  // The motion without this step's contact forces: x_free = x - h^2 A^-1
-  // J^T N lambda, so c_free = c - W N lambda (exact on the same factor).
-  const std::size_t k = compliance_spheres_.size();
-  for (std::size_t s = 0; s < k; ++s) {
-    Eigen::Vector3d shift = Eigen::Vector3d::Zero();
-    for (std::size_t t = 0; t < k; ++t) {
-      if (applied_lambda_[t] == 0.0) continue;
-      for (std::size_t d = 0; d < 3; ++d) {
-        const float* row = compliance_.data() + (3 * s + d) * 3 * k + 3 * t;
-        shift[static_cast<Eigen::Index>(d)] += applied_lambda_[t] * (double{row[0]} * applied_normal_[t].x() +
-                                                                     double{row[1]} * applied_normal_[t].y() +
-                                                                     double{row[2]} * applied_normal_[t].z());
-      }
-    }
-    free_centres_[compliance_spheres_[s]] -= shift;
-  }
-
-  const std::span<const double> x_free = body.positions_m();
-  if (contacts != nullptr && !contacts->contacts.empty()) {
-    std::copy(x_free.begin(), x_free.end(), projected_.begin());
-    report.projection = fem::project_contacts(*contacts, links_, body.inverse_mass_per_kg(),
-                                              settings_.body.projection, projected_);
-    const double h2 = body.time_step_s() * body.time_step_s();
-    for (std::size_t n = 0; n < nodes; ++n) {
-      const Eigen::Vector3d moved(projected_[3 * n] - x_free[3 * n], projected_[3 * n + 1] - x_free[3 * n + 1],
-                                  projected_[3 * n + 2] - x_free[3 * n + 2]);
-      if (moved.squaredNorm() == 0.0) continue;
-      const auto node = static_cast<std::uint32_t>(n);
-      body.set_node_position(node, Eigen::Vector3d(projected_[3 * n], projected_[3 * n + 1], projected_[3 * n + 2]));
-      const Eigen::Vector3d carry = body.mass_kg()[n] * moved / h2;
-      for (std::size_t d = 0; d < 3; ++d) carry_n_[3 * n + d] = carry[static_cast<Eigen::Index>(d)];
-    }
-  }
-  update_centres(centres_);
-  if (settings_.recompute_compliance || !compliance_ready_) {
-    compliance_ready_ = body.compliance(compliance_spheres_, links_, compliance_);
-  }
-  report.step = body.step_index();
-  const std::span<const double> x = body.positions_m();
+  report.projection = step.projection;
+  update_centres();
+  report.step = body_->step_index();
+  const std::span<const double> x = body_->positions_m();
   report.finite = std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); });
   return report;
 }

@@ -40,7 +40,6 @@ PunchScene make_punch_scene(double punch_radius_m, double fem_period_s, std::str
   for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::uint32_t>(i);
   FemDriverSettings settings;
   settings.body = block_body_settings(fem_period_s);
-  settings.recompute_compliance = recompute_compliance;
   if (recompute_compliance) settings.body.solver.refactor_period = 1;
   scene.fem = FemDriver::create(settings, scene.block.mesh, scene.block.fixed_nodes,
                                 make_node_spheres(scene.sphere_nodes, scene.sphere_radius_m), ids, error);

@@ -4,12 +4,18 @@
 
 #include <cmath>
 
+#include "fahr/contact/force_limit.h"
+
 namespace fahr::contact {
 namespace {
 
-// Secant steps of yield_to_limit; each is one pinned PGS solve, and the
-// reaction is nearly linear in the back-off, so 4 reach the tolerance.
-constexpr int kMaxYieldIterations = 4;
+// Regula falsi steps of yield_to_limit; each is one pinned PGS solve, and
+// the reaction is nearly linear in the back-off, so a few reach the
+// tolerance; 8 bound the rare strongly curved case.
+constexpr int kMaxYieldIterations = 8;
+// How much farther than its deepest row a backing-off or stepping proxy may
+// go, m: 1 mm, a tick of a fast hand.
+constexpr double kYieldCapMarginM = 1e-3;
 // Relative band around the limit the back-off aims for: 0.1 %, far below
 // what the 5 % target allows and what a hand feels.
 constexpr double kYieldTolerance = 1e-3;
@@ -64,32 +70,59 @@ void ContactResponse::capture_holds(const TissueCompliance& compliance) {
 // changed under it, or the hand eased off slower than the tissue relaxes)
 // backs off along the reaction until the reaction is the limit: the tissue
 // never receives more than the device can render. The reaction falls
-// monotonically as the tool backs off; secant steps on the pinned solve.
-Eigen::Vector3d ContactResponse::yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n,
-                                                double guess_stiffness_npm) {
+// monotonically as the tool backs off, so the back-off s is bracketed in
+// [0, cap] and found by regula falsi (Illinois) on the pinned solve. The cap
+// bounds it by the deepest tissue row plus a millimetre: an unconverged
+// reaction (a huge lambda) can then not throw the proxy across the mouth.
+Eigen::Vector3d ContactResponse::yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n) {
   const Eigen::Vector3d reaction = solver_.resultant(RowKind::kTissue);
   const double r0 = reaction.norm();
   if (!(r0 > limit_n)) return offset_m;
-  const Eigen::Vector3d out = -reaction / r0;  // the tissue pushes the tool this way
-  double s0 = 0.0, f0 = r0 - limit_n;
-  double s1 = f0 / guess_stiffness_npm;
-  for (int iteration = 0; iteration < kMaxYieldIterations; ++iteration) {
-    solver_.solve_pinned(offset_m + s1 * out, settings_.pgs);
-    const double f1 = solver_.resultant(RowKind::kTissue).norm() - limit_n;
-    if (std::abs(f1) <= kYieldTolerance * limit_n || f1 == f0) break;
-    const double next = f1 < 0.0 && s1 > s0 ? s0 + (s1 - s0) * f0 / (f0 - f1) : s1 + (s1 - s0) * f1 / (f0 - f1);
-    s0 = s1;
-    f0 = f1;
-    s1 = std::max(0.0, next);
-  }
-  // Never leave the tissue above the limit: if the secant ended short,
-  // back off a little more (the reaction only falls).
-  if (solver_.resultant(RowKind::kTissue).norm() > limit_n) {
-    s1 *= 1.0 + kYieldTolerance;
-    solver_.solve_pinned(offset_m + s1 * out, settings_.pgs);
-  }
   report_.yielded = true;
-  return offset_m + s1 * out;
+  const Eigen::Vector3d out = -reaction / r0;  // the tissue pushes the tool this way
+  double deepest = 0.0;
+  for (std::size_t i = 0; i < solver_.size(); ++i) {
+    if (solver_.row(i).kind != RowKind::kTissue) continue;
+    deepest = std::max(deepest, solver_.penetration(i) + solver_.row(i).normal.dot(offset_m));
+  }
+  const auto excess = [&](double s) {
+    solver_.solve_pinned(offset_m + s * out, settings_.pgs);
+    return solver_.resultant(RowKind::kTissue).norm() - limit_n;
+  };
+  double lo = 0.0, f_lo = r0 - limit_n;
+  double hi = deepest + kYieldCapMarginM;
+  double f_hi = excess(hi);
+  if (f_hi > 0.0) return offset_m + hi * out;  // the most the cap allows
+  int stale_side = 0;  // Illinois: halve the value kept twice in a row
+  for (int iteration = 0; iteration < kMaxYieldIterations; ++iteration) {
+    const double s = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+    const double f = excess(s);
+    if (std::abs(f) <= kYieldTolerance * limit_n && f <= 0.0) return offset_m + s * out;
+    if (f > 0.0) {
+      lo = s;
+      f_lo = f;
+      if (stale_side == 1) f_hi *= 0.5;
+      stale_side = 1;
+    } else {
+      hi = s;
+      f_hi = f;
+      if (stale_side == -1) f_lo *= 0.5;
+      stale_side = -1;
+    }
+  }
+  // Never leave the tissue above the limit: end on the side below it.
+  excess(hi);
+  return offset_m + hi * out;
+}
+
+// The coupled solve's step is implausible when it moves the proxy farther
+// than the hand's pull plus the deepest row plus a margin: no equilibrium
+// lies beyond that, so an unconverged or infeasible solve (the tool pinched
+// between bone and tissue) produced it.
+bool ContactResponse::plausible_step(const Eigen::Vector3d& step_m, const Eigen::Vector3d& target_offset_m) const {
+  double deepest = 0.0;
+  for (std::size_t i = 0; i < solver_.size(); ++i) deepest = std::max(deepest, solver_.penetration(i));
+  return step_m.allFinite() && step_m.norm() <= target_offset_m.norm() + deepest + kYieldCapMarginM;
 }
 
 Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const EffectiveCoupling& coupling) {
@@ -98,16 +131,31 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
   const double limit = device.renderable_force_n;
   if (state_ == TrackingState::kLostTrack) {
     const double spring = coupling.stiffness_npm * (device.position_m - proxy_.position_m).norm();
-    if (!should_release(settings_.force_aware, spring, limit)) {
+    bool release = should_release(settings_.force_aware, spring, limit);
+    if (!release) {
+      // The spring alone cannot tell a hand still pushing in from one that
+      // has drawn back out of the tissue (or the mouth): both stretch it.
+      // Release when tracking again would load the tissue within the band.
+      solver_.solve_coupled(coupling.effective_stiffness_npm, coupling.target_m - proxy_.position_m, settings_.pgs);
+      release = should_release(settings_.force_aware, solver_.resultant(RowKind::kTissue).norm(), limit);
+    }
+    if (!release) {
       solver_.solve_pinned(zero, settings_.pgs);
-      const Eigen::Vector3d back = yield_to_limit(zero, limit, coupling.stiffness_npm);
+      const Eigen::Vector3d back = yield_to_limit(zero, limit);
       if (back != zero) capture_holds(input.compliance);
       return back;
     }
     state_ = TrackingState::kCatchingUp;
   }
-  Eigen::Vector3d step = solver_.solve_coupled(coupling.effective_stiffness_npm,
-                                               coupling.target_m - proxy_.position_m, settings_.pgs);
+  const Eigen::Vector3d target_offset = coupling.target_m - proxy_.position_m;
+  Eigen::Vector3d step = solver_.solve_coupled(coupling.effective_stiffness_npm, target_offset, settings_.pgs);
+  if (!plausible_step(step, target_offset)) {
+    // Hold the tool this tick (the pinned solve is well posed: no coupling
+    // term) rather than jump; the next tick's warm start solves from here.
+    report_.implausible_step = true;
+    solver_.solve_pinned(zero, settings_.pgs);
+    return yield_to_limit(zero, limit);
+  }
   if (state_ == TrackingState::kCatchingUp) {
     // Reactivated: the equilibrium may be a few mm away (the tissue relaxed
     // while the hand eased off); go there at a bounded speed so the force
@@ -116,7 +164,7 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     if (step.norm() > max_step) {
       step *= max_step / step.norm();
       solver_.solve_pinned(step, settings_.pgs);
-      step = yield_to_limit(step, limit, coupling.stiffness_npm);
+      step = yield_to_limit(step, limit);
       report_.catch_up_limited = true;
     } else {
       state_ = TrackingState::kTracking;
@@ -132,7 +180,7 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     // within the limit) and the loaded spheres are held there.
     state_ = TrackingState::kLostTrack;
     solver_.solve_pinned(zero, settings_.pgs);
-    const Eigen::Vector3d back = yield_to_limit(zero, limit, coupling.stiffness_npm);
+    const Eigen::Vector3d back = yield_to_limit(zero, limit);
     capture_holds(input.compliance);
     return back;
   }
@@ -159,7 +207,7 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
     c.normal = row.normal;
     c.plane_point_m = row.tool_point_m + plane_shift_m;
     c.penetration_m = solver_.penetration(i) + row.normal.dot(plane_shift_m);
-    c.force_n = solver_.lambda(i);
+    c.force_n = tissue_force_scale_ * solver_.lambda(i);
     c.hold_centre_m = row.other_point_m;
     const Hold* hold = frozen ? find_hold(row.id) : nullptr;
     if (hold != nullptr) {
@@ -200,7 +248,17 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
                                                         device.position_m, device.velocity_mps, p0);
   report_.load = solver_.load(input.rows, input.compliance, settings_.fallback_compliance_mpn);
   if (settings_.mode == ResponseMode::kNaive) solver_.make_rigid();
-  const Eigen::Vector3d step = move_proxy(input, coupling);
+  Eigen::Vector3d step = move_proxy(input, coupling);
+  if (solver_.has_obstacle_rows() && (state_ != TrackingState::kTracking || report_.implausible_step)) {
+    // A held, backing-off or catching-up proxy was placed by the pinned
+    // solve, which gives bone no force: keep it out of the bone, and
+    // re-solve the tissue where it ends up.
+    const Eigen::Vector3d kept_out = solver_.project_on_obstacles(step, settings_.pgs);
+    if (kept_out.allFinite() && (kept_out - step).squaredNorm() > 0.0) {
+      step = kept_out;
+      solver_.solve_pinned(step, settings_.pgs);
+    }
+  }
   solver_.store_warm_start();
   report_.pgs = solver_.last_report();
   report_.state = state_;
@@ -219,16 +277,27 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   // coupling spring. Otherwise the active set's stiffness, <= K_c.
   out.stiffness_npm = pinned ? Eigen::Matrix3d(coupling.stiffness_npm * Eigen::Matrix3d::Identity())
                              : solver_.local_stiffness(coupling.stiffness_npm);
+  report_.force_limited = limit_force(device.renderable_force_n, out.force_n, out.stiffness_npm);
   out.proxy_position_m = proxy_.position_m;
   out.proxy_orientation = proxy_.orientation;
   out.lost_track = state_ == TrackingState::kLostTrack;
   out.device_minus_proxy_m = device.position_m - proxy_.position_m;
-  out.tissue_reaction_n = solver_.resultant(RowKind::kTissue).norm();
+  // What the tissue receives is never more than the device can render: a
+  // solve that asks for more (the tool wedged between bone and tongue, where
+  // the bone's rows push it into the tissue) has its tissue forces scaled
+  // down to the limit; the FEM's projection still keeps the geometry.
+  const double solved_reaction = solver_.resultant(RowKind::kTissue).norm();
+  tissue_force_scale_ = 1.0;
+  if (settings_.mode != ResponseMode::kNaive && solved_reaction > device.renderable_force_n) {
+    tissue_force_scale_ = device.renderable_force_n / solved_reaction;
+    report_.tissue_force_clamped = true;
+  }
+  out.tissue_reaction_n = tissue_force_scale_ * solved_reaction;
   report_.obstacle_reaction_n = solver_.resultant(RowKind::kObstacle).norm();
   out.active_contacts = 0;
   for (std::size_t i = 0; i < solver_.size(); ++i) out.active_contacts += solver_.lambda(i) > 0.0 ? 1u : 0u;
   out.fem_step = input.compliance.fem_step;
-  previous_reaction_n_ = out.tissue_reaction_n;
+  previous_reaction_n_ = solved_reaction;
 
   // The FEM sees the tool where the proxy is; the naive loop's tool is the
   // device itself (it has no tissue model to stop it).

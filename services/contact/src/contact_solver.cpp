@@ -10,6 +10,10 @@
 namespace fahr::contact {
 namespace {
 
+// A projection onto the obstacles may push the tool by its deepest row's
+// depth plus this, m; more means the rows contradict each other.
+constexpr double kProjectionSlackM = 1e-3;
+
 // Normals are unit by contract; one off by more than this is a caller bug
 // (or c == q at the collision stage) and its row is dropped.
 constexpr double kUnitNormalTolerance = 1e-3;
@@ -39,7 +43,11 @@ ContactSolver::ContactSolver(std::size_t capacity)
       previous_lambda_(capacity, 0.0),
       active_(capacity, 0),
       factor_(capacity * capacity, 0.0),
-      columns_(3 * capacity, 0.0) {}
+      columns_(3 * capacity, 0.0),
+      obstacle_rows_(capacity, 0),
+      projection_s_(capacity * capacity, 0.0),
+      projection_b_(capacity, 0.0),
+      projection_mu_(capacity, 0.0) {}
 
 SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows, const TissueCompliance& compliance,
                                      double fallback_compliance_mpn) {
@@ -123,6 +131,37 @@ void ContactSolver::solve_pinned(const Eigen::Vector3d& proxy_offset_m, const Pg
     b_[i] = depth_[i] + rows_[i].normal.dot(proxy_offset_m);
   }
   report_ = solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), settings);
+}
+
+bool ContactSolver::has_obstacle_rows() const {
+  for (std::size_t i = 0; i < k_; ++i) {
+    if (rows_[i].kind == RowKind::kObstacle) return true;
+  }
+  return false;
+}
+
+Eigen::Vector3d ContactSolver::project_on_obstacles(const Eigen::Vector3d& step_m, const PgsSettings& settings) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < k_; ++i) {
+    if (rows_[i].kind == RowKind::kObstacle) obstacle_rows_[n++] = static_cast<std::uint32_t>(i);
+  }
+  if (n == 0) return step_m;
+  for (std::size_t a = 0; a < n; ++a) {
+    const Eigen::Vector3d& na = rows_[obstacle_rows_[a]].normal;
+    for (std::size_t b = 0; b < n; ++b) projection_s_[a * capacity_ + b] = na.dot(rows_[obstacle_rows_[b]].normal);
+    projection_b_[a] = depth_[obstacle_rows_[a]] + na.dot(step_m);
+    projection_mu_[a] = 0.0;
+  }
+  double deepest = 0.0;
+  for (std::size_t a = 0; a < n; ++a) deepest = std::max(deepest, projection_b_[a]);
+  solve_pgs(projection_s_.data(), capacity_, n, projection_b_.data(), projection_mu_.data(), settings);
+  Eigen::Vector3d push = Eigen::Vector3d::Zero();
+  for (std::size_t a = 0; a < n; ++a) push += rows_[obstacle_rows_[a]].normal * projection_mu_[a];
+  // Rows pinching the tool from opposite sides have no common solution and
+  // mu grows without bound: then no push is trusted beyond the deepest row
+  // (the tool is stuck in the bone it is in, not thrown out of the mouth).
+  if (!push.allFinite() || push.norm() > deepest + kProjectionSlackM) return step_m;
+  return step_m - push;
 }
 
 Eigen::Matrix3d ContactSolver::local_stiffness(double k_c_npm) {

@@ -12,8 +12,6 @@
 #include <cstdio>
 #include <thread>
 
-#include "contact_conversion.h"
-#include "contact_step.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/stop_signal.h"
@@ -21,7 +19,8 @@
 #include "fahr/runtime/scene_transport.h"
 #include "fahr/runtime/service_main.h"
 #include "fahr/scene/plan.h"
-#include "fem_body_setup.h"
+#include "fahr/fem_service/fem_body_setup.h"
+#include "fahr/fem_service/service_step.h"
 
 namespace fahr::fem_service {
 namespace {
@@ -29,71 +28,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-// What one FEM step needs, allocated once.
-struct StepContext {
-  FemBodySetup& setup;
-  ContactStep contact_step;
-  fem::ContactSet contacts;
-  bool have_contacts = false;
-  std::uint64_t applied_contact_seq = 0;
-  msg::DeformationState state;
-  fem::StepReport last_report;
-  std::uint64_t inverted_max = 0;
-  std::uint64_t stale_sets = 0;
-  double step_ms_max = 0.0;
-
-  explicit StepContext(FemBodySetup& s)
-      : setup(s), contact_step(*s.body, s.links, s.settings.max_compliance_spheres) {
-    const std::size_t cap = s.settings.max_compliance_spheres;
-    contacts.contacts.reserve(msg::MAX_CONTACTS);
-    state.positions_m().reserve(3 * s.mesh.node_count());
-    state.velocities_mps().reserve(3 * s.mesh.node_count());
-    state.compliance_sphere_ids().reserve(cap);
-    state.compliance_mpn().reserve(9 * cap * cap);
-    state.compliance_free_centres_m().reserve(3 * cap);
-  }
-
-  // One FEM step and the DeformationState that reports it.
-  void step() {
-    // A set older than the body allows is ignored and counted (stale).
-    const bool usable = have_contacts && setup.body->step_index() <= contacts.state_step +
-                                                                        setup.settings.max_contact_age_steps;
-    if (have_contacts && !usable) ++stale_sets;
-    last_report = contact_step.step(usable ? &contacts : nullptr);
-    inverted_max = std::max<std::uint64_t>(inverted_max, static_cast<std::uint64_t>(last_report.inverted_elements));
-    fill_state(*setup.body, setup.scene_body->id, state);
-    state.stale_contact_sets(static_cast<std::uint32_t>(stale_sets));
-    state.applied_contact_seq(usable ? applied_contact_seq : 0);
-    const auto& ids = contact_step.compliance_spheres();
-    state.compliance_sphere_ids().assign(ids.begin(), ids.end());
-    state.compliance_mpn().assign(contact_step.compliance().begin(), contact_step.compliance().end());
-    state.compliance_free_centres_m().assign(contact_step.free_centres().begin(), contact_step.free_centres().end());
-  }
-
-  void take(const msg::ContactSet& wire, std::uint64_t seq) {
-    to_fem(wire, contacts);
-    have_contacts = true;
-    applied_contact_seq = seq;
-  }
-
-  void metrics(std::vector<std::pair<std::string, double>>& out) const {
-    out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets));
-    out.emplace_back("compliance_reuses", static_cast<double>(contact_step.compliance_reuses()));
-    out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max));
-    out.emplace_back("projection_sweeps_last", static_cast<double>(last_report.projection.sweeps));
-    out.emplace_back("solver_iterations_last", static_cast<double>(last_report.solver_iterations));
-    out.emplace_back("asleep", setup.body->asleep() ? 1.0 : 0.0);
-    out.emplace_back("nodes", static_cast<double>(setup.mesh.node_count()));
-    out.emplace_back("tets", static_cast<double>(setup.mesh.tet_count()));
-    out.emplace_back("spheres", static_cast<double>(setup.links.size()));
-  }
-};
-
 void record(common::TickRecorder& recorder, std::uint64_t tick, std::int64_t start_ns, std::int64_t cpu_start_ns) {
   recorder.push({tick, start_ns, common::monotonic_now_ns() - start_ns, common::thread_cpu_now_ns() - cpu_start_ns});
 }
 
-int run_realtime(common::Participant& participant, StepContext& ctx, const scene::Scene& scene,
+int run_realtime(common::Participant& participant, ServiceStep& fem_step, const scene::Scene& scene,
                  common::TickRecorder& recorder, double duration_s) {
   common::QosProfile out_qos = common::QosProfile::for_role(common::TopicRole::kStateStream);
   out_qos.deadline = 3 * scene.rates.fem_period();  // a late step is expected now and then; three are not
@@ -108,17 +47,17 @@ int run_realtime(common::Participant& participant, StepContext& ctx, const scene
     if (duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(duration_s)) break;
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
-    if (in.fetch_newest()) ctx.take(in.newest(), in.newest_info().seq);
-    ctx.step();
-    ctx.state.header().sim_step(ctx.setup.body->step_index());
-    ctx.state.header().sim_time_ns(static_cast<std::int64_t>(ctx.last_report.time_s * 1e9));
-    out.write(ctx.state);
+    if (in.fetch_newest()) fem_step.take(in.newest(), in.newest_info().seq);
+    fem_step.step();
+    fem_step.state().header().sim_step(fem_step.setup().body->step_index());
+    fem_step.state().header().sim_time_ns(static_cast<std::int64_t>(fem_step.last_report().time_s * 1e9));
+    out.write(fem_step.state());
     record(recorder, tick, t0, c0);
   }
   return 0;
 }
 
-int run_lockstep(common::Participant& participant, StepContext& ctx, const scene::Scene& scene,
+int run_lockstep(common::Participant& participant, ServiceStep& fem_step, const scene::Scene& scene,
                  common::TickRecorder& recorder) {
   common::Publisher<msg::DeformationState> out(participant,
                                                common::lockstep_output_qos<msg::DeformationState>());
@@ -139,13 +78,13 @@ int run_lockstep(common::Participant& participant, StepContext& ctx, const scene
                      static_cast<unsigned long long>(*s));
         return 1;
       }
-      ctx.take(*set, set->header().seq());
+      fem_step.take(*set, set->header().seq());
     }
-    ctx.step();
-    ctx.state.header().sim_step(k);
-    ctx.state.header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
-    out.write(ctx.state);
-    hash.add(ctx.state);
+    fem_step.step();
+    fem_step.state().header().sim_step(k);
+    fem_step.state().header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+    out.write(fem_step.state());
+    hash.add(fem_step.state());
     record(recorder, k, t0, c0);
     client.complete_through(k + fem_steps - 1, hash.value());
   }
@@ -183,26 +122,26 @@ int run(int argc, char** argv) {
 
   common::install_stop_handlers();
   FemBodySetup setup = set_up_body(*scene, scene->bodies[plan.fem_bodies.front()]);
-  StepContext ctx(setup);
+  ServiceStep fem_step(setup);
   common::Participant participant(runtime::transport_for(*scene, dds, domain, profile, "fem"));
   common::TickRecorder recorder;
   common::ServiceReporter reporter(participant, {"fem", scene->rates.fem_hz, scene->rates.status_period() > 0ns ?
                                                  std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period()) : 250ms},
-                                   recorder, [&](auto& metrics) { ctx.metrics(metrics); });
+                                   recorder, [&](auto& metrics) { fem_step.metrics(metrics); });
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // launchers wait for the start line
   std::printf("fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres), %.0f Hz, %s\n",
               std::string(common::vendor_name(participant.vendor())).c_str(), setup.scene_body->name.c_str(),
               setup.mesh.node_count(), setup.mesh.tet_count(), setup.fixed_nodes.size(), setup.links.size(),
               scene->rates.fem_hz, lockstep ? "lockstep" : "realtime");
   reporter.set_state(msg::SERVICE_RUNNING);
-  const int status = lockstep ? run_lockstep(participant, ctx, *scene, recorder)
-                              : run_realtime(participant, ctx, *scene, recorder, duration_s);
+  const int status = lockstep ? run_lockstep(participant, fem_step, *scene, recorder)
+                              : run_realtime(participant, fem_step, *scene, recorder, duration_s);
   reporter.set_state(msg::SERVICE_STOPPING);
   reporter.report();
   std::printf("fahr_fem_service: %llu steps, stale contact sets %llu, max inverted elements %llu\n",
               static_cast<unsigned long long>(setup.body->step_index()),
-              static_cast<unsigned long long>(ctx.stale_sets),
-              static_cast<unsigned long long>(ctx.inverted_max));
+              static_cast<unsigned long long>(fem_step.stale_sets()),
+              static_cast<unsigned long long>(fem_step.inverted_max()));
   return status;
 }
 

@@ -319,6 +319,17 @@ void Body::set_velocities_zero() { v_.setZero(); }
 
 void Body::wake() { sleep_.wake(); }
 
+bool Body::reset_to_rest() {
+  x_ = rest_x_;
+  v_.setZero();
+  clear_external_forces();
+  sleep_.wake();
+  std::fill(rotations_.begin(), rotations_.end(), Eigen::Matrix3d::Identity());
+  warp_.update_rotations(rest_, rotations_);
+  assemble_system();
+  return refactorise();
+}
+
 void Body::elastic_forces(std::span<double> out_n) {
   force_.setZero();
   update_rotations_and_forces(false, nullptr);

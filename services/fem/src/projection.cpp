@@ -16,7 +16,9 @@ bool contact_is_frozen(const Contact& contact) {
   return contact.kind == ContactKind::kTool && contact.state == ContactState::kFrozen;
 }
 
-bool contact_is_projected(const Contact& contact) { return contact.state != ContactState::kCandidate; }
+bool contact_is_projected(const Contact& contact) {
+  return contact.state != ContactState::kCandidate && contact.kind != ContactKind::kPenalty;
+}
 
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
                         std::span<const double> inverse_mass_per_node, const Eigen::Vector3d& dc_m,

@@ -16,7 +16,13 @@ namespace {
 // margin add as many again. 1024 leaves headroom, and a full buffer is
 // counted, not fatal.
 constexpr std::size_t kToolContactCapacity = 1024;
-constexpr std::size_t kObstacleContactCapacity = 256;
+// Leaves of the tool's surface samples near the anatomy in one tick: the
+// blade lying along the palate touches a few dozen.
+constexpr std::size_t kAnatomyContactCapacity = 128;
+// Tool samples within this distance of the anatomy become rows (separated,
+// lambda = 0 unless the proxy moves into them): the solve then stops the
+// proxy within the tick instead of one tick late, m. 1 mm: a hand at 1 m/s.
+constexpr double kAnatomyMarginM = 1e-3;
 
 template <class T>
 void relaxed_store(std::atomic<T>& a, T v) {
@@ -42,23 +48,21 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
     : setup_(setup),
       nominal_period_s_(1.0 / setup.scene->rates.haptic_hz),
       response_(setup.response),
-      spheres_(setup.layout),
-      tree_(setup.layout),
-      positions_m_(3 * setup.mesh.node_count(), 0.0),
+      penalty_(setup.penalty_settings),
+      penalty_contacts_(setup.response.max_contacts),
       tool_memory_(setup.layout.size()),
       tool_contacts_(kToolContactCapacity),
       order_(kToolContactCapacity, 0),
-      rows_(setup.response.max_rows),
-      obstacle_buffer_(kObstacleContactCapacity),
-      obstacle_contacts_(kObstacleContactCapacity),
-      obstacle_body_ids_(kObstacleContactCapacity, 0),
-      compliance_index_(setup.layout.size(), contact::kNoCompliance),
-      indexed_ids_(msg::MAX_COMPLIANCE_SPHERES, 0) {
-  // Until the FEM publishes, the tongue is at rest: the tool can touch it
-  // from the first tick (the response then uses the fallback compliance).
-  spheres_.reset_to_rest(setup.layout);
-  tree_.refit(spheres_);
-
+      anatomy_contacts_(kAnatomyContactCapacity),
+      anatomy_order_(kAnatomyContactCapacity, 0),
+      tissue_row_budget_(std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES, setup.response.max_rows)),
+      rows_(setup.response.max_rows) {
+  if (setup.collision == CollisionMethod::kTriangle) {
+    triangle_contacts_.reserve(kToolContactCapacity);
+    row_of_sphere_.assign(setup.layout.size(), -1);
+    sphere_contact_.assign(kToolContactCapacity, 0);
+    slot_sphere_.assign(kToolContactCapacity, 0);
+  }
   tool_body_.id = setup.tool->scene_body->id;
   tool_body_.sdf = setup.tool->sdf.get();
   // Spheres within 1 mm of the blade are sent as candidates, so the FEM
@@ -70,87 +74,14 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
   // It is exact on the blade's flat underside, off by a fraction of a cell
   // (0.5 mm) at its edges.
   tool_query_.exact_narrow_phase = false;
-
-  // Tissue against anatomy changes only with the FEM state (200 Hz here), so
-  // the grid distance is enough: off by a fraction of a cell at edges only.
-  obstacle_query_.exact_narrow_phase = false;
-  obstacle_query_.candidate_margin_m = 0.0;
-  // The anatomy is thick: the field's normal points the right way even with
-  // the centre inside, so no approach memory (which visits every sphere
-  // within the margin: most of the tongue's underside lies 0.37 mm off the jaw).
-  obstacle_query_.approach_margin_m = 0.0;
-  for (const auto& field : setup.obstacles) {
+  for (const std::size_t a : setup.tool_obstacles) {
+    const RigidField& field = *setup.anatomy[a];
     haptic::RigidBody body;
-    body.id = field->scene_body->id;
-    body.sdf = field->sdf.get();
-    body.world_from_body = Eigen::Translation3d(field->scene_body->pose.position_m) * field->scene_body->pose.orientation;
-    obstacle_bodies_.push_back(body);
-    obstacle_memory_.emplace_back(setup.layout.size());
+    body.id = field.scene_body->id;
+    body.sdf = field.sdf.get();
+    body.world_from_body = Eigen::Translation3d(field.scene_body->pose.position_m) * field.scene_body->pose.orientation;
+    anatomy_bodies_.push_back(body);
   }
-  query_obstacles();
-}
-
-void HapticLoop::query_obstacles() {
-  obstacle_buffer_.clear();
-  for (std::size_t b = 0; b < obstacle_bodies_.size(); ++b) {
-    const auto stats = haptic::query_spheres(tree_, spheres_, obstacle_bodies_[b], obstacle_query_,
-                                             obstacle_memory_[b], obstacle_buffer_);
-    if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
-  }
-  obstacle_count_ = 0;
-  for (const haptic::SphereContact& s : obstacle_buffer_) {
-    if (s.candidate || s.depth_m <= 0.0) continue;
-    fem::Contact& c = obstacle_contacts_[obstacle_count_];
-    c.sphere_id = s.sphere_id;
-    c.kind = fem::ContactKind::kObstacle;
-    c.state = fem::ContactState::kActive;
-    c.plane_point_m = s.point_m;
-    c.normal = s.normal;
-    c.hold_centre_m = spheres_.centres_m()[s.sphere_id];
-    c.penetration_m = s.depth_m;
-    c.force_n = 0.0;  // a hard constraint: the FEM's projection alone resolves it
-    obstacle_body_ids_[obstacle_count_] = s.body_id;
-    ++obstacle_count_;
-  }
-  relaxed_store(metrics_.obstacle_contacts, static_cast<std::uint32_t>(obstacle_count_));
-}
-
-bool HapticLoop::take_state(const msg::DeformationState& state) {
-  const auto start = std::chrono::steady_clock::now();
-  const auto& x = state.positions_m();
-  if (x.size() != positions_m_.size()) {
-    relaxed_add<std::uint64_t>(metrics_.bad_states, 1);
-    return false;
-  }
-  for (std::size_t i = 0; i < x.size(); ++i) positions_m_[i] = static_cast<double>(x[i]);
-  if (!spheres_.update(setup_.layout, positions_m_)) {
-    // A NaN from the FEM: the tree keeps the last good boxes; centres past
-    // the bad node keep their last values.
-    relaxed_add<std::uint64_t>(metrics_.bad_states, 1);
-    return false;
-  }
-  tree_.refit(spheres_);
-  query_obstacles();
-
-  for (std::size_t i = 0; i < indexed_count_; ++i) compliance_index_[indexed_ids_[i]] = contact::kNoCompliance;
-  indexed_count_ = 0;
-  const auto& ids = state.compliance_sphere_ids();
-  const std::size_t k = ids.size();
-  const bool w_ok = state.compliance_mpn().size() >= 9 * k * k;
-  if (w_ok) {
-    for (std::size_t i = 0; i < k && i < indexed_ids_.size(); ++i) {
-      if (ids[i] >= compliance_index_.size()) continue;
-      compliance_index_[ids[i]] = static_cast<std::int32_t>(i);
-      indexed_ids_[indexed_count_++] = ids[i];
-    }
-  }
-  have_free_centres_ = w_ok && k > 0 && state.compliance_free_centres_m().size() >= 3 * k;
-  relaxed_store(metrics_.free_centres, have_free_centres_);
-  relaxed_add<std::uint64_t>(metrics_.fem_states, 1);
-  const double state_us = elapsed_us(start);
-  store_max(metrics_.state_us_max, state_us);
-  store_max(metrics_.state_us_peak, state_us);
-  return true;
 }
 
 contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
@@ -169,10 +100,10 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   return d;
 }
 
-void HapticLoop::collect_rows(const msg::DeformationState* state) {
+void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
   const std::size_t n = tool_contacts_.size();
   std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
-  const std::size_t keep = std::min(n, rows_.size());
+  const std::size_t keep = std::min(n, tissue_row_budget_);
   if (n > keep) {
     // More than W can cover: keep the deepest (touching before candidates).
     std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(keep),
@@ -181,28 +112,116 @@ void HapticLoop::collect_rows(const msg::DeformationState* state) {
                       });
     relaxed_add<std::uint64_t>(metrics_.rows_dropped, n - keep);
   }
-  const float* free_centres = have_free_centres_ && state != nullptr ? state->compliance_free_centres_m().data() : nullptr;
+  // (The penalty baseline's forces are part of the FEM's step, so it reads
+  // the published centres.)
+  const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
   for (std::size_t r = 0; r < keep; ++r) {
     const haptic::SphereContact& s = tool_contacts_[order_[r]];
-    contact::ContactRow& row = rows_[r];
+    contact::ContactRow& row = rows_[row_count_++];
     row.kind = contact::RowKind::kTissue;
     row.id = s.sphere_id;
     row.normal = s.normal;
     row.tool_point_m = s.point_m;
-    row.radius_m = spheres_.radii_m()[s.sphere_id];
-    row.compliance_index = state != nullptr ? compliance_index_[s.sphere_id] : contact::kNoCompliance;
-    row.other_point_m = spheres_.centres_m()[s.sphere_id];
-    if (free_centres != nullptr && row.compliance_index >= 0) {
+    row.radius_m = tissue.spheres.radii_m()[s.sphere_id];
+    row.compliance_index = tissue.compliance_index[s.sphere_id];
+    row.other_point_m = tissue.spheres.centres_m()[s.sphere_id];
+    if (free_centres && row.compliance_index >= 0) {
       // Penetration on the free-motion centre (services/contact README,
       // "Which centre"): the projected one reads zero at a steady contact.
-      const float* c = free_centres + 3 * row.compliance_index;
+      const float* c = tissue.free_centres_m.data() + 3 * row.compliance_index;
       row.other_point_m = Eigen::Vector3d(c[0], c[1], c[2]);
     }
   }
-  row_count_ = keep;
 }
 
-void HapticLoop::tick(const msg::DevicePose& pose, const msg::DeformationState* state, msg::ForceCommand& command,
+// The baseline's vertex-face contacts as rows of the same response: each
+// penetrating tongue vertex speaks for the sphere nearest it at rest (its
+// compliance, its ContactSet entry), the deepest vertex per sphere. The
+// vertex comes from the published (projected) positions; it is moved by its
+// sphere's free-motion offset, as the AIST rows use the free centres.
+// Contacts where a tool vertex is inside the tissue have no tissue vertex
+// and give no row (they are found, and timed, all the same).
+void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
+  tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_);
+  const auto& vertex_sphere = setup_.triangles->vertex_sphere;
+  std::size_t slots = 0;
+  for (std::size_t i = 0; i < triangle_contacts_.size() && slots < sphere_contact_.size(); ++i) {
+    const haptic::TriangleContact& c = triangle_contacts_[i];
+    if (c.tissue_vertex < 0) continue;
+    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.tissue_vertex)];
+    const std::int32_t slot = row_of_sphere_[sphere];
+    if (slot < 0) {
+      row_of_sphere_[sphere] = static_cast<std::int32_t>(slots);
+      slot_sphere_[slots] = sphere;
+      sphere_contact_[slots++] = static_cast<std::uint32_t>(i);
+    } else if (c.depth_m > triangle_contacts_[sphere_contact_[static_cast<std::size_t>(slot)]].depth_m) {
+      sphere_contact_[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(i);
+    }
+  }
+  for (std::size_t k = 0; k < slots; ++k) row_of_sphere_[slot_sphere_[k]] = -1;
+  const std::size_t keep = std::min(slots, tissue_row_budget_);
+  if (slots > keep) {
+    std::partial_sort(sphere_contact_.begin(), sphere_contact_.begin() + static_cast<std::ptrdiff_t>(keep),
+                      sphere_contact_.begin() + static_cast<std::ptrdiff_t>(slots), [&](std::uint32_t a, std::uint32_t b) {
+                        return triangle_contacts_[a].depth_m > triangle_contacts_[b].depth_m;
+                      });
+    relaxed_add<std::uint64_t>(metrics_.rows_dropped, slots - keep);
+  }
+  // (The penalty baseline's forces are part of the FEM's step, so it reads
+  // the published centres.)
+  const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
+  for (std::size_t r = 0; r < keep; ++r) {
+    const haptic::TriangleContact& c = triangle_contacts_[sphere_contact_[r]];
+    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.tissue_vertex)];
+    contact::ContactRow& row = rows_[row_count_++];
+    row.kind = contact::RowKind::kTissue;
+    row.id = sphere;
+    row.normal = c.normal;
+    row.tool_point_m = c.point_m;
+    row.other_point_m = c.point_m - c.depth_m * c.normal;  // the vertex: depth = -(v - q) . n
+    row.radius_m = 0.0;
+    row.compliance_index = tissue.compliance_index[sphere];
+    if (free_centres && row.compliance_index >= 0) {
+      const float* f = tissue.free_centres_m.data() + 3 * row.compliance_index;
+      row.other_point_m += Eigen::Vector3d(f[0], f[1], f[2]) - tissue.spheres.centres_m()[sphere];
+    }
+  }
+}
+
+void HapticLoop::collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool) {
+  std::size_t n = 0;
+  for (const haptic::RigidBody& body : anatomy_bodies_) {
+    const auto stats =
+        haptic::query_surface_samples(setup_.tool_samples, world_from_tool, body, kAnatomyMarginM, anatomy_contacts_, n);
+    if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
+  }
+  const std::size_t keep = std::min({n, kMaxAnatomyRows, rows_.size() - row_count_});
+  std::iota(anatomy_order_.begin(), anatomy_order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
+  if (n > keep) {
+    std::partial_sort(anatomy_order_.begin(), anatomy_order_.begin() + static_cast<std::ptrdiff_t>(keep),
+                      anatomy_order_.begin() + static_cast<std::ptrdiff_t>(n), [&](std::uint32_t a, std::uint32_t b) {
+                        return anatomy_contacts_[a].depth_m > anatomy_contacts_[b].depth_m;
+                      });
+    relaxed_add<std::uint64_t>(metrics_.rows_dropped, n - keep);
+  }
+  for (std::size_t r = 0; r < keep; ++r) {
+    const haptic::SurfaceContact& c = anatomy_contacts_[anatomy_order_[r]];
+    contact::ContactRow& row = rows_[row_count_++];
+    row.kind = contact::RowKind::kObstacle;
+    // (body, leaf) keys the warm start: body ids are small scene indices,
+    // leaves fewer than 2^20.
+    row.id = (c.body_id << 20) | c.leaf;
+    // From the tool toward the anatomy: moving the tool into it deepens the row.
+    row.normal = -c.normal;
+    row.tool_point_m = c.tool_point_m;
+    row.other_point_m = c.surface_point_m;
+    row.radius_m = 0.0;
+    row.compliance_index = contact::kNoCompliance;
+  }
+  relaxed_store(metrics_.anatomy_rows, static_cast<std::uint32_t>(keep));
+}
+
+void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue, msg::ForceCommand& command,
                       msg::ContactSet& contacts) {
   const auto start = std::chrono::steady_clock::now();
   const contact::DeviceSample device = device_sample(pose);
@@ -210,48 +229,66 @@ void HapticLoop::tick(const msg::DevicePose& pose, const msg::DeformationState* 
     response_.reset(device.position_m, device.orientation);
     started_ = true;
   }
-  // Rows are measured with the tool at the proxy, in the device's
-  // orientation: the reference pose p0 of the solve.
-  tool_body_.world_from_body = Eigen::Translation3d(response_.proxy().position_m) * device.orientation;
-  tool_contacts_.clear();
-  const auto stats = haptic::query_spheres(tree_, spheres_, tool_body_, tool_query_, tool_memory_, tool_contacts_);
-  if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
-  collect_rows(state);
-
-  contact::TickInput input;
-  input.device = device;
-  input.rows = {rows_.data(), row_count_};
-  if (state != nullptr) {
-    input.compliance.fem_step = state->step();
-    if (indexed_count_ > 0) {
-      input.compliance.sphere_ids = {state->compliance_sphere_ids().data(), state->compliance_sphere_ids().size()};
-      input.compliance.w_mpn = {state->compliance_mpn().data(), state->compliance_mpn().size()};
-    }
+  if (tissue.from_fem && tissue.fem_step != last_fem_step_) {
+    last_fem_step_ = tissue.fem_step;
+    relaxed_add<std::uint64_t>(metrics_.snapshots, 1);
   }
-  input.tissue_obstacle_contacts = {obstacle_contacts_.data(), obstacle_count_};
-  const contact::ForceOutput& out = response_.tick(input);
-  const double solve_us = elapsed_us(start);
-  store_max(metrics_.solve_us_max, solve_us);
-  store_max(metrics_.solve_us_peak, solve_us);
+  // Rows are measured with the tool at the proxy, in the device's
+  // orientation: the reference pose p0 of the solve. The penalty baseline
+  // has no proxy: its tool is the device.
+  const Eigen::Vector3d tool_at = setup_.penalty ? device.position_m : response_.proxy().position_m;
+  tool_body_.world_from_body = Eigen::Translation3d(tool_at) * device.orientation;
+  row_count_ = 0;
+  if (setup_.collision == CollisionMethod::kTriangle && tissue.triangles) {
+    collect_triangle_rows(tissue);
+  } else {
+    tool_contacts_.clear();
+    const auto stats =
+        haptic::query_spheres(tissue.tree, tissue.spheres, tool_body_, tool_query_, tool_memory_, tool_contacts_);
+    if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
+    collect_tissue_rows(tissue);
+  }
+  const std::size_t tissue_rows = row_count_;
+  collect_anatomy_rows(tool_body_.world_from_body);
+
+  const contact::ForceOutput* output = nullptr;
+  if (setup_.penalty) {
+    output = &penalty_tick(device, tissue);
+  } else {
+    contact::TickInput input;
+    input.device = device;
+    input.rows = {rows_.data(), row_count_};
+    if (tissue.from_fem) input.compliance = tissue.compliance();
+    input.tissue_obstacle_contacts = tissue.tissue_obstacle_contacts();
+    output = &response_.tick(input);
+  }
+  const contact::ForceOutput& out = *output;
 
   fill_command(out, pose.device_id(), command);
   command.header().sim_step(pose.servo_tick());
   command.header().sim_time_ns(pose.header().sim_time_ns());
   contacts.body_id(setup_.deformable->id);
   contacts.haptic_tick(tick_);
-  contacts.fem_step(state != nullptr ? state->step() : 0);
-  contacts.tool_frozen(response_.tool_frozen());
-  fill_contacts(response_.contacts(), tool_body_.id, {obstacle_body_ids_.data(), obstacle_count_}, contacts);
+  contacts.fem_step(tissue.fem_step);
+  if (setup_.penalty) {
+    contacts.tool_frozen(false);
+    fill_contacts({penalty_contacts_.data(), penalty_count_}, tool_body_.id, tissue.tissue_obstacle_body_ids(),
+                  contacts);
+  } else {
+    contacts.tool_frozen(response_.tool_frozen());
+    fill_contacts(response_.contacts(), tool_body_.id, tissue.tissue_obstacle_body_ids(), contacts);
+  }
   contacts.header().sim_step(pose.servo_tick());
   contacts.header().sim_time_ns(pose.header().sim_time_ns());
   ++tick_;
 
   relaxed_add<std::uint64_t>(metrics_.ticks, 1);
-  relaxed_store(metrics_.tool_rows, static_cast<std::uint32_t>(row_count_));
+  relaxed_store(metrics_.tool_rows, static_cast<std::uint32_t>(tissue_rows));
   relaxed_store(metrics_.active_contacts, out.active_contacts);
   relaxed_store(metrics_.missing_compliance,
                 static_cast<std::uint32_t>(std::max(0, response_.report().load.missing_compliance)));
   relaxed_store(metrics_.reaction_n, out.tissue_reaction_n);
+  relaxed_store(metrics_.obstacle_reaction_n, response_.report().obstacle_reaction_n);
   const double force_n = out.force_n.norm();
   if (force_n > metrics_.peak_force_n.load(std::memory_order_relaxed)) relaxed_store(metrics_.peak_force_n, force_n);
   if (out.lost_track) {
@@ -259,26 +296,54 @@ void HapticLoop::tick(const msg::DevicePose& pose, const msg::DeformationState* 
     if (!was_lost_) relaxed_add<std::uint64_t>(metrics_.lost_track_episodes, 1);
   }
   was_lost_ = out.lost_track;
+  const double tick_us = elapsed_us(start);
+  store_max(metrics_.tick_us_max, tick_us);
+  store_max(metrics_.tick_us_peak, tick_us);
+}
+
+// The penalty baseline: each penetrating tissue row pushes its sphere with
+// k_p d along n, as a force-only ContactSet entry (the FEM applies it and
+// projects nothing); bone rows push the tool but not the tissue.
+const contact::ForceOutput& HapticLoop::penalty_tick(const contact::DeviceSample& device,
+                                                     const TissueSnapshot& tissue) {
+  const contact::ForceOutput& out = penalty_.tick(device, {rows_.data(), row_count_}, tissue.fem_step);
+  penalty_count_ = 0;
+  for (const contact::SphereForce& f : penalty_.sphere_forces()) {
+    const double magnitude = f.force_n.norm();
+    if (!(magnitude > 0.0) || penalty_count_ == penalty_contacts_.size()) continue;
+    fem::Contact& c = penalty_contacts_[penalty_count_++];
+    c.sphere_id = f.sphere_id;
+    c.kind = fem::ContactKind::kPenalty;
+    c.state = fem::ContactState::kActive;
+    c.normal = f.force_n / magnitude;
+    c.force_n = magnitude;
+    c.hold_centre_m = tissue.spheres.centres_m()[f.sphere_id];
+    c.plane_point_m = c.hold_centre_m;
+    c.penetration_m = magnitude / setup_.penalty_settings.stiffness_npm;
+  }
+  for (const fem::Contact& c : tissue.tissue_obstacle_contacts()) {
+    if (penalty_count_ == penalty_contacts_.size()) break;
+    penalty_contacts_[penalty_count_++] = c;
+  }
+  return out;
 }
 
 void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out) {
   const auto get = [](const auto& a) { return static_cast<double>(a.load(std::memory_order_relaxed)); };
-  out.emplace_back("fem_states", get(metrics_.fem_states));
-  out.emplace_back("bad_states", get(metrics_.bad_states));
+  out.emplace_back("fem_states_used", get(metrics_.snapshots));
   out.emplace_back("tool_rows", get(metrics_.tool_rows));
+  out.emplace_back("anatomy_rows", get(metrics_.anatomy_rows));
   out.emplace_back("active_contacts", get(metrics_.active_contacts));
-  out.emplace_back("obstacle_contacts", get(metrics_.obstacle_contacts));
   out.emplace_back("rows_dropped", get(metrics_.rows_dropped));
   out.emplace_back("query_overflows", get(metrics_.query_overflows));
   out.emplace_back("missing_compliance", get(metrics_.missing_compliance));
   out.emplace_back("lost_track_ticks", get(metrics_.lost_track_ticks));
   out.emplace_back("lost_track_episodes", get(metrics_.lost_track_episodes));
-  out.emplace_back("free_centres", metrics_.free_centres.load(std::memory_order_relaxed) ? 1.0 : 0.0);
   out.emplace_back("tissue_reaction_n", get(metrics_.reaction_n));
+  out.emplace_back("anatomy_reaction_n", get(metrics_.obstacle_reaction_n));
   out.emplace_back("peak_force_n", get(metrics_.peak_force_n));
   out.emplace_back("spheres", static_cast<double>(setup_.layout.size()));
-  out.emplace_back("state_us_max", metrics_.state_us_max.exchange(0.0, std::memory_order_relaxed));
-  out.emplace_back("solve_us_max", metrics_.solve_us_max.exchange(0.0, std::memory_order_relaxed));
+  out.emplace_back("tick_us_max", metrics_.tick_us_max.exchange(0.0, std::memory_order_relaxed));
 }
 
 }  // namespace fahr::haptic_service

@@ -1,7 +1,8 @@
-// One haptic tick per DevicePose: sphere centres from the newest FEM state,
-// the tool's contacts through the AIST, the contact response on the FEM's
-// compliance, and the ForceCommand and ContactSet that answer it. Every
-// buffer is sized in the constructor; take_state() and tick() allocate
+// One haptic tick per DevicePose: the tool's contacts with the tongue
+// through the AIST of the newest digested FEM state (TissueSnapshot), its
+// contacts with the rigid anatomy through its surface samples, the contact
+// response on the FEM's compliance, and the ForceCommand and ContactSet that
+// answer it. Every buffer is sized in the constructor; tick() allocates
 // nothing once the wire samples hold their reserved capacity.
 #pragma once
 
@@ -12,16 +13,16 @@
 #include <vector>
 
 #include "contact_set.h"
-#include "deformation_state.h"
 #include "device_pose.h"
 #include "fahr/contact/contact_response.h"
+#include "fahr/contact/penalty_response.h"
 #include "fahr/haptic/contact_buffer.h"
 #include "fahr/haptic/rigid_body.h"
 #include "fahr/haptic/sphere_query.h"
-#include "fahr/haptic/sphere_state.h"
-#include "fahr/haptic/sphere_tree.h"
+#include "fahr/haptic/surface_samples.h"
 #include "force_command.h"
 #include "haptic_setup.h"
+#include "tissue_snapshot.h"
 
 namespace fahr::haptic_service {
 
@@ -29,41 +30,34 @@ namespace fahr::haptic_service {
 // each is a single value, no invariant ties them together).
 struct LoopMetrics {
   std::atomic<std::uint64_t> ticks{0};
-  std::atomic<std::uint64_t> fem_states{0};
-  std::atomic<std::uint64_t> bad_states{0};         // wrong size or non-finite positions: ignored
-  std::atomic<std::uint32_t> tool_rows{0};          // rows of the last tick (touching and candidates)
+  std::atomic<std::uint64_t> snapshots{0};          // distinct FEM states the ticks used
+  std::atomic<std::uint32_t> tool_rows{0};          // tissue rows of the last tick (touching and candidates)
+  std::atomic<std::uint32_t> anatomy_rows{0};       // tool vs rigid anatomy rows of the last tick
   std::atomic<std::uint32_t> active_contacts{0};    // rows with lambda > 0, last tick
-  std::atomic<std::uint32_t> obstacle_contacts{0};  // tongue vs anatomy, newest state
-  std::atomic<std::uint64_t> rows_dropped{0};       // tool contacts beyond max_rows, total
+  std::atomic<std::uint64_t> rows_dropped{0};       // tool contacts beyond the row budget, total
   std::atomic<std::uint64_t> query_overflows{0};    // contact buffer full, total
   std::atomic<std::uint32_t> missing_compliance{0}; // rows on the fallback compliance, last tick
   std::atomic<std::uint64_t> lost_track_ticks{0};
   std::atomic<std::uint64_t> lost_track_episodes{0};
-  std::atomic<bool> free_centres{false};            // the newest state carried free-motion centres
   std::atomic<double> reaction_n{0.0};              // last tissue reaction, N
+  std::atomic<double> obstacle_reaction_n{0.0};     // last reaction of the rigid anatomy on the tool, N
   std::atomic<double> peak_force_n{0.0};            // largest |F_k| commanded, N
-  // Work time of the two parts of a tick, largest since the last report
-  // (the reporter resets them), us: a new FEM state (centres, refit,
-  // tissue-obstacle contacts) and the tool query plus the solve.
-  std::atomic<double> state_us_max{0.0};
-  std::atomic<double> solve_us_max{0.0};
-  // The same over the whole run (never reset), us.
-  std::atomic<double> state_us_peak{0.0};
-  std::atomic<double> solve_us_peak{0.0};
+  // Work time of a tick (query, solve, messages): largest since the last
+  // report (the reporter resets it) and over the whole run, us.
+  std::atomic<double> tick_us_max{0.0};
+  std::atomic<double> tick_us_peak{0.0};
 };
+
+// Rows the tool may have against rigid anatomy per tick: one per sample
+// leaf touching (~5 mm of blade each), the deepest kept.
+inline constexpr std::size_t kMaxAnatomyRows = 16;
 
 class HapticLoop {
  public:
   explicit HapticLoop(const HapticSetup& setup);
 
-  // A new DeformationState: centres and radii from its positions, tree
-  // refit, tissue-obstacle contacts, and the index of its compliance
-  // spheres. Returns false (state ignored) if it does not fit the mesh.
-  bool take_state(const msg::DeformationState& state);
-
-  // Answers `pose`. `state` is the newest DeformationState (the one last
-  // given to take_state), or null before the first.
-  void tick(const msg::DevicePose& pose, const msg::DeformationState* state, msg::ForceCommand& command,
+  // Answers `pose` on the tissue of `tissue` (the newest snapshot).
+  void tick(const msg::DevicePose& pose, const TissueSnapshot& tissue, msg::ForceCommand& command,
             msg::ContactSet& contacts);
 
   const contact::ContactResponse& response() const { return response_; }
@@ -73,40 +67,39 @@ class HapticLoop {
 
  private:
   contact::DeviceSample device_sample(const msg::DevicePose& pose);
-  void collect_rows(const msg::DeformationState* state);
-  void query_obstacles();
+  void collect_tissue_rows(const TissueSnapshot& tissue);
+  void collect_triangle_rows(const TissueSnapshot& tissue);
+  void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
+  const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device, const TissueSnapshot& tissue);
 
   const HapticSetup& setup_;
   double nominal_period_s_;
   contact::ContactResponse response_;
-  haptic::SphereState spheres_;
-  haptic::SphereTree tree_;
-  std::vector<double> positions_m_;  // float wire positions widened for SphereState
+  // The penalty baseline (setup.penalty) and its ContactSet entries.
+  contact::PenaltyResponse penalty_;
+  std::vector<fem::Contact> penalty_contacts_;
+  std::size_t penalty_count_ = 0;
 
-  // Tool.
+  // Tool against the tongue (AIST).
   haptic::RigidBody tool_body_;
   haptic::QuerySettings tool_query_;
   haptic::PrePenetrationMemory tool_memory_;
   haptic::ContactBuffer tool_contacts_;
   std::vector<std::uint32_t> order_;  // indices into tool_contacts_, deepest first when over capacity
+  // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
+  std::vector<haptic::TriangleContact> triangle_contacts_;
+  std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1
+  std::vector<std::uint32_t> sphere_contact_;  // per slot: the deepest triangle contact of a sphere
+  std::vector<std::uint32_t> slot_sphere_;     // per slot: the sphere (to clear row_of_sphere_)
+  // Tool against the rigid anatomy (surface samples).
+  std::vector<haptic::RigidBody> anatomy_bodies_;
+  std::vector<haptic::SurfaceContact> anatomy_contacts_;
+  std::vector<std::uint32_t> anatomy_order_;
+  std::size_t tissue_row_budget_ = 0;
   std::vector<contact::ContactRow> rows_;
   std::size_t row_count_ = 0;
 
-  // Obstacles (tissue side, always hard): queried once per FEM state.
-  std::vector<haptic::RigidBody> obstacle_bodies_;
-  std::vector<haptic::PrePenetrationMemory> obstacle_memory_;
-  haptic::QuerySettings obstacle_query_;
-  haptic::ContactBuffer obstacle_buffer_;
-  std::vector<fem::Contact> obstacle_contacts_;
-  std::vector<std::uint32_t> obstacle_body_ids_;
-  std::size_t obstacle_count_ = 0;
-
-  // Compliance sphere index per sphere id for the newest state (-1: none).
-  std::vector<std::int32_t> compliance_index_;
-  std::vector<std::uint32_t> indexed_ids_;  // ids set in compliance_index_, to clear them again
-  std::size_t indexed_count_ = 0;
-  bool have_free_centres_ = false;
-
+  std::uint64_t last_fem_step_ = 0;
   bool started_ = false;
   bool was_lost_ = false;
   std::uint64_t last_servo_tick_ = 0;

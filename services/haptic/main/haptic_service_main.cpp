@@ -2,20 +2,25 @@
 // (the gateway's servo loop is the clock): sphere centres from the newest
 // DeformationState, the blade's contacts through the AIST, the contact
 // response on the FEM's compliance with the force-aware decision, and a
-// ForceCommand and a ContactSet in answer. Real time only for now.
+// ForceCommand and a ContactSet in answer. Real time (a FEM state thread
+// digests DeformationStates beside the tick) or lockstep.
 //
 //   fahr_haptic_service --scene FILE [--dds V] [--domain N] [--dds-profile F]
-//                       [--duration-s S]
+//                       [--duration-s S] [--mode realtime|lockstep]
 #include <CLI/CLI.hpp>
 
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
+#include <optional>
 
+#include "fahr/common/lockstep.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/stop_signal.h"
+#include "fahr/metrics/duration_histogram.h"
 #include "fahr/common/subscriber.h"
 #include "fahr/runtime/scene_transport.h"
 #include "fahr/runtime/service_main.h"
@@ -23,6 +28,8 @@
 #include "haptic_loop.h"
 #include "haptic_setup.h"
 #include "scene_publication.h"
+#include "tissue_feed.h"
+#include "tissue_snapshot.h"
 
 namespace fahr::haptic_service {
 namespace {
@@ -30,16 +37,16 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-
-// The vendor and domain: flag, else environment, else the scene (as the FEM
-// service does, so both join the same domain from the same scene).
+// A period between ticks longer than this is a late answer (the gateway's
+// servo loop runs at 1 ms).
+constexpr std::int64_t kLongPeriodNs = 1'500'000;
 
 // Ticks until the duration has passed or a signal asks to stop. Blocks only
-// between ticks, waiting for the next DevicePose.
-void run_realtime(common::Participant& participant, HapticLoop& loop, common::TickRecorder& recorder,
+// between ticks, waiting for the next DevicePose; FEM states are digested
+// on the feed's thread.
+void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop& loop, common::TickRecorder& recorder,
                   double duration_s) {
   common::Subscriber<msg::DevicePose> poses(participant);
-  common::Subscriber<msg::DeformationState> states(participant);
   common::Publisher<msg::ForceCommand> commands(participant);
   common::Publisher<msg::ContactSet> contact_sets(participant);
   msg::ForceCommand command;
@@ -47,6 +54,12 @@ void run_realtime(common::Participant& participant, HapticLoop& loop, common::Ti
   contacts.contacts().reserve(msg::MAX_CONTACTS);
   const auto start = Clock::now();
   const auto duration = std::chrono::duration<double>(duration_s);
+  // Whole-run figures of the tick (the status windows hold 250 ms each): its
+  // thread-CPU time (the work, whatever the scheduler does) and the wall
+  // periods between ticks longer than 1.5 ms (late answers).
+  metrics::DurationHistogram tick_cpu(std::chrono::microseconds(2));
+  std::uint64_t long_periods = 0;
+  std::int64_t previous_start_ns = 0;
   std::uint64_t seen = 0;
   std::uint64_t tick = 0;
   while (!common::stop_requested()) {
@@ -56,68 +69,161 @@ void run_realtime(common::Participant& participant, HapticLoop& loop, common::Ti
     if (!poses.fetch_newest()) continue;
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
-    if (states.fetch_newest()) loop.take_state(states.newest());
-    loop.tick(poses.newest(), states.has_sample() ? &states.newest() : nullptr, command, contacts);
+    loop.tick(poses.newest(), feed.newest(), command, contacts);
     commands.write(command);
     contact_sets.write(contacts);
-    recorder.push({tick++, t0, common::monotonic_now_ns() - t0, common::thread_cpu_now_ns() - c0});
+    const std::int64_t cpu_ns = common::thread_cpu_now_ns() - c0;
+    recorder.push({tick++, t0, common::monotonic_now_ns() - t0, cpu_ns});
+    tick_cpu.record(std::chrono::nanoseconds(cpu_ns));
+    if (previous_start_ns != 0 && t0 - previous_start_ns > kLongPeriodNs) ++long_periods;
+    previous_start_ns = t0;
   }
+  const auto& m = feed.metrics();
+  std::printf("fahr_haptic_service: %llu FEM states digested (%llu refused), worst digest %.0f us\n",
+              static_cast<unsigned long long>(m.fem_states.load()), static_cast<unsigned long long>(m.bad_states.load()),
+              m.digest_us_peak.load());
+  const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
+  std::printf("fahr_haptic_service: tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f over %llu ticks; "
+              "periods > 1.5 ms: %llu\n",
+              us(tick_cpu.percentile(0.5)), us(tick_cpu.percentile(0.99)), us(tick_cpu.percentile(0.999)),
+              us(tick_cpu.max()), static_cast<unsigned long long>(tick_cpu.count()),
+              static_cast<unsigned long long>(long_periods));
+}
+
+// One tick per granted base step (the haptic rate is the base rate). At
+// step k the pose is the gateway's of step k-1 and the tissue the FEM's
+// newest step before k (common/lockstep.h); step 0 has no pose yet and
+// answers with no force, so the gateway's step 1 has a command to read.
+int run_lockstep(common::Participant& participant, const HapticSetup& setup, HapticLoop& loop,
+                 common::TickRecorder& recorder) {
+  const scene::Scene& scene = *setup.scene;
+  const auto base = scene.run.base_period;
+  const auto haptic_steps = static_cast<std::uint64_t>(scene.rates.haptic_period() / base);
+  const auto fem_steps = static_cast<std::uint64_t>(scene.rates.fem_period() / base);
+  if (haptic_steps != 1) {
+    std::fprintf(stderr, "fahr_haptic_service: lockstep needs the haptic rate to be the base rate (%.0f Hz)\n",
+                 1e9 / static_cast<double>(base.count()));
+    return 2;
+  }
+  common::StepInput<msg::DevicePose> poses(participant);
+  common::StepInput<msg::DeformationState> states(participant);
+  common::Publisher<msg::ForceCommand> commands(participant, common::lockstep_output_qos<msg::ForceCommand>());
+  common::Publisher<msg::ContactSet> contact_sets(participant, common::lockstep_output_qos<msg::ContactSet>());
+  common::LockstepClient client(participant, "haptic");
+  client.join();
+  TissueDigest digest(setup);
+  TissueSnapshot tissue = digest.make_snapshot();
+  msg::ForceCommand command;
+  msg::ContactSet contacts;
+  contacts.contacts().reserve(msg::MAX_CONTACTS);
+  contacts.body_id(setup.deformable->id);
+  common::OutputHash hash;
+  std::optional<std::uint64_t> digested_fem_step;
+  for (std::uint64_t k = 0; !common::stop_requested() && client.wait_for_grant(k, 60s); ++k) {
+    const std::int64_t t0 = common::monotonic_now_ns();
+    const std::int64_t c0 = common::thread_cpu_now_ns();
+    if (const auto f = common::producer_step_for(k, fem_steps); f && f != digested_fem_step) {
+      const msg::DeformationState* state = states.wait(*f, 60s);
+      if (state == nullptr) {
+        std::fprintf(stderr, "fahr_haptic_service: DeformationState of FEM step %llu never came\n",
+                     static_cast<unsigned long long>(*f));
+        return 1;
+      }
+      if (!digest.digest(*state, tissue)) {
+        std::fprintf(stderr, "fahr_haptic_service: DeformationState of FEM step %llu does not fit the mesh\n",
+                     static_cast<unsigned long long>(*f));
+        return 1;
+      }
+      digested_fem_step = f;
+    }
+    if (const auto p = common::producer_step_for(k, 1)) {
+      const msg::DevicePose* pose = poses.wait(*p, 60s);
+      if (pose == nullptr) {
+        std::fprintf(stderr, "fahr_haptic_service: DevicePose of step %llu never came\n",
+                     static_cast<unsigned long long>(*p));
+        return 1;
+      }
+      loop.tick(*pose, tissue, command, contacts);
+    }
+    command.header().sim_step(k);
+    command.header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+    contacts.header().sim_step(k);
+    contacts.header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+    commands.write(command);
+    contact_sets.write(contacts);
+    hash.add(command);
+    hash.add(contacts);
+    recorder.push({k, t0, common::monotonic_now_ns() - t0, common::thread_cpu_now_ns() - c0});
+    client.complete_through(k, hash.value());
+  }
+  std::printf("fahr_haptic_service: lockstep output hash %016llx\n", static_cast<unsigned long long>(hash.value()));
+  return 0;
 }
 
 int run(int argc, char** argv) {
   CLI::App app{"fahr haptic/contact service"};
-  std::string scene_path, dds, domain, profile;
+  std::string scene_path, dds, domain, profile, mode;
   double duration_s = -1;
   app.add_option("--scene", scene_path, "scene file")->required();
   app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds, inprocess");
   app.add_option("--domain", domain, "DDS domain id 0-230");
   app.add_option("--dds-profile", profile, "vendor XML configuration");
   app.add_option("--duration-s", duration_s, "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");
+  app.add_option("--mode", mode, "realtime or lockstep (default: the scene's run.mode)")
+      ->check(CLI::IsMember({"realtime", "lockstep"}));
+  std::string collision = "aist";
+  app.add_option("--collision", collision,
+                 "tool-tissue collision: aist (the paper's spheres) or triangle (the baseline it is measured against)")
+      ->check(CLI::IsMember({"aist", "triangle"}));
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // log lines reach a launcher's log file as they happen
 
   const auto scene = scene::load_scene(scene_path);
-  if (scene->run.mode == scene::RunMode::kLockstep) {
-    std::fprintf(stderr, "fahr_haptic_service: scene '%s' asks for lockstep; this service runs real time only so far\n",
-                 scene->name.c_str());
-    return 2;
-  }
+  const bool lockstep = mode.empty() ? scene->run.mode == scene::RunMode::kLockstep : mode == "lockstep";
   if (duration_s < 0) duration_s = std::chrono::duration<double>(scene->run.duration).count();
   common::install_stop_handlers();
 
   const auto setup_start = Clock::now();
-  const HapticSetup setup = set_up(*scene);
+  const HapticSetup setup =
+      set_up(*scene, collision == "triangle" ? CollisionMethod::kTriangle : CollisionMethod::kAist);
   HapticLoop loop(setup);
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
 
   common::Participant participant(runtime::transport_for(*scene, dds, domain, profile, "haptic"));
   common::TickRecorder recorder;
+  // Real time: FEM states are digested on the feed's own thread.
+  std::unique_ptr<TissueFeed> feed;
+  if (!lockstep) feed = std::make_unique<TissueFeed>(participant, setup);
   const auto status_period = std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period());
   common::ServiceReporter reporter(participant,
                                    {"haptic", scene->rates.haptic_hz, status_period > 0ms ? status_period : 250ms},
-                                   recorder, [&](auto& metrics) { loop.append_metrics(metrics); });
+                                   recorder, [&](auto& metrics) {
+                                     loop.append_metrics(metrics);
+                                     if (feed) feed->append_metrics(metrics);
+                                   });
   // Transient local: the writer must live as long as the run for late
   // joiners to get the samples.
   common::Publisher<msg::SceneDescription> scene_out(participant);
   auto descriptions = describe_scene(setup);
   for (auto& d : descriptions) scene_out.write(d);
 
-  std::printf("fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres), tool '%s', %zu obstacles, "
-              "%.0f Hz, set-up %.2f s\n",
+  std::printf("fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres), tool '%s' (%zu surface samples), "
+              "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s\n",
               std::string(common::vendor_name(participant.vendor())).c_str(), setup.deformable->name.c_str(),
-              setup.mesh.node_count(), setup.layout.size(), setup.tool->scene_body->name.c_str(), setup.obstacles.size(),
-              scene->rates.haptic_hz, setup_s);
+              setup.mesh.node_count(), setup.layout.size(), setup.tool->scene_body->name.c_str(),
+              setup.tool_samples.points_m().size(), setup.tissue_obstacles.size(), setup.tool_obstacles.size(),
+              collision.c_str(), scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s);
   reporter.set_state(msg::SERVICE_RUNNING);
-  run_realtime(participant, loop, recorder, duration_s);
+  const int status = lockstep ? run_lockstep(participant, setup, loop, recorder)
+                              : (run_realtime(participant, *feed, loop, recorder, duration_s), 0);
   reporter.set_state(msg::SERVICE_STOPPING);
   reporter.report();
   const auto& m = loop.metrics();
-  std::printf("fahr_haptic_service: %llu ticks, %llu FEM states, lost-track episodes %llu, peak |F| %.3f N, "
-              "free centres %s, worst state update %.0f us, worst query+solve %.0f us\n",
-              static_cast<unsigned long long>(m.ticks.load()), static_cast<unsigned long long>(m.fem_states.load()),
-              static_cast<unsigned long long>(m.lost_track_episodes.load()), m.peak_force_n.load(),
-              m.free_centres.load() ? "yes" : "no", m.state_us_peak.load(), m.solve_us_peak.load());
-  return 0;
+  std::printf("fahr_haptic_service: %llu ticks on %llu FEM states, lost-track episodes %llu, peak |F| %.3f N, "
+              "worst tick %.0f us\n",
+              static_cast<unsigned long long>(m.ticks.load()), static_cast<unsigned long long>(m.snapshots.load()),
+              static_cast<unsigned long long>(m.lost_track_episodes.load()), m.peak_force_n.load(), m.tick_us_peak.load());
+  return status;
 }
 
 }  // namespace

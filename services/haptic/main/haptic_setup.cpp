@@ -1,6 +1,8 @@
 // Scene -> AIST, rigid fields and response settings of the haptic service.
 #include "haptic_setup.h"
 
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -28,11 +30,6 @@ std::unique_ptr<RigidField> rigid_field(const scene::Body& body) {
 }
 
 contact::ResponseSettings response_settings(const scene::Scene& scene) {
-  if (scene.contact.response != scene::ContactResponse::kForceAware) {
-    throw std::runtime_error("contact.response '" + std::string(scene::to_string(scene.contact.response)) +
-                             "': fahr_haptic_service runs force_aware only (the penalty baseline is in "
-                             "tools/contact_bench)");
-  }
   contact::ResponseSettings s;
   s.mode = contact::ResponseMode::kCompliance;
   s.coupling.stiffness_npm = scene.contact.coupling_stiffness_npm;
@@ -40,7 +37,8 @@ contact::ResponseSettings response_settings(const scene::Scene& scene) {
   s.force_aware.hysteresis = scene.contact.force_aware_hysteresis;
   // The DeformationState carries W for at most 64 spheres: more rows would
   // all run on the fallback compliance.
-  s.max_rows = 64;
+  // Tissue rows are bounded by W (64 spheres); the anatomy adds its own.
+  s.max_rows = 64 + 16;
   s.max_contacts = 512;  // msg::MAX_CONTACTS
   s.max_holds = 64;
   return s;
@@ -48,7 +46,28 @@ contact::ResponseSettings response_settings(const scene::Scene& scene) {
 
 }  // namespace
 
-HapticSetup set_up(const scene::Scene& scene) {
+std::unique_ptr<TriangleCollisionSetup> triangle_setup(const HapticSetup& setup) {
+  auto t = std::make_unique<TriangleCollisionSetup>();
+  t->boundary = setup.mesh.boundary_surface(&t->surface_to_node);
+  // Nearest rest sphere per boundary vertex: a one-off O(vertices x
+  // spheres) scan (~10 M distances on the neonatal tongue, tens of ms).
+  const auto& spheres = setup.layout.spheres();
+  t->vertex_sphere.resize(t->boundary.vertex_count());
+  for (std::size_t v = 0; v < t->boundary.vertex_count(); ++v) {
+    const Eigen::Vector3d& x = t->boundary.vertices()[v];
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t s = 0; s < spheres.size(); ++s) {
+      const double d = (spheres[s].rest_centre_m - x).squaredNorm();
+      if (d < best) {
+        best = d;
+        t->vertex_sphere[v] = static_cast<std::uint32_t>(s);
+      }
+    }
+  }
+  return t;
+}
+
+HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision) {
   const scene::ServicePlan plan = scene::derive_plan(scene);
   if (!plan.tool_body) throw std::runtime_error("scene '" + scene.name + "' has no tool: nothing for the haptic service");
   if (plan.fem_bodies.size() != 1) {
@@ -65,11 +84,33 @@ HapticSetup set_up(const scene::Scene& scene) {
     throw std::runtime_error("body '" + setup.deformable->name + "': AIST: " + e.what());
   }
   setup.tool = rigid_field(scene.bodies[*plan.tool_body]);
+  try {
+    setup.tool_samples = haptic::SurfaceSamples(setup.tool->surface, haptic::SurfaceSampleSettings{});
+  } catch (const std::exception& e) {
+    throw std::runtime_error("body '" + setup.tool->scene_body->name + "': surface samples: " + e.what());
+  }
+  // Each anatomy body is loaded once, whichever pairs name it.
+  std::vector<std::size_t> anatomy_of_body(scene.bodies.size(), SIZE_MAX);
+  const auto anatomy_index = [&](std::size_t body) {
+    if (anatomy_of_body[body] == SIZE_MAX) {
+      anatomy_of_body[body] = setup.anatomy.size();
+      setup.anatomy.push_back(rigid_field(scene.bodies[body]));
+    }
+    return anatomy_of_body[body];
+  };
   for (const auto& pair : plan.pairs) {
-    if (pair.kind != scene::PairKind::kHard || pair.first != plan.fem_bodies.front()) continue;
-    setup.obstacles.push_back(rigid_field(scene.bodies[pair.second]));
+    if (pair.kind == scene::PairKind::kHard && pair.first == plan.fem_bodies.front()) {
+      setup.tissue_obstacles.push_back(anatomy_index(pair.second));
+    } else if (pair.kind == scene::PairKind::kTool && pair.reason == scene::PairReason::kToolObstacle) {
+      setup.tool_obstacles.push_back(anatomy_index(pair.second));
+    }
   }
   setup.response = response_settings(scene);
+  setup.penalty = scene.contact.response == scene::ContactResponse::kPenalty;
+  setup.penalty_settings.stiffness_npm = scene.contact.penalty_stiffness_npm;
+  setup.penalty_settings.max_rows = setup.response.max_rows;
+  setup.collision = collision;
+  if (collision == CollisionMethod::kTriangle) setup.triangles = triangle_setup(setup);
   return setup;
 }
 

@@ -10,11 +10,13 @@
 #include <vector>
 
 #include "fahr/contact/contact_response.h"
+#include "fahr/contact/penalty_response.h"
 #include "fahr/geometry/signed_distance_field.h"
 #include "fahr/geometry/surface_mesh.h"
 #include "fahr/geometry/tet_mesh.h"
 #include "fahr/haptic/fill_settings.h"
 #include "fahr/haptic/sphere_layout.h"
+#include "fahr/haptic/surface_samples.h"
 #include "fahr/scene/scene.h"
 
 namespace fahr::haptic_service {
@@ -27,21 +29,46 @@ struct RigidField {
   std::unique_ptr<geometry::SignedDistanceField> sdf;
 };
 
+// How the tool's contacts with the deformable body are found.
+enum class CollisionMethod {
+  kAist,      // the adaptive inner sphere tree (the paper's method)
+  kTriangle,  // the triangle-level baseline (Bullet box trees, vertex-face)
+};
+
+// What the triangle baseline needs beyond the AIST: the body's boundary and,
+// per boundary vertex, the sphere whose compliance and ContactSet entry its
+// contacts use (the nearest sphere at rest), so both methods feed the same
+// response and the same FEM.
+struct TriangleCollisionSetup {
+  geometry::SurfaceMesh boundary;                // world frame, rest, m
+  std::vector<geometry::Index> surface_to_node;  // FEM node of each boundary vertex
+  std::vector<std::uint32_t> vertex_sphere;      // sphere id of each boundary vertex
+};
+
 struct HapticSetup {
   const scene::Scene* scene = nullptr;
   const scene::Body* deformable = nullptr;
   geometry::TetMesh mesh;  // world frame, m (the FEM service's frame too)
   haptic::SphereLayout layout;
   std::unique_ptr<RigidField> tool;
-  // Obstacles the deformable body is tested against (the plan's hard pairs).
-  std::vector<std::unique_ptr<RigidField>> obstacles;
+  // Points on the tool's surface (tool frame) tested against the anatomy.
+  haptic::SurfaceSamples tool_samples;
+  // Every rigid body either side touches, loaded once.
+  std::vector<std::unique_ptr<RigidField>> anatomy;
+  // Indices into anatomy: what the deformable body is tested against (the
+  // plan's hard pairs), and what the tool is (its tool-obstacle pairs).
+  std::vector<std::size_t> tissue_obstacles;
+  std::vector<std::size_t> tool_obstacles;
   contact::ResponseSettings response;
+  // contact.response: penalty: the baseline of the paper's Figure 7a (the
+  // tool follows the device rigidly; forces k_p d on the FEM, no projection).
+  bool penalty = false;
+  contact::PenaltySettings penalty_settings;
+  CollisionMethod collision = CollisionMethod::kAist;
+  std::unique_ptr<TriangleCollisionSetup> triangles;  // set for kTriangle only
 };
 
-// The FEM service's mapping of the scene's aist block (kept identical: a
-// different mapping would give different sphere ids on the two sides).
-
 // Throws std::runtime_error naming the body and what is wrong.
-HapticSetup set_up(const scene::Scene& scene);
+HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision = CollisionMethod::kAist);
 
 }  // namespace fahr::haptic_service

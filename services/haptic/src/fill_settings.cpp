@@ -31,6 +31,9 @@ void validate_fill_settings(const FillSettings& s) {
           "weight_spread", s.weight_spread, "[0, 1)");
   require(std::isfinite(s.hugging_weight_spread) && s.hugging_weight_spread >= 0.0 && s.hugging_weight_spread < 1.0,
           "hugging_weight_spread", s.hugging_weight_spread, "[0, 1)");
+  require(std::isfinite(s.hugging_anchor_depth_factor) && s.hugging_anchor_depth_factor >= 1.0 &&
+              s.hugging_anchor_depth_factor <= 8.0,
+          "hugging_anchor_depth_factor", s.hugging_anchor_depth_factor, "[1, 8]");
   require(std::isfinite(s.min_radius_fraction) && s.min_radius_fraction >= 0.0 &&
               s.min_radius_fraction <= 1.0,
           "min_radius_fraction", s.min_radius_fraction, "[0, 1]");

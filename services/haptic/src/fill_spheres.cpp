@@ -1,7 +1,10 @@
 // fill_spheres: grid, octree, hugging closure, then links (see fill_spheres.h).
 #include "fahr/haptic/fill_spheres.h"
 
+#include <Eigen/Geometry>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -18,11 +21,11 @@ namespace {
 // speeds up the far field, so a coarse one (half a coarse radius) is enough.
 constexpr double kSdfCellPerCoarseRadius = 0.5;
 
-geometry::SurfaceMesh checked_boundary(const geometry::TetMesh& mesh) {
+geometry::SurfaceMesh checked_boundary(const geometry::TetMesh& mesh, std::vector<geometry::Index>& surface_to_node) {
   if (mesh.tet_count() == 0 || mesh.node_count() == 0) {
     throw std::invalid_argument("sphere filling: the tet mesh is empty (0 tets); nothing to fill");
   }
-  geometry::SurfaceMesh surface = mesh.boundary_surface();
+  geometry::SurfaceMesh surface = mesh.boundary_surface(&surface_to_node);
   const auto& topo = surface.topology();
   if (!surface.is_closed() || !surface.is_manifold()) {
     std::ostringstream message;
@@ -35,11 +38,39 @@ geometry::SurfaceMesh checked_boundary(const geometry::TetMesh& mesh) {
   return surface;
 }
 
+// The hugging sphere's tangent point (its nearest boundary point) and the
+// face it lies on, for TetLinker::link_anchored.
+detail::SphereLink anchored_link(detail::TetLinker& linker, const detail::CandidateSphere& c,
+                                 const geometry::SurfaceMesh& boundary,
+                                 const std::vector<geometry::Index>& surface_to_node,
+                                 const geometry::SignedDistanceField& sdf, double depth_factor) {
+  const geometry::BvhClosestPoint hit =
+      sdf.bvh().closest_point(c.centre_m, std::numeric_limits<double>::infinity());
+  if (hit.triangle < 0) return linker.link(c.centre_m, c.radius_m, 0.0);
+  const geometry::Triangle& t = boundary.triangles()[static_cast<std::size_t>(hit.triangle)];
+  const auto& v = boundary.vertices();
+  // Barycentric coordinates of the hit in its triangle (areas of the sub-triangles).
+  const Eigen::Vector3d n = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]);
+  const double area2 = n.squaredNorm();
+  if (!(area2 > 0.0)) return linker.link(c.centre_m, c.radius_m, 0.0);
+  Eigen::Vector3d bary;
+  for (int k = 0; k < 3; ++k) {
+    bary[k] = n.dot((v[t[(k + 1) % 3]] - hit.point).cross(v[t[(k + 2) % 3]] - hit.point)) / area2;
+  }
+  bary = bary.cwiseMax(0.0);
+  bary /= bary.sum();
+  const Eigen::Vector3d anchor = bary[0] * v[t[0]] + bary[1] * v[t[1]] + bary[2] * v[t[2]];
+  std::array<std::uint32_t, 3> nodes{};
+  for (int k = 0; k < 3; ++k) nodes[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(surface_to_node[t[k]]);
+  return linker.link_anchored(c.centre_m, c.radius_m, anchor, nodes, bary, depth_factor);
+}
+
 }  // namespace
 
 SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& settings) {
   validate_fill_settings(settings);
-  const geometry::SurfaceMesh boundary = checked_boundary(mesh);
+  std::vector<geometry::Index> surface_to_node;
+  const geometry::SurfaceMesh boundary = checked_boundary(mesh, surface_to_node);
 
   double mean_volume = 0.0;
   for (const auto& r : mesh.rest_data()) mean_volume += r.volume_m3;
@@ -71,7 +102,10 @@ SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& set
   for (const auto& c : candidates) {
     const double spread =
         c.origin == SphereOrigin::kHugging ? settings.hugging_weight_spread : settings.weight_spread;
-    const detail::SphereLink link = linker.link(c.centre_m, c.radius_m, spread);
+    const bool anchored = c.origin == SphereOrigin::kHugging && settings.hugging_anchor_depth_factor > 1.0;
+    const detail::SphereLink link = anchored ? anchored_link(linker, c, boundary, surface_to_node, sdf,
+                                                             settings.hugging_anchor_depth_factor)
+                                             : linker.link(c.centre_m, c.radius_m, spread);
     SphereRecord r;
     r.rest_centre_m = link.centre_m;
     r.rest_radius_m = c.radius_m;

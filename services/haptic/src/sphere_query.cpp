@@ -16,6 +16,11 @@ constexpr double kGridErrorCells = 0.8660254037844386;
 // Below this |c - q| (m) the direction is numerically meaningless: the
 // field's own normal is used instead.
 constexpr double kMinNormalLength = 1e-9;
+// Relative slack on a search bound, so rounding never drops the true nearest triangle.
+constexpr double kBoundSlack = 1e-9;
+// Absolute slack of a search bound, m: a hint exactly on the surface gives a
+// bound of 0 for a point on it.
+constexpr double kBoundFloorM = 1e-12;
 
 struct Frame {
   Eigen::Matrix3d body_from_world_rotation;
@@ -27,8 +32,10 @@ struct Frame {
 
 // The field's grid alone: trilinear distance, gradient by central
 // differences over half a cell, nearest point along it.
+// gradient_length: the length of the finite-difference gradient (1 where the
+// field is one plane's distance over the cells read).
 geometry::SdfSample grid_sample(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& p,
-                                double distance) noexcept {
+                                double distance, double& gradient_length) noexcept {
   geometry::SdfSample s;
   s.distance_m = distance;
   const double h = 0.5 * sdf.cell_size_m();
@@ -38,19 +45,55 @@ geometry::SdfSample grid_sample(const geometry::SignedDistanceField& sdf, const 
     gradient[axis] = sdf.grid_distance(p + step) - sdf.grid_distance(p - step);
   }
   const double norm = gradient.norm();
+  gradient_length = norm / (2.0 * h);
   s.normal = norm > 0.0 ? Eigen::Vector3d(gradient / norm) : Eigen::Vector3d::UnitZ();
   s.closest_point_m = p - distance * s.normal;
   return s;
 }
 
+// The exact nearest point, searched only within `bound` (m, >= the true
+// distance), the sign from the grid (certain: the caller passes only points
+// where |grid| exceeds the grid's error). Cheaper than the field's own
+// queries: the field bounds its search by |grid| + sqrt(3) cells, or not at
+// all beyond its band, and a search ball of 1-2 mm on the finely tessellated
+// blade tests hundreds of triangles.
+geometry::SdfSample bounded_exact(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& p, double grid,
+                                  double bound) noexcept {
+  const double reach = bound * (1.0 + kBoundSlack) + kBoundFloorM;
+  const geometry::BvhClosestPoint hit = sdf.bvh().closest_point(p, reach * reach);
+  if (hit.triangle < 0) return sdf.query_exact(p);  // rounding at the bound: search everything
+  geometry::SdfSample s;
+  const double distance = std::sqrt(hit.distance_squared);
+  const double sign = grid < 0.0 ? -1.0 : 1.0;
+  s.distance_m = sign * distance;
+  s.closest_point_m = hit.point;
+  s.normal = distance > kMinNormalLength ? Eigen::Vector3d(sign * (p - hit.point) / distance) : Eigen::Vector3d::UnitZ();
+  s.exact = true;
+  return s;
+}
+
+// hint: a point of the body's surface (body frame) or null; |p - hint| bounds
+// the distance from above.
 geometry::SdfSample sample(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& p, double grid,
-                           double exact_reach, bool exact) noexcept {
-  if (!exact) return grid_sample(sdf, p, grid);
-  return std::abs(grid) <= exact_reach ? sdf.query(p) : sdf.query_exact(p);
+                           double grid_error, const QuerySettings& settings, const Eigen::Vector3d* hint) noexcept {
+  double gradient_length = 0.0;
+  if (!settings.exact_narrow_phase) return grid_sample(sdf, p, grid, gradient_length);
+  // Too near the surface for the grid's sign: the field's pseudo-normal test.
+  if (!(std::abs(grid) > grid_error)) return sdf.query(p);
+  if (settings.flat_gradient_tolerance > 0.0) {
+    geometry::SdfSample s = grid_sample(sdf, p, grid, gradient_length);
+    if (std::abs(gradient_length - 1.0) <= settings.flat_gradient_tolerance) {
+      return s;  // one plane's distance: trilinear interpolation reproduces it
+    }
+  }
+  double bound = std::abs(grid) + grid_error;
+  if (hint != nullptr) bound = std::min(bound, (p - *hint).norm());
+  return bounded_exact(sdf, p, grid, bound);
 }
 
 // The contact of one sphere whose exact sample at its centre is `s`.
-bool narrow_phase(const geometry::SignedDistanceField& sdf, double exact_reach, bool exact, double margin,
+bool narrow_phase(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d* hint, double grid_error,
+                  double margin,
                   const Eigen::Vector3d& centre_body,
                   double radius, const geometry::SdfSample& s, const QuerySettings& settings,
                   const PrePenetrationMemory& memory, std::uint32_t sphere, std::uint64_t query,
@@ -67,7 +110,7 @@ bool narrow_phase(const geometry::SignedDistanceField& sdf, double exact_reach, 
   }
   Eigen::Vector3d before;
   if (memory.recall(sphere, query, settings.max_memory_age, before)) {
-    const geometry::SdfSample b = sample(sdf, before, sdf.grid_distance(before), exact_reach, exact);
+    const geometry::SdfSample b = sample(sdf, before, sdf.grid_distance(before), grid_error, settings, hint);
     q = b.closest_point_m;
     const Eigen::Vector3d d = before - q;
     const double len = d.norm();
@@ -92,7 +135,6 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   if (nodes.empty() || tree.order().empty() || body.sdf == nullptr) return stats;
   const geometry::SignedDistanceField& sdf = *body.sdf;
   const double grid_error = kGridErrorCells * sdf.cell_size_m();
-  const double exact_reach = sdf.band_m() + grid_error;
   const Eigen::Isometry3d body_from_world = body.world_from_body.inverse();
   const Frame frame{body_from_world.linear(), body_from_world.translation()};
   const Eigen::Matrix3d world_rotation = body.world_from_body.linear();
@@ -132,12 +174,15 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
         continue;
       }
       ++stats.exact_queries;
-      const geometry::SdfSample s = sample(sdf, p, grid, exact_reach, settings.exact_narrow_phase);
+      Eigen::Vector3d last_nearest;
+      const Eigen::Vector3d* hint = memory.recall_nearest(sphere, last_nearest) ? &last_nearest : nullptr;
+      const geometry::SdfSample s = sample(sdf, p, grid, grid_error, settings, hint);
       if (s.distance_m > 0.0) memory.remember(sphere, p, query);
+      if (s.exact) memory.remember_nearest(sphere, s.closest_point_m);
       Eigen::Vector3d q, n;
       double depth = 0.0;
       bool no_history = false;
-      if (!narrow_phase(sdf, exact_reach, settings.exact_narrow_phase, settings.candidate_margin_m, p, r, s,
+      if (!narrow_phase(sdf, hint, grid_error, settings.candidate_margin_m, p, r, s,
                         settings, memory, sphere, query, q, n, depth, no_history)) {
         continue;
       }

@@ -14,6 +14,10 @@ namespace {
 // A point whose smallest barycentric coordinate is above -this is inside the
 // tet: rounding in Dm^-1 (p - x0) on millimetre tets is ~1e-15.
 constexpr double kInsideTolerance = 1e-12;
+// link_anchored: halvings of (depth_factor - 1) tried before giving up, and
+// the smallest surface share worth anchoring for.
+constexpr int kAnchorAttempts = 4;
+constexpr double kMinAnchorShare = 0.05;
 
 Eigen::Vector3i cell_of(const Eigen::Vector3d& p, const Eigen::Vector3d& origin, double cell,
                         const Eigen::Vector3i& dims) {
@@ -180,6 +184,11 @@ SphereLink TetLinker::link(const Eigen::Vector3d& centre_m, double radius_m, dou
 
   SphereLink link;
   for (const auto& [d, t] : near) link.tets.push_back(t);
+  set_weights(weights, link);
+  return link;
+}
+
+void TetLinker::set_weights(const std::map<std::uint32_t, double>& weights, SphereLink& link) const {
   double sum = 0.0;
   for (const auto& [node, w] : weights) {
     if (w <= 0.0) continue;
@@ -187,9 +196,48 @@ SphereLink TetLinker::link(const Eigen::Vector3d& centre_m, double radius_m, dou
     link.weights.push_back(w);
     sum += w;
   }
+  const auto& x = mesh_.rest_positions();
   for (double& w : link.weights) w /= sum;
+  link.centre_m = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < link.nodes.size(); ++k) link.centre_m += link.weights[k] * x[link.nodes[k]];
-  return link;
+}
+
+std::int64_t TetLinker::holding_tet(const Eigen::Vector3d& p) {
+  candidates(p, p);
+  std::int64_t best = -1;
+  double best_min = -kInsideTolerance;
+  for (const std::uint32_t t : found_) {
+    const double m = barycentric(t, p).minCoeff();
+    if (m >= best_min) {
+      best_min = m;
+      best = t;
+    }
+  }
+  return best;
+}
+
+SphereLink TetLinker::link_anchored(const Eigen::Vector3d& centre_m, double radius_m, const Eigen::Vector3d& anchor_m,
+                                    const std::array<std::uint32_t, 3>& face_nodes,
+                                    const Eigen::Vector3d& face_weights, double depth_factor) {
+  SphereLink plain = link(centre_m, radius_m, 0.0);
+  const Eigen::Vector3d down = centre_m - anchor_m;
+  double k = depth_factor;
+  std::int64_t tet = -1;
+  for (int attempt = 0; attempt < kAnchorAttempts && k > 1.0 + kMinAnchorShare; ++attempt, k = 1.0 + 0.5 * (k - 1.0)) {
+    tet = holding_tet(anchor_m + k * down);
+    if (tet >= 0) break;
+  }
+  if (tet < 0) return plain;
+  const Eigen::Vector4d inner = barycentric(static_cast<std::uint32_t>(tet), anchor_m + k * down).cwiseMax(0.0);
+  const double inner_share = 1.0 / k;
+  std::map<std::uint32_t, double> weights;
+  for (int j = 0; j < 3; ++j) weights[face_nodes[static_cast<std::size_t>(j)]] += (1.0 - inner_share) * std::max(0.0, face_weights[j]);
+  const auto& ht = mesh_.tets()[static_cast<std::size_t>(tet)];
+  for (int j = 0; j < 4; ++j) weights[static_cast<std::uint32_t>(ht[j])] += inner_share * inner[j] / inner.sum();
+  SphereLink out;
+  out.tets = std::move(plain.tets);
+  set_weights(weights, out);
+  return out;
 }
 
 }  // namespace fahr::haptic::detail

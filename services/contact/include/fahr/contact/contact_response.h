@@ -77,6 +77,9 @@ struct TickReport {
   bool holds_overflow = false;     // spheres not held while frozen
   bool catch_up_limited = false;   // the proxy moved at the catch-up speed bound
   bool yielded = false;            // a held proxy backed off to keep the reaction at the limit
+  bool implausible_step = false;   // the coupled solve's step was refused; the proxy held
+  bool tissue_force_clamped = false;  // the tissue forces were scaled down to the limit
+  bool force_limited = false;      // the commanded force was scaled to the renderable force
   double obstacle_reaction_n = 0.0;  // |force of rigid obstacles on the tool|, N
 };
 
@@ -108,7 +111,8 @@ class ContactResponse {
   };
 
   Eigen::Vector3d move_proxy(const TickInput& input, const EffectiveCoupling& coupling);
-  Eigen::Vector3d yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n, double guess_stiffness_npm);
+  Eigen::Vector3d yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n);
+  bool plausible_step(const Eigen::Vector3d& step_m, const Eigen::Vector3d& target_offset_m) const;
   void capture_holds(const TissueCompliance& compliance);
   const Hold* find_hold(std::uint32_t sphere_id) const;
   void write_contacts(const TickInput& input, const Eigen::Vector3d& plane_shift_m);
@@ -119,6 +123,7 @@ class ContactResponse {
   ToolProxy proxy_;
   TrackingState state_ = TrackingState::kTracking;
   double previous_reaction_n_ = 0.0;
+  double tissue_force_scale_ = 1.0;  // applied to the ContactSet's tissue forces this tick
   std::vector<Hold> holds_;
   std::size_t hold_count_ = 0;
   std::vector<fem::Contact> contacts_;

@@ -49,6 +49,14 @@ class ContactSolver {
   // force here, since a held proxy needs none from them.
   void solve_pinned(const Eigen::Vector3d& proxy_offset_m, const PgsSettings& settings);
 
+  // The proxy step nearest `step_m` that leaves no obstacle row penetrating
+  // (n_i . step <= -d_i for every obstacle row): what a held or catching-up
+  // proxy may do, since the pinned solve gives obstacles no force. A
+  // projection onto a polyhedron, solved as the LCP (N_o^T N_o) mu >=
+  // d_o + N_o^T step by PGS; returns step - N_o mu. Leaves lambda alone.
+  Eigen::Vector3d project_on_obstacles(const Eigen::Vector3d& step_m, const PgsSettings& settings);
+  bool has_obstacle_rows() const;
+
   // K = N_S (A_S + N_S^T N_S / k_c)^-1 N_S^T over rows with lambda > 0, N/m:
   // d(force on the stylus)/d(device position) = -K. Symmetric PSD, <= k_c.
   Eigen::Matrix3d local_stiffness(double k_c_npm);
@@ -86,6 +94,10 @@ class ContactSolver {
   std::vector<std::uint32_t> active_;  // rows of the active set (local stiffness)
   std::vector<double> factor_;         // capacity^2
   std::vector<double> columns_;        // 3 x capacity right-hand sides
+  std::vector<std::uint32_t> obstacle_rows_;  // project_on_obstacles: its rows, matrix, rhs, mu
+  std::vector<double> projection_s_;
+  std::vector<double> projection_b_;
+  std::vector<double> projection_mu_;
   PgsReport report_;
 };
 

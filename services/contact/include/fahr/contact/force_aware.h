@@ -33,7 +33,8 @@ inline bool should_freeze(const ForceAwareSettings& s, double tissue_reaction_n,
   return s.enabled && tissue_reaction_n > limit_n;
 }
 
-// Coupling force back below the hysteresis band: reactivate.
+// Coupling force (or the tissue reaction tracking again would give) back
+// below the hysteresis band: reactivate.
 inline bool should_release(const ForceAwareSettings& s, double coupling_force_n, double limit_n) {
   return coupling_force_n < (1.0 - s.hysteresis) * limit_n;
 }

@@ -10,8 +10,9 @@ namespace fahr::contact {
 struct ForceOutput {
   std::uint64_t answered_pose_seq = 0;                           // DevicePose seq answered
   Eigen::Vector3d answered_position_m = Eigen::Vector3d::Zero(); // x_k, m
-  // F_k: force on the stylus at x_k, N. Not saturated here: the gateway
-  // scales it to what it can render.
+  // F_k: force on the stylus at x_k, N, at most the renderable force of the
+  // DevicePose answered (force_limit.h); the gateway still scales what it
+  // extrapolates to its newer pose.
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
   // K_k = -dF/dx at x_k, N/m, symmetric PSD, <= the coupling stiffness.
   Eigen::Matrix3d stiffness_npm = Eigen::Matrix3d::Zero();

@@ -106,6 +106,11 @@ class Body {
   void set_node_position(std::uint32_t node, const Eigen::Vector3d& position_m);
   void set_velocities_zero();
   void wake();
+  // Back to the state create() left: rest positions, no motion, no external
+  // force, awake, the rest factorisation (refactorised, so a body that ran is
+  // stepped exactly as a new one). The step count goes on, so ContactSets
+  // keep their meaning. Not for a per-step path: the factorisation mallocs.
+  bool reset_to_rest();
 
   // Corotational elastic force of the current positions, 3 per node, N.
   void elastic_forces(std::span<double> out_n);

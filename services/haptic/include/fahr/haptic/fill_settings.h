@@ -27,6 +27,16 @@ struct FillSettings {
   // 72.7% with 0.5 on every sphere, 79.6% with 0).
   double weight_spread = 0.5;
   double hugging_weight_spread = 0.0;  // in [0, 1)
+  // Surface-hugging spheres tied to the surface (ours): a value k > 1 writes
+  // the centre of a hugging sphere 1/k of the way from its tangent point on
+  // the boundary to a point k times as deep, so the boundary face's nodes
+  // carry 1 - 1/k of its weight and the FEM moves the surface when it
+  // projects the sphere. With 1 (the previous rule: the tet holding the
+  // centre, spread by hugging_weight_spread) a pressed surface node that no
+  // sphere carries stays in the tool while the spheres under it are pushed
+  // out (aist_bench trajectory: tongue vertices up to 0.6 mm inside the blade
+  // and 1-2 mm from the sphere union). In [1, 8].
+  double hugging_anchor_depth_factor = 3.0;
   // A finest-level sphere clipped to the surface is kept only if its radius
   // is at least this fraction of the level radius, in [0, 1]: smaller ones add
   // nodes to link but hardly any covered volume.

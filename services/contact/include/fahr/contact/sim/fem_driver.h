@@ -1,13 +1,9 @@
 // The FEM side of the in-process lockstep: one fem::Body stepped as the FEM
-// service does (implicit Euler, then the Algorithm 1 projection of the
-// newest ContactSet), split in two phases so the free-motion sphere centres
-// the contact solve needs are available (README, "Which centre"):
-//   1. Body::step without contacts: the free motion x_free;
-//   2. fem::project_contacts on a copy: x~, written back to the body;
-//   3. the velocity correction (x~ - x_free)/h of Algorithm 1 is carried
-//      into the next step as an impulse, f = m (x~ - x_free)/h^2 on each
-//      moved node, so the next right-hand side is M (v + dx/h) + h f, exactly
-//      Algorithm 1's.
+// service does, through fem::ContactStep (forces from lambda, free step,
+// compliance and free-motion centres, Algorithm 1 projection with its
+// velocity correction carried as the next step's force). Adds what the
+// harness reads: centres of every sphere (free-motion and projected), the
+// compliance index of the candidate spheres, strain and inversion checks.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +16,7 @@
 #include "fahr/contact/contact_row.h"
 #include "fahr/fem/body.h"
 #include "fahr/fem/box_mesh.h"
+#include "fahr/fem/contact_step.h"
 #include "fahr/fem/element_rest.h"
 #include "fahr/fem/sphere_links.h"
 
@@ -27,12 +24,10 @@ namespace fahr::contact::sim {
 
 struct FemDriverSettings {
   fem::BodySettings body;
-  // Recompute W every step (exact for refactor_period 1); with
-  // refactor_period 0 the factor never changes and W is computed once.
-  bool recompute_compliance = false;
   // Apply the ContactSet's forces (lambda along n, through the sphere
   // weights) in the implicit step before the projection (README, "What the
   // FEM must do with lambda"). false: the projection alone, as Algorithm 1.
+  // W follows the factorisation (recomputed when it is refreshed).
   bool apply_contact_forces = true;
 };
 
@@ -56,13 +51,18 @@ class FemDriver {
   // forces (3 per node, N; empty for none).
   FemStepReport step(const fem::ContactSet* contacts, std::span<const double> external_forces_n);
 
+  // Back to rest, as created: the body (rest factorisation), no carried
+  // correction, the rest W. Lets one scene serve many independent runs.
+  bool reset();
+
   const fem::SphereLinks& links() const { return links_; }
   std::span<const Eigen::Vector3d> free_centres() const { return free_centres_; }
   std::span<const Eigen::Vector3d> centres() const { return centres_; }
   std::span<const double> radii() const { return radii_; }
   std::span<const std::int32_t> compliance_index() const { return compliance_index_; }
-  std::span<const std::uint32_t> compliance_spheres() const { return compliance_spheres_; }
-  std::span<const float> compliance() const { return compliance_; }
+  std::span<const std::uint32_t> compliance_spheres() const { return contact_step_->compliance_spheres(); }
+  std::span<const float> compliance() const { return contact_step_->compliance(); }
+  const fem::ContactStep& contact_step() const { return *contact_step_; }
   std::uint64_t step_index() const { return body_->step_index(); }
   fem::Body& body() { return *body_; }
   std::span<const double> positions_m() const { return body_->positions_m(); }
@@ -76,22 +76,16 @@ class FemDriver {
 
  private:
   FemDriver() = default;
-  void update_centres(std::vector<Eigen::Vector3d>& out) const;
+  void update_centres();
 
   FemDriverSettings settings_;
   std::unique_ptr<fem::Body> body_;
   fem::SphereLinks links_;
+  std::unique_ptr<fem::ContactStep> contact_step_;
   fem::ElementRest rest_;
   std::vector<Eigen::Vector3d> free_centres_, centres_;
   std::vector<double> radii_;
   std::vector<std::int32_t> compliance_index_;
-  std::vector<std::uint32_t> compliance_spheres_;
-  std::vector<float> compliance_;
-  std::vector<double> projected_;
-  std::vector<double> applied_lambda_;           // per compliance sphere, N
-  std::vector<Eigen::Vector3d> applied_normal_;  // per compliance sphere
-  std::vector<double> carry_n_;  // Algorithm 1 velocity correction as next-step force, N
-  bool compliance_ready_ = false;
 };
 
 // One sphere per node, weight 1, radius r: the node is the sphere centre.

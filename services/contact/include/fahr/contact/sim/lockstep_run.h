@@ -37,7 +37,9 @@ struct TickRecord {
   double time_s = 0.0;
   Eigen::Vector3d device_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d proxy_m = Eigen::Vector3d::Zero();
-  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();  // on the stylus, unsaturated
+  // The ForceCommand's force on the stylus (force-aware and naive: at most
+  // the renderable force; penalty: unsaturated, as the baseline asks).
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
   double tissue_reaction_n = 0.0;
   bool lost_track = false;
   Eigen::Vector3d gap_m = Eigen::Vector3d::Zero();

@@ -39,6 +39,8 @@ inline constexpr PunchMesh kAccuratePunchMesh{};
 inline constexpr PunchMesh kSmallPunchMesh{2.5, 4.0, 1.5};
 
 // A flat punch of radius `punch_radius_m` on a graded neonatal-tissue block.
+// recompute_compliance: refactorise every step, so W (which follows the
+// factorisation) is exact every step instead of the rest W.
 PunchScene make_punch_scene(double punch_radius_m, double fem_period_s, std::string& error,
                             const PunchMesh& mesh = kAccuratePunchMesh, bool recompute_compliance = false);
 

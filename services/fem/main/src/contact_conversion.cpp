@@ -1,5 +1,5 @@
 // Wire <-> library conversions of the FEM service.
-#include "contact_conversion.h"
+#include "fahr/fem_service/contact_conversion.h"
 
 #include <algorithm>
 
@@ -15,7 +15,9 @@ void to_fem(const msg::ContactSet& wire, fem::ContactSet& out) {
     const auto& w = wire.contacts()[i];
     auto& c = out.contacts[i];
     c.sphere_id = w.sphere_id();
-    c.kind = w.kind() == msg::CONTACT_OBSTACLE ? fem::ContactKind::kObstacle : fem::ContactKind::kTool;
+    c.kind = w.kind() == msg::CONTACT_OBSTACLE  ? fem::ContactKind::kObstacle
+             : w.kind() == msg::CONTACT_PENALTY ? fem::ContactKind::kPenalty
+                                                : fem::ContactKind::kTool;
     c.state = w.state() == msg::CONSTRAINT_ACTIVE   ? fem::ContactState::kActive
               : w.state() == msg::CONSTRAINT_FROZEN ? fem::ContactState::kFrozen
                                                     : fem::ContactState::kCandidate;

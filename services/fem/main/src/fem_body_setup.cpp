@@ -1,5 +1,5 @@
 // Scene body -> FEM body and sphere links.
-#include "fem_body_setup.h"
+#include "fahr/fem_service/fem_body_setup.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,111 @@
+// One FEM step under the contact contract (DESIGN.md, "The contact
+// contract"; services/contact/README.md, "Which centre" and "What the FEM
+// must do with lambda"). The FEM service and the in-process lockstep harness
+// both step their body through this:
+//   1. the haptic solve's contact forces (lambda along n, through each
+//      sphere's node weights) and the carried Algorithm 1 correction act as
+//      external forces in the implicit step: the free motion x_free;
+//   2. the compliance W = h^2 J A^-1 J^T of the compliance spheres (reused
+//      while the spheres and the factorisation are unchanged: W depends on
+//      nothing else) and their free-motion centres c_free = c - W N lambda,
+//      the centres without this step's contact forces;
+//   3. the Algorithm 1 projection of the ContactSet on the free motion,
+//      written back to the body; its velocity correction (x~ - x_free)/h is
+//      carried into the next step as the nodal force m (x~ - x_free)/h^2, so
+//      the next right-hand side M (v + dx/h) + h f is exactly Algorithm 1's.
+// The projection is done here, not by Body::step, because step 2 needs the
+// motion before it. Staleness of a ContactSet is the caller's decision.
+// Capacities are fixed at construction: nothing allocates per step once the
+// compliance block and the contact list have reached their largest size.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fahr/fem/body.h"
+#include "fahr/fem/contact_set.h"
+#include "fahr/fem/projection.h"
+#include "fahr/fem/sphere_links.h"
+
+namespace fahr::fem {
+
+struct ContactStepSettings {
+  // Apply the ContactSet's lambda as external forces before the projection.
+  // false: the projection alone, as Algorithm 1 is written; its fixed point
+  // displaces only the constrained spheres' nodes when the step is
+  // quasi-static (services/contact/README.md), kept for that comparison.
+  bool apply_contact_forces = true;
+  // Spheres in the compliance block at most (a DeformationState carries 64).
+  std::size_t max_compliance_spheres = 64;
+};
+
+class ContactStep {
+ public:
+  // `body` and `links` must outlive this object; the links are the spheres
+  // the ContactSets refer to.
+  ContactStep(Body& body, const SphereLinks& links, const ContactStepSettings& settings = {});
+
+  // Fixes the compliance spheres, in this order, whatever the ContactSets
+  // name (a test surface whose candidates are all known), and computes W now
+  // so a contact solve has it before the first step. Without a call the
+  // block follows each step's ContactSet: its distinct spheres in order, up
+  // to the capacity. Allocates: call at set-up. False (and no block) if a
+  // sphere is unknown, there are more than the capacity, or the solve fails.
+  bool fix_compliance_spheres(std::span<const std::uint32_t> spheres);
+
+  // One step. `contacts` may be null (no usable ContactSet); `extra_forces_n`
+  // (3 per node, N, empty for none) acts in this step only (the penalty
+  // baseline's forces).
+  StepReport step(const ContactSet* contacts, std::span<const double> extra_forces_n = {});
+
+  // After the caller reset the body (Body::reset_to_rest): forgets the
+  // carried correction and the applied forces, and solves a fixed block
+  // again on the body's new factorisation. False if that solve fails.
+  bool reset();
+
+  // The compliance spheres of the newest step, their W (row-major 3k x 3k,
+  // m/N) and free-motion centres (one per sphere, m).
+  std::span<const std::uint32_t> compliance_spheres() const { return spheres_; }
+  std::span<const float> compliance() const { return compliance_; }
+  std::span<const Eigen::Vector3d> free_centres() const { return free_centres_; }
+  // Positions after the implicit step, before the projection (3 per node, m).
+  std::span<const double> free_positions_m() const { return free_positions_; }
+  const ProjectionReport& projection() const { return projection_; }
+  // Steps that reused the previous block, and blocks solved.
+  std::uint64_t compliance_reuses() const { return compliance_reuses_; }
+  std::uint64_t compliance_solves() const { return compliance_solves_; }
+
+ private:
+  void collect(const ContactSet* contacts);
+  void add_sphere_force(const Contact& contact);
+  void apply_forces(std::span<const double> extra_forces_n);
+  void update_compliance(bool refactorised);
+  void update_free_centres();
+  void project(const ContactSet& contacts);
+
+  Body& body_;
+  const SphereLinks& links_;
+  ContactStepSettings settings_;
+  bool fixed_spheres_ = false;
+  std::vector<double> carry_n_;         // carried Algorithm 1 correction, N per DOF
+  std::vector<double> force_n_;         // this step's contact and carried force, N per DOF
+  std::vector<double> free_positions_;  // x_free, m per DOF
+  std::vector<double> projected_;       // projection workspace, m per DOF
+  std::vector<std::uint32_t> spheres_;
+  std::vector<std::int32_t> slot_of_sphere_;  // fixed spheres: index in spheres_, or -1
+  // Contact force applied per compliance sphere: magnitude along a unit
+  // normal (several contacts on one sphere are summed into one vector).
+  std::vector<double> lambda_n_;
+  std::vector<Eigen::Vector3d> normals_;
+  std::vector<float> compliance_;
+  std::vector<std::uint32_t> compliance_of_;  // spheres the block was solved for
+  bool compliance_valid_ = false;
+  std::uint64_t compliance_reuses_ = 0;
+  std::uint64_t compliance_solves_ = 0;
+  std::vector<Eigen::Vector3d> free_centres_;
+  ProjectionReport projection_;
+};
+
+}  // namespace fahr::fem

@@ -1,0 +1,62 @@
+// What one FEM service step is, without transport: take the newest wire
+// ContactSet, step the body under the contact contract (fem::ContactStep),
+// and fill the DeformationState that reports it, with the compliance block
+// and the free-motion centres of the spheres the haptic service works with.
+// The service main moves these messages over DDS; tests and tools can step
+// the service's own code in one process, in lockstep with a haptic side.
+// Everything is sized at construction: a step allocates nothing once the
+// containers have reached their largest size.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "contact_set.h"
+#include "deformation_state.h"
+#include "fahr/fem/contact_set.h"
+#include "fahr/fem/contact_step.h"
+#include "fahr/fem_service/fem_body_setup.h"
+
+namespace fahr::fem_service {
+
+class ServiceStep {
+ public:
+  // `setup` must outlive this object.
+  explicit ServiceStep(FemBodySetup& setup);
+
+  // The newest ContactSet and its sample sequence number; kept until the
+  // next one (a set older than the body's max_contact_age_steps is ignored).
+  void take(const msg::ContactSet& wire, std::uint64_t seq);
+
+  // One FEM step and the DeformationState that reports it (the header is
+  // the caller's: its clock and step numbering depend on the mode).
+  void step();
+
+  msg::DeformationState& state() { return state_; }
+  const msg::DeformationState& state() const { return state_; }
+  const fem::StepReport& last_report() const { return last_report_; }
+  const fem::ContactStep& contact_step() const { return contact_step_; }
+  const FemBodySetup& setup() const { return setup_; }
+  std::uint64_t stale_sets() const { return stale_sets_; }
+  std::uint64_t inverted_max() const { return inverted_max_; }
+
+  // The service's own ServiceStatus metrics.
+  void metrics(std::vector<std::pair<std::string, double>>& out) const;
+
+ private:
+  void fill_compliance();
+
+  FemBodySetup& setup_;
+  fem::ContactStep contact_step_;
+  fem::ContactSet contacts_;
+  bool have_contacts_ = false;
+  std::uint64_t applied_contact_seq_ = 0;
+  msg::DeformationState state_;
+  fem::StepReport last_report_;
+  std::uint64_t inverted_max_ = 0;
+  std::uint64_t stale_sets_ = 0;
+};
+
+}  // namespace fahr::fem_service

@@ -1,0 +1,68 @@
+// One FEM service step: wire ContactSet in, DeformationState out.
+#include "fahr/fem_service/service_step.h"
+
+#include <algorithm>
+
+#include "fahr/fem_service/contact_conversion.h"
+
+namespace fahr::fem_service {
+
+ServiceStep::ServiceStep(FemBodySetup& setup)
+    : setup_(setup),
+      contact_step_(*setup.body, setup.links,
+                    fem::ContactStepSettings{.apply_contact_forces = true,
+                                             .max_compliance_spheres = setup.settings.max_compliance_spheres}) {
+  const std::size_t cap = setup.settings.max_compliance_spheres;
+  contacts_.contacts.reserve(msg::MAX_CONTACTS);
+  state_.positions_m().reserve(3 * setup.mesh.node_count());
+  state_.velocities_mps().reserve(3 * setup.mesh.node_count());
+  state_.compliance_sphere_ids().reserve(cap);
+  state_.compliance_mpn().reserve(9 * cap * cap);
+  state_.compliance_free_centres_m().reserve(3 * cap);
+}
+
+void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
+  to_fem(wire, contacts_);
+  have_contacts_ = true;
+  applied_contact_seq_ = seq;
+}
+
+void ServiceStep::step() {
+  // A set older than the body allows is ignored and counted (stale).
+  const bool usable = have_contacts_ && setup_.body->step_index() <=
+                                            contacts_.state_step + setup_.settings.max_contact_age_steps;
+  if (have_contacts_ && !usable) ++stale_sets_;
+  last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
+  inverted_max_ = std::max<std::uint64_t>(inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
+  fill_state(*setup_.body, setup_.scene_body->id, state_);
+  state_.stale_contact_sets(static_cast<std::uint32_t>(stale_sets_));
+  state_.applied_contact_seq(usable ? applied_contact_seq_ : 0);
+  fill_compliance();
+}
+
+void ServiceStep::fill_compliance() {
+  const auto ids = contact_step_.compliance_spheres();
+  const auto w = contact_step_.compliance();
+  const auto free = contact_step_.free_centres();
+  state_.compliance_sphere_ids().assign(ids.begin(), ids.end());
+  state_.compliance_mpn().assign(w.begin(), w.end());
+  auto& centres = state_.compliance_free_centres_m();
+  centres.resize(3 * free.size());
+  for (std::size_t s = 0; s < free.size(); ++s) {
+    for (std::size_t d = 0; d < 3; ++d) centres[3 * s + d] = static_cast<float>(free[s][static_cast<Eigen::Index>(d)]);
+  }
+}
+
+void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) const {
+  out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets_));
+  out.emplace_back("compliance_reuses", static_cast<double>(contact_step_.compliance_reuses()));
+  out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));
+  out.emplace_back("projection_sweeps_last", static_cast<double>(last_report_.projection.sweeps));
+  out.emplace_back("solver_iterations_last", static_cast<double>(last_report_.solver_iterations));
+  out.emplace_back("asleep", setup_.body->asleep() ? 1.0 : 0.0);
+  out.emplace_back("nodes", static_cast<double>(setup_.mesh.node_count()));
+  out.emplace_back("tets", static_cast<double>(setup_.mesh.tet_count()));
+  out.emplace_back("spheres", static_cast<double>(setup_.links.size()));
+}
+
+}  // namespace fahr::fem_service

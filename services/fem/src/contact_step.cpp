@@ -1,0 +1,220 @@
+// One FEM step under the contact contract: forces, free step, compliance,
+// free-motion centres, projection.
+#include "fahr/fem/contact_step.h"
+
+#include <algorithm>
+
+namespace fahr::fem {
+namespace {
+
+constexpr std::int32_t kNoSlot = -1;
+
+// Candidates carry no force; obstacle contacts are the tissue against a rigid
+// surface, not the tool's push; the penalty baseline's are nothing but force.
+bool carries_force(const Contact& c) {
+  if (c.kind == ContactKind::kPenalty) return c.force_n > 0.0;
+  return c.kind == ContactKind::kTool && c.state != ContactState::kCandidate && c.force_n > 0.0;
+}
+
+}  // namespace
+
+ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStepSettings& settings)
+    : body_(body), links_(links), settings_(settings) {
+  const std::size_t dofs = 3 * body.node_count();
+  const std::size_t k = settings_.max_compliance_spheres;
+  carry_n_.assign(dofs, 0.0);
+  force_n_.assign(dofs, 0.0);
+  free_positions_.assign(body.positions_m().begin(), body.positions_m().end());
+  projected_.assign(dofs, 0.0);
+  spheres_.reserve(k);
+  lambda_n_.reserve(k);
+  normals_.reserve(k);
+  compliance_.reserve(9 * k * k);
+  compliance_of_.reserve(k);
+  free_centres_.reserve(k);
+}
+
+bool ContactStep::fix_compliance_spheres(std::span<const std::uint32_t> spheres) {
+  fixed_spheres_ = true;
+  spheres_.clear();
+  compliance_valid_ = false;
+  const bool known = std::all_of(spheres.begin(), spheres.end(), [&](std::uint32_t s) { return s < links_.size(); });
+  if (!known || spheres.size() > settings_.max_compliance_spheres) {
+    compliance_.clear();
+    free_centres_.clear();
+    return false;
+  }
+  spheres_.assign(spheres.begin(), spheres.end());
+  slot_of_sphere_.assign(links_.size(), kNoSlot);
+  for (std::size_t i = 0; i < spheres_.size(); ++i) slot_of_sphere_[spheres_[i]] = static_cast<std::int32_t>(i);
+  lambda_n_.assign(spheres_.size(), 0.0);
+  normals_.assign(spheres_.size(), Eigen::Vector3d::Zero());
+  compliance_.assign(9 * spheres_.size() * spheres_.size(), 0.0f);
+  const auto x = body_.positions_m();
+  std::copy(x.begin(), x.end(), free_positions_.begin());
+  update_compliance(true);
+  update_free_centres();
+  return compliance_valid_;
+}
+
+bool ContactStep::reset() {
+  std::fill(carry_n_.begin(), carry_n_.end(), 0.0);
+  std::fill(lambda_n_.begin(), lambda_n_.end(), 0.0);
+  const auto x = body_.positions_m();
+  std::copy(x.begin(), x.end(), free_positions_.begin());
+  projection_ = {};
+  compliance_valid_ = false;
+  if (!fixed_spheres_) {
+    spheres_.clear();
+    compliance_.clear();
+  }
+  update_compliance(true);
+  update_free_centres();
+  return compliance_valid_ || spheres_.empty();
+}
+
+void ContactStep::add_sphere_force(const Contact& c) {
+  const auto nodes = links_.nodes(c.sphere_id);
+  const auto weights = links_.weights(c.sphere_id);
+  for (std::size_t m = 0; m < nodes.size(); ++m) {
+    for (std::size_t d = 0; d < 3; ++d) {
+      force_n_[3 * std::size_t{nodes[m]} + d] += weights[m] * c.force_n * c.normal[static_cast<Eigen::Index>(d)];
+    }
+  }
+}
+
+// The spheres of this step's block (unless fixed) and the force each
+// carries; the contact forces join the carried correction in force_n_.
+void ContactStep::collect(const ContactSet* contacts) {
+  std::copy(carry_n_.begin(), carry_n_.end(), force_n_.begin());
+  std::fill(carry_n_.begin(), carry_n_.end(), 0.0);
+  if (fixed_spheres_) {
+    std::fill(lambda_n_.begin(), lambda_n_.end(), 0.0);
+  } else {
+    spheres_.clear();
+    lambda_n_.clear();
+    normals_.clear();
+  }
+  if (contacts == nullptr) return;
+  for (const Contact& c : contacts->contacts) {
+    if (c.sphere_id >= links_.size()) continue;
+    std::int32_t slot = kNoSlot;
+    if (fixed_spheres_) {
+      slot = slot_of_sphere_[c.sphere_id];
+    } else {
+      const auto found = std::find(spheres_.begin(), spheres_.end(), c.sphere_id);
+      if (found != spheres_.end()) {
+        slot = static_cast<std::int32_t>(found - spheres_.begin());
+      } else if (spheres_.size() < settings_.max_compliance_spheres) {
+        slot = static_cast<std::int32_t>(spheres_.size());
+        spheres_.push_back(c.sphere_id);
+        lambda_n_.push_back(0.0);
+        normals_.push_back(c.normal);
+      }
+    }
+    if (!settings_.apply_contact_forces || !carries_force(c)) continue;
+    add_sphere_force(c);
+    if (slot == kNoSlot) continue;
+    const auto i = static_cast<std::size_t>(slot);
+    if (lambda_n_[i] == 0.0) {
+      lambda_n_[i] = c.force_n;
+      normals_[i] = c.normal;
+    } else {
+      // A second pushing contact on the sphere: one resultant force.
+      const Eigen::Vector3d f = lambda_n_[i] * normals_[i] + c.force_n * c.normal;
+      lambda_n_[i] = f.norm();
+      if (lambda_n_[i] > 0.0) normals_[i] = f / lambda_n_[i];
+    }
+  }
+}
+
+void ContactStep::apply_forces(std::span<const double> extra_forces_n) {
+  body_.clear_external_forces();
+  for (std::size_t n = 0; n < body_.node_count(); ++n) {
+    Eigen::Vector3d f(force_n_[3 * n], force_n_[3 * n + 1], force_n_[3 * n + 2]);
+    if (!extra_forces_n.empty()) {
+      f += Eigen::Vector3d(extra_forces_n[3 * n], extra_forces_n[3 * n + 1], extra_forces_n[3 * n + 2]);
+    }
+    if (f.squaredNorm() > 0.0) body_.set_external_force(static_cast<std::uint32_t>(n), f);
+  }
+}
+
+// W depends only on the factorisation: with the same spheres and no
+// refactorisation since, the last block is still exact and is reused.
+void ContactStep::update_compliance(bool refactorised) {
+  const std::size_t k = spheres_.size();
+  if (k == 0) {
+    compliance_.clear();
+    return;
+  }
+  if (compliance_valid_ && !refactorised && std::equal(spheres_.begin(), spheres_.end(), compliance_of_.begin(),
+                                                       compliance_of_.end())) {
+    ++compliance_reuses_;
+    return;
+  }
+  compliance_.resize(9 * k * k);
+  compliance_valid_ = body_.compliance(spheres_, links_, compliance_);
+  ++compliance_solves_;
+  compliance_of_.assign(spheres_.begin(), spheres_.end());
+  if (!compliance_valid_ && !fixed_spheres_) {
+    // No block rather than a wrong one; fixed spheres retry next step.
+    spheres_.clear();
+    compliance_.clear();
+  }
+}
+
+// c_free = c - W N lambda: x_free = x - h^2 A^-1 J^T N lambda on this
+// step's factor, so exact wherever W is.
+void ContactStep::update_free_centres() {
+  const std::size_t k = spheres_.size();
+  free_centres_.resize(k);
+  const double* x = free_positions_.data();
+  for (std::size_t s = 0; s < k; ++s) {
+    Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+    for (std::size_t t = 0; t < k && compliance_valid_; ++t) {
+      if (lambda_n_[t] == 0.0) continue;
+      for (std::size_t d = 0; d < 3; ++d) {
+        const float* row = compliance_.data() + (3 * s + d) * 3 * k + 3 * t;
+        shift[static_cast<Eigen::Index>(d)] += lambda_n_[t] * (double{row[0]} * normals_[t].x() +
+                                                               double{row[1]} * normals_[t].y() +
+                                                               double{row[2]} * normals_[t].z());
+      }
+    }
+    free_centres_[s] = links_.centre(spheres_[s], x) - shift;
+  }
+}
+
+void ContactStep::project(const ContactSet& contacts) {
+  std::copy(free_positions_.begin(), free_positions_.end(), projected_.begin());
+  projection_ = project_contacts(contacts, links_, body_.inverse_mass_per_kg(), body_.settings().projection,
+                                 projected_);
+  const double h2 = body_.time_step_s() * body_.time_step_s();
+  const auto mass = body_.mass_kg();
+  for (std::size_t n = 0; n < body_.node_count(); ++n) {
+    const Eigen::Vector3d moved(projected_[3 * n] - free_positions_[3 * n],
+                                projected_[3 * n + 1] - free_positions_[3 * n + 1],
+                                projected_[3 * n + 2] - free_positions_[3 * n + 2]);
+    if (moved.squaredNorm() == 0.0) continue;
+    const auto node = static_cast<std::uint32_t>(n);
+    body_.set_node_position(node, Eigen::Vector3d(projected_[3 * n], projected_[3 * n + 1], projected_[3 * n + 2]));
+    const Eigen::Vector3d carry = mass[n] * moved / h2;
+    for (std::size_t d = 0; d < 3; ++d) carry_n_[3 * n + d] = carry[static_cast<Eigen::Index>(d)];
+  }
+}
+
+StepReport ContactStep::step(const ContactSet* contacts, std::span<const double> extra_forces_n) {
+  collect(contacts);
+  apply_forces(extra_forces_n);
+  StepReport report = body_.step(nullptr, nullptr);
+  const auto x = body_.positions_m();
+  std::copy(x.begin(), x.end(), free_positions_.begin());
+  update_compliance(report.refactorised);
+  update_free_centres();
+  projection_ = {};
+  if (contacts != nullptr && !contacts->contacts.empty()) project(*contacts);
+  report.projection = projection_;
+  report.contacts_applied = contacts != nullptr;
+  return report;
+}
+
+}  // namespace fahr::fem

@@ -1,0 +1,140 @@
+// fem::ContactStep: the free-motion centres are the motion without this
+// step's contact forces, W is reused only while it is still exact, a reset
+// body steps as a new one, and a step allocates nothing once sized.
+#include <gtest/gtest.h>
+
+#include "allocation_counter.h"
+#include "fahr/fem/contact_step.h"
+#include "scenes.h"
+
+namespace fahr::fem {
+namespace {
+
+// The bar's free-end top nodes, one sphere each (weight 1).
+struct Bar {
+  TetMesh mesh = test::bar_mesh(2);
+  std::vector<std::uint32_t> top;
+  SphereLinks links;
+  Bar() {
+    top = test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.029 && p.y() > 0.0099; });
+    const double w = 1.0;
+    for (const std::uint32_t n : top) EXPECT_EQ(links.add_sphere({&n, 1}, {&w, 1}, 0.001), "");
+  }
+};
+
+BodySettings rest_factor_settings() {
+  BodySettings s;
+  s.sleep.enabled = false;
+  s.gravity_m_per_s2 = Eigen::Vector3d::Zero();
+  s.solver.refactor_period = 0;
+  s.solver.refactor_rotation_rad = 0.0;  // one factorisation: W exact throughout
+  return s;
+}
+
+// A tool pressing the first sphere down with 0.01 N, active on its plane.
+ContactSet press(const Bar& bar, const Body& body, double force_n) {
+  ContactSet set;
+  set.state_step = body.step_index();
+  for (std::size_t s = 0; s < bar.top.size(); ++s) {
+    Contact c;
+    c.sphere_id = static_cast<std::uint32_t>(s);
+    c.normal = Eigen::Vector3d(0, -1, 0);
+    c.state = s == 0 ? ContactState::kActive : ContactState::kCandidate;
+    c.force_n = s == 0 ? force_n : 0.0;
+    c.plane_point_m = body.position(bar.top[s]) + Eigen::Vector3d(0, 0.0015, 0);
+    set.contacts.push_back(c);
+  }
+  return set;
+}
+
+TEST(ContactStep, FreeCentresAreTheMotionWithoutTheContactForces) {
+  Bar bar;
+  auto pushed = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  auto free = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  ASSERT_TRUE(pushed && free);
+  ContactStep with(*pushed, bar.links);
+  ContactStepSettings no_forces;
+  no_forces.apply_contact_forces = false;
+  ContactStep without(*free, bar.links, no_forces);
+  ContactSet set = press(bar, *pushed, 0.01);
+  // Candidates only on the second body: no projection, no force.
+  ContactSet candidates = set;
+  for (Contact& c : candidates.contacts) c.state = ContactState::kCandidate;
+  with.step(&set);
+  without.step(&candidates);
+  ASSERT_EQ(with.compliance_spheres().size(), bar.top.size());
+  for (std::size_t s = 0; s < bar.top.size(); ++s) {
+    const Eigen::Vector3d expected = free->position(bar.top[s]);
+    EXPECT_LT((with.free_centres()[s] - expected).norm(), 1e-9) << "sphere " << s;
+  }
+  // And the force did move the pushed sphere down: the check is not vacuous.
+  EXPECT_LT(with.free_positions_m()[3 * bar.top[0] + 1], free->position(bar.top[0]).y() - 1e-7);
+}
+
+TEST(ContactStep, ReusesComplianceOnlyWhileSpheresAndFactorAreUnchanged) {
+  Bar bar;
+  auto body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  ASSERT_TRUE(body);
+  ContactStep step(*body, bar.links);
+  ContactSet set = press(bar, *body, 0.0);
+  step.step(&set);
+  step.step(&set);
+  EXPECT_EQ(step.compliance_solves(), 1u);
+  EXPECT_EQ(step.compliance_reuses(), 1u);
+  set.contacts.pop_back();  // other spheres: solved again
+  step.step(&set);
+  EXPECT_EQ(step.compliance_solves(), 2u);
+  EXPECT_EQ(step.compliance_spheres().size(), bar.top.size() - 1);
+}
+
+TEST(ContactStep, AResetBodyStepsAsANewOne) {
+  Bar bar;
+  BodySettings settings = rest_factor_settings();
+  settings.solver.refactor_rotation_rad = 0.1;
+  auto used = test::make_body(settings, bar.mesh, test::fixed_x0(bar.mesh));
+  auto fresh = test::make_body(settings, bar.mesh, test::fixed_x0(bar.mesh));
+  ASSERT_TRUE(used && fresh);
+  ContactStep used_step(*used, bar.links);
+  ContactStep fresh_step(*fresh, bar.links);
+  ASSERT_TRUE(used_step.fix_compliance_spheres(std::vector<std::uint32_t>{0, 1}));
+  ASSERT_TRUE(fresh_step.fix_compliance_spheres(std::vector<std::uint32_t>{0, 1}));
+  for (int k = 0; k < 30; ++k) {
+    ContactSet set = press(bar, *used, 0.5);
+    used_step.step(&set);
+  }
+  ASSERT_TRUE(used->reset_to_rest());
+  ASSERT_TRUE(used_step.reset());
+  for (int k = 0; k < 10; ++k) {
+    ContactSet a = press(bar, *used, 0.02), b = press(bar, *fresh, 0.02);
+    used_step.step(&a);
+    fresh_step.step(&b);
+  }
+  for (std::uint32_t n = 0; n < used->node_count(); ++n) EXPECT_EQ(used->position(n), fresh->position(n)) << n;
+  for (std::size_t i = 0; i < used_step.compliance().size(); ++i) {
+    EXPECT_EQ(used_step.compliance()[i], fresh_step.compliance()[i]);
+  }
+}
+
+TEST(ContactStep, StepAllocatesNothingOnceSized) {
+  test::hook_suitesparse_allocations();
+  Bar bar;
+  auto body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  ASSERT_TRUE(body);
+  ContactStep step(*body, bar.links);
+  ContactSet set = press(bar, *body, 0.01);
+  std::vector<double> extra(3 * body->node_count(), 0.0);
+  extra[3 * bar.top[1] + 1] = -0.001;
+  for (int k = 0; k < 3; ++k) step.step(&set, extra);
+  test::reset_allocation_counts();
+  test::enable_allocation_counting(true);
+  for (int k = 0; k < 20; ++k) {
+    set.state_step = body->step_index();
+    step.step(&set, extra);
+  }
+  test::enable_allocation_counting(false);
+  EXPECT_EQ(test::new_count(), 0u);
+  EXPECT_EQ(test::suitesparse_alloc_count(), 0u);
+}
+
+}  // namespace
+}  // namespace fahr::fem

@@ -1,0 +1,228 @@
+// The haptic service's tick on the neonatal scene, in one process: the
+// blade stops at the palate (tool rows against the rigid anatomy), a tick
+// and a state digest allocate nothing, bad FEM states are refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "contact_set.h"
+#include "fahr/device/trajectory.h"
+#include "fahr/haptic/surface_samples.h"
+#include "force_command.h"
+#include "haptic_loop.h"
+#include "scene_fixture.h"
+#include "tissue_snapshot.h"
+
+#ifndef FAHR_SANITIZE_BUILD
+#include "allocation_counter.h"
+#endif
+
+namespace fahr::haptic_service::test {
+namespace {
+
+// The pressing pose of the gateway's scripts (meshes/neonatal/README.md).
+const Eigen::Vector3d kPressTipM(-0.033, -0.0005, 0.0);
+constexpr double kPressPitchDeg = 8.0;
+// The intubation script's keyframe "insert between the lips, tip over the
+// tongue" (services/device_gateway/src/trajectory.cpp).
+constexpr double kInsertedS = 3.5;
+constexpr double kInsertedPitchDeg = 4.0;
+
+// The pitch about +z of a script orientation, degrees.
+double script_pitch_deg(const Eigen::Quaterniond& q) {
+  return 2.0 * std::atan2(q.z(), q.w()) * 180.0 / std::numbers::pi;
+}
+
+// Deepest penetration of the tool's samples into `field` with the tool at
+// `tip` (negative: the gap, when within 2 mm).
+double tool_depth(const HapticSetup& setup, const RigidField& field, const Eigen::Vector3d& tip_m, double pitch_deg) {
+  const double half = 0.5 * pitch_deg * std::numbers::pi / 180.0;
+  const Eigen::Quaterniond q(std::cos(half), 0.0, 0.0, std::sin(half));
+  std::vector<haptic::SurfaceContact> contacts(256);
+  std::size_t n = 0;
+  haptic::query_surface_samples(setup.tool_samples, Eigen::Translation3d(tip_m) * q, rigid_body(field), 2e-3,
+                                contacts, n);
+  double deepest = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) deepest = std::max(deepest, contacts[i].depth_m);
+  return deepest;
+}
+
+// The deepest over every body the tool is tested against.
+double anatomy_depth(const HapticSetup& setup, const Eigen::Vector3d& tip_m, double pitch_deg) {
+  double deepest = -std::numeric_limits<double>::infinity();
+  for (const std::size_t a : setup.tool_obstacles) deepest = std::max(deepest, tool_depth(setup, *setup.anatomy[a], tip_m, pitch_deg));
+  return deepest;
+}
+
+Eigen::Vector3d to_eigen(const msg::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+TEST(HapticLoop, BladeStopsAtTheAnatomy) {
+  const HapticSetup& setup = neonatal_scene().setup;
+  // The blade enters the mouth as the intubation script has it (3.5 s, to
+  // the tip over the tongue), then the hand lifts it 5 mm into what lies
+  // above: the upper lip, then the palate.
+  const device::Trajectory script = device::intubation_script();
+  const auto inserted = script.at(std::chrono::duration<double>(kInsertedS));
+  const double pitch_deg = kInsertedPitchDeg;
+  double touch_y = inserted.position_m.y();
+  while (!(anatomy_depth(setup, {inserted.position_m.x(), touch_y, 0.0}, pitch_deg) > 0.0)) {
+    touch_y += 1e-4;
+    ASSERT_LT(touch_y, 0.05) << "no anatomy above the inserted blade";
+  }
+  std::printf("inserted blade touches the anatomy %.1f mm higher\n", 1e3 * (touch_y - inserted.position_m.y()));
+
+  TissueDigest digest(setup);
+  const TissueSnapshot rest = digest.make_snapshot();
+  HapticLoop loop(setup);
+  msg::ForceCommand command;
+  msg::ContactSet contacts;
+  contacts.contacts().reserve(msg::MAX_CONTACTS);
+  std::uint64_t tick = 0;
+  for (; tick < static_cast<std::uint64_t>(kInsertedS * 1000); ++tick) {
+    const auto p = script.at(std::chrono::duration<double>(1e-3 * static_cast<double>(tick)));
+    loop.tick(device_pose(tick, p.position_m, script_pitch_deg(p.orientation)), rest, command, contacts);
+  }
+  ASSERT_FALSE(command.lost_track());
+  // Up to 5 mm into the palate in 0.5 s, then hold 0.5 s.
+  const double start_y = inserted.position_m.y(), end_y = touch_y + 5e-3;
+  for (std::uint64_t i = 0; i < 1000; ++i, ++tick) {
+    const double s = std::min(1.0, static_cast<double>(i) / 500.0);
+    const Eigen::Vector3d hand(inserted.position_m.x(), start_y + s * (end_y - start_y), 0.0);
+    loop.tick(device_pose(tick, hand, pitch_deg), rest, command, contacts);
+  }
+  const Eigen::Vector3d proxy = to_eigen(command.world_from_proxy().position_m());
+  const Eigen::Vector3d force = to_eigen(command.force_n());
+  const double depth = anatomy_depth(setup, proxy, pitch_deg);
+  std::printf("hand 5 mm into the anatomy: proxy %.2f mm into it, force (%.2f, %.2f, %.2f) N\n", 1e3 * depth,
+              force.x(), force.y(), force.z());
+  // The proxy stops at the bone (within a fraction of the field's 1 mm grid)...
+  EXPECT_LT(depth, 0.3e-3);
+  EXPECT_GT(depth, -0.5e-3);
+  // ...and the stylus is pushed back down, by the coupling stretched ~5 mm.
+  const double k_c = setup.response.coupling.stiffness_npm;
+  EXPECT_LT(force.y(), -0.8 * k_c * 5e-3);
+  EXPECT_GT(force.y(), -1.2 * k_c * 5e-3);
+  EXPECT_FALSE(command.lost_track());  // bone is hard, not force-aware
+}
+
+// A hostile start: the loop's first pose puts the blade inside the resting
+// tongue (no approach history, so some normals point through the blade)
+// and the hand then levers it up into the anatomy. Whatever the contacts
+// say, the proxy must never jump (it did by 290 mm before its steps were
+// bounded) and every force must be finite.
+TEST(HapticLoop, EmbeddedStartStaysBounded) {
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest(setup);
+  const TissueSnapshot rest = digest.make_snapshot();
+  HapticLoop loop(setup);
+  msg::ForceCommand command;
+  msg::ContactSet contacts;
+  contacts.contacts().reserve(msg::MAX_CONTACTS);
+  Eigen::Vector3d previous_proxy = kPressTipM;
+  double largest_jump = 0.0, largest_force = 0.0;
+  for (std::uint64_t tick = 0; tick < 1000; ++tick) {
+    const double s = std::min(1.0, static_cast<double>(tick) / 500.0);
+    const Eigen::Vector3d hand(kPressTipM.x(), kPressTipM.y() - 1e-3 + s * 9e-3, 0.0);
+    loop.tick(device_pose(tick, hand, kPressPitchDeg), rest, command, contacts);
+    const Eigen::Vector3d proxy = to_eigen(command.world_from_proxy().position_m());
+    ASSERT_TRUE(proxy.allFinite()) << "tick " << tick;
+    ASSERT_TRUE(to_eigen(command.force_n()).allFinite()) << "tick " << tick;
+    if (tick > 0) largest_jump = std::max(largest_jump, (proxy - previous_proxy).norm());
+    largest_force = std::max(largest_force, to_eigen(command.force_n()).norm());
+    previous_proxy = proxy;
+  }
+  std::printf("embedded start: largest proxy step %.2f mm, largest force %.2f N\n", 1e3 * largest_jump,
+              largest_force);
+  // A tick moves the proxy by the hand's pull plus the deepest row plus
+  // 1 mm at most (services/contact); rows here are at most a few mm deep.
+  EXPECT_LT(largest_jump, 10e-3);
+}
+
+#ifndef FAHR_SANITIZE_BUILD
+TEST(HapticLoop, TickAndDigestAllocateNothing) {
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest(setup);
+  TissueSnapshot snapshot = digest.make_snapshot();
+  msg::DeformationState state;
+  state.body_id(setup.deformable->id);
+  for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
+    for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
+  }
+  HapticLoop loop(setup);
+  msg::ForceCommand command;
+  msg::ContactSet contacts;
+  contacts.contacts().reserve(msg::MAX_CONTACTS);
+  const Eigen::Vector3d deep(kPressTipM.x() - 0.001, kPressTipM.y() - 0.004, 0.0);
+  // Warm-up: press into the tongue (and so fill every buffer once).
+  std::uint64_t tick = 0;
+  for (; tick < 400; ++tick) {
+    const double s = std::min(1.0, static_cast<double>(tick) / 200.0);
+    loop.tick(device_pose(tick, kPressTipM + s * (deep - kPressTipM), kPressPitchDeg), snapshot, command, contacts);
+  }
+  ASSERT_GT(loop.metrics().tool_rows.load(), 0u) << "the blade does not touch the tongue";
+  state.step(1);
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  fahr::test::AllocationCounter counter;
+  for (int i = 0; i < 200; ++i, ++tick) {
+    if (i % 5 == 0) {
+      state.step(state.step() + 1);
+      ASSERT_TRUE(digest.digest(state, snapshot));
+    }
+    loop.tick(device_pose(tick, deep, kPressPitchDeg), snapshot, command, contacts);
+  }
+  EXPECT_EQ(counter.count(), 0);
+  EXPECT_GT(contacts.contacts().size(), 0u);
+}
+#endif
+
+TEST(TissueDigest, RefusesStatesThatDoNotFit) {
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest(setup);
+  TissueSnapshot snapshot = digest.make_snapshot();
+  msg::DeformationState state;
+  state.positions_m().assign(3 * setup.mesh.node_count() - 3, 0.0f);
+  EXPECT_FALSE(digest.digest(state, snapshot));
+  for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
+    for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
+  }
+  state.positions_m().erase(state.positions_m().begin(), state.positions_m().begin() + (3 * setup.mesh.node_count() - 3));
+  ASSERT_EQ(state.positions_m().size(), 3 * setup.mesh.node_count());
+  EXPECT_TRUE(digest.digest(state, snapshot));
+  state.positions_m()[7] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(digest.digest(state, snapshot));
+}
+
+TEST(TissueDigest, IndexesTheComplianceSpheres) {
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest(setup);
+  TissueSnapshot snapshot = digest.make_snapshot();
+  msg::DeformationState state;
+  for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
+    for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
+  }
+  state.compliance_sphere_ids({5, 9});
+  state.compliance_mpn().assign(36, 1e-3f);
+  state.compliance_free_centres_m().assign(6, 0.01f);
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  EXPECT_EQ(snapshot.compliance_index[5], 0);
+  EXPECT_EQ(snapshot.compliance_index[9], 1);
+  EXPECT_EQ(snapshot.compliance_index[6], contact::kNoCompliance);
+  EXPECT_TRUE(snapshot.have_free_centres);
+  // The next state in the same slot forgets the old spheres.
+  state.compliance_sphere_ids({6});
+  state.compliance_mpn().assign(9, 1e-3f);
+  state.compliance_free_centres_m().clear();
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  EXPECT_EQ(snapshot.compliance_index[5], contact::kNoCompliance);
+  EXPECT_EQ(snapshot.compliance_index[6], 0);
+  EXPECT_FALSE(snapshot.have_free_centres);
+  // An id beyond the layout refuses the whole W.
+  state.compliance_sphere_ids({static_cast<std::uint32_t>(setup.layout.size())});
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  EXPECT_EQ(snapshot.compliance_count, 0u);
+}
+
+}  // namespace
+}  // namespace fahr::haptic_service::test

@@ -1,0 +1,48 @@
+// Shared neonatal set-up and pose helpers (see scene_fixture.h).
+#include "scene_fixture.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace fahr::haptic_service::test {
+
+const NeonatalScene& neonatal_scene() {
+  static const NeonatalScene loaded = [] {
+    NeonatalScene s;
+    s.scene = scene::load_scene(FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml");
+    s.setup = set_up(*s.scene);
+    return s;
+  }();
+  return loaded;
+}
+
+msg::DevicePose device_pose(std::uint64_t tick, const Eigen::Vector3d& position_m, double pitch_deg,
+                            double renderable_force_n) {
+  msg::DevicePose pose;
+  pose.header().seq(tick + 1);
+  pose.header().sim_step(tick);
+  pose.header().sim_time_ns(static_cast<std::int64_t>(tick) * 1000000);
+  pose.device_id(1);
+  pose.servo_tick(tick);
+  pose.world_from_stylus().position_m().x(position_m.x());
+  pose.world_from_stylus().position_m().y(position_m.y());
+  pose.world_from_stylus().position_m().z(position_m.z());
+  const double half = 0.5 * pitch_deg * std::numbers::pi / 180.0;
+  pose.world_from_stylus().orientation().w(std::cos(half));
+  pose.world_from_stylus().orientation().x(0.0);
+  pose.world_from_stylus().orientation().y(0.0);
+  pose.world_from_stylus().orientation().z(std::sin(half));
+  pose.renderable_force_n(renderable_force_n);
+  pose.max_stiffness_npm(1480.0);
+  return pose;
+}
+
+haptic::RigidBody rigid_body(const RigidField& field) {
+  haptic::RigidBody body;
+  body.id = field.scene_body->id;
+  body.sdf = field.sdf.get();
+  body.world_from_body = Eigen::Translation3d(field.scene_body->pose.position_m) * field.scene_body->pose.orientation;
+  return body;
+}
+
+}  // namespace fahr::haptic_service::test

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The intubation benchmark of issue 6 (the paper's Figure 6 setting): the
+# whole stack in real time (deployment/run_local.sh: gateway with the
+# simulated hand on the intubation script, FEM service, haptic service, as
+# separate processes over DDS) for S seconds, once with the AIST and once
+# with the triangle-level baseline finding the blade's contacts with the
+# tongue; prints the haptic tick's thread-CPU time (median, p99, p99.9,
+# max over the whole run) and the number of tick periods longer than 1.5 ms.
+#
+#   tools/intubation_bench.sh [BUILD_DIR] [--seconds 60] [--dds cyclonedds]
+#
+# The script lasts 13 s; the gateway repeats it. Numbers depend on what
+# else the machine runs (three processes share its cores): compare the two
+# rows of one run, not runs of different days.
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+build="$repo/build"
+seconds=60
+dds=cyclonedds
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --seconds) seconds="$2"; shift 2 ;;
+    --dds) dds="$2"; shift 2 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    -*) echo "intubation_bench: unknown flag '$1'" >&2; exit 2 ;;
+    *) build="$1"; shift ;;
+  esac
+done
+
+out=$(mktemp -d /tmp/fahr-intubation-bench-XXXXXX)
+trap 'rm -rf "$out"' EXIT
+for collision in aist triangle; do
+  echo "intubation_bench: $collision, ${seconds} s ..." >&2
+  FAHR_RUN_LOG_DIR="$out/$collision" bash "$repo/deployment/run_local.sh" "$build" --dds "$dds" \
+    --duration-s "$seconds" --haptic-collision "$collision" >"$out/$collision.txt" 2>&1 ||
+    { cat "$out/$collision.txt" >&2; exit 1; }
+done
+
+echo "| collision | ticks | tick CPU median us | p99 us | p99.9 us | max us | periods > 1.5 ms | peak tissue reaction N | FEM states used |"
+echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+for collision in aist triangle; do
+  log="$out/$collision/haptic.log"
+  line=$(grep "tick CPU us median" "$log")
+  read -r median p99 p999 max ticks long <<<"$(sed -E 's/.*median ([0-9]+) p99 ([0-9]+) p99.9 ([0-9]+) max ([0-9]+) over ([0-9]+) ticks; periods > 1.5 ms: ([0-9]+).*/\1 \2 \3 \4 \5 \6/' <<<"$line")"
+  reaction=$(awk -F'|' '{ gsub(/^ +| +$/, "", $2) } $2 == "peak tissue reaction N" { gsub(/ /, "", $3); print $3 }' "$out/$collision.txt")
+  used=$(sed -nE 's/.* ticks on ([0-9]+) FEM states.*/\1/p' "$log")
+  echo "| $collision | $ticks | $median | $p99 | $p999 | $max | $long | ${reaction:-?} | ${used:-?} |"
+done
