@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(sim.body().step_index()),
                 static_cast<unsigned long long>(sim.fem().stale_sets()),
                 static_cast<unsigned long long>(sim.fem().inverted_max()));
+    const auto& cpu = sim.haptic_tick_cpu();
+    const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
+    std::printf("stack_sim: haptic tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f\n", us(cpu.percentile(0.5)),
+                us(cpu.percentile(0.99)), us(cpu.percentile(0.999)), us(cpu.max()));
     std::printf("lockstep_clock: hash device_gateway %016llx\n", static_cast<unsigned long long>(sim.gateway_hash()));
     std::printf("lockstep_clock: hash fem %016llx\n", static_cast<unsigned long long>(sim.fem_hash()));
     std::printf("lockstep_clock: hash haptic %016llx\n", static_cast<unsigned long long>(sim.haptic_hash()));

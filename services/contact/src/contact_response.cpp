@@ -16,6 +16,9 @@ constexpr int kMaxYieldIterations = 8;
 // How much farther than its deepest row a backing-off or stepping proxy may
 // go, m: 1 mm, a tick of a fast hand.
 constexpr double kYieldCapMarginM = 1e-3;
+// A tissue reaction above this multiple of the limit is not the force-aware
+// decision's rounding but a wedge (see tick()): the 5 % band.
+constexpr double kWedgeBand = 1.05;
 // Relative band around the limit the back-off aims for: 0.1 %, far below
 // what the 5 % target allows and what a hand feels.
 constexpr double kYieldTolerance = 1e-3;
@@ -210,7 +213,13 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
     c.force_n = tissue_force_scale_ * solver_.lambda(i);
     c.hold_centre_m = row.other_point_m;
     const Hold* hold = frozen ? find_hold(row.id) : nullptr;
-    if (hold != nullptr) {
+    if (report_.tissue_force_clamped) {
+      // Wedged past the limit (bone drives the tool into the tissue): the
+      // tissue gets the limited forces and no geometric constraint, which
+      // would push it as far as the bone says whatever the force.
+      c.kind = fem::ContactKind::kForceOnly;
+      c.state = c.force_n > 0.0 ? fem::ContactState::kActive : fem::ContactState::kCandidate;
+    } else if (hold != nullptr) {
       c.state = fem::ContactState::kFrozen;
       c.hold_centre_m = hold->centre_m;
     } else if (c.force_n > 0.0 || c.penetration_m > 0.0) {
@@ -220,7 +229,7 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
     }
     push_contact(c);
   }
-  if (frozen) {
+  if (frozen && !report_.tissue_force_clamped) {
     // Held spheres the collision stage no longer reports stay held.
     for (std::size_t h = 0; h < hold_count_; ++h) {
       bool listed = false;
@@ -283,12 +292,14 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   out.lost_track = state_ == TrackingState::kLostTrack;
   out.device_minus_proxy_m = device.position_m - proxy_.position_m;
   // What the tissue receives is never more than the device can render: a
-  // solve that asks for more (the tool wedged between bone and tongue, where
-  // the bone's rows push it into the tissue) has its tissue forces scaled
-  // down to the limit; the FEM's projection still keeps the geometry.
+  // solve that asks for clearly more (the tool wedged between bone and
+  // tongue, where the bone's rows push it into the tissue) has its tissue
+  // forces scaled down to the limit and sent as force only. Within the band
+  // the force-aware decision already keeps the reaction at the limit (to
+  // its yield tolerance and the one-tick lag), and the constraints stay.
   const double solved_reaction = solver_.resultant(RowKind::kTissue).norm();
   tissue_force_scale_ = 1.0;
-  if (settings_.mode != ResponseMode::kNaive && solved_reaction > device.renderable_force_n) {
+  if (settings_.mode != ResponseMode::kNaive && solved_reaction > kWedgeBand * device.renderable_force_n) {
     tissue_force_scale_ = device.renderable_force_n / solved_reaction;
     report_.tissue_force_clamped = true;
   }

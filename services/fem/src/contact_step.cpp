@@ -10,9 +10,9 @@ namespace {
 constexpr std::int32_t kNoSlot = -1;
 
 // Candidates carry no force; obstacle contacts are the tissue against a rigid
-// surface, not the tool's push; the penalty baseline's are nothing but force.
+// surface, not the tool's push; force-only contacts are nothing but force.
 bool carries_force(const Contact& c) {
-  if (c.kind == ContactKind::kPenalty) return c.force_n > 0.0;
+  if (c.kind == ContactKind::kForceOnly) return c.force_n > 0.0;
   return c.kind == ContactKind::kTool && c.state != ContactState::kCandidate && c.force_n > 0.0;
 }
 

@@ -17,7 +17,7 @@ bool contact_is_frozen(const Contact& contact) {
 }
 
 bool contact_is_projected(const Contact& contact) {
-  return contact.state != ContactState::kCandidate && contact.kind != ContactKind::kPenalty;
+  return contact.state != ContactState::kCandidate && contact.kind != ContactKind::kForceOnly;
 }
 
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,

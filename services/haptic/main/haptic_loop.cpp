@@ -313,7 +313,7 @@ const contact::ForceOutput& HapticLoop::penalty_tick(const contact::DeviceSample
     if (!(magnitude > 0.0) || penalty_count_ == penalty_contacts_.size()) continue;
     fem::Contact& c = penalty_contacts_[penalty_count_++];
     c.sphere_id = f.sphere_id;
-    c.kind = fem::ContactKind::kPenalty;
+    c.kind = fem::ContactKind::kForceOnly;
     c.state = fem::ContactState::kActive;
     c.normal = f.force_n / magnitude;
     c.force_n = magnitude;

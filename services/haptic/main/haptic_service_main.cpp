@@ -57,7 +57,7 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
   // Whole-run figures of the tick (the status windows hold 250 ms each): its
   // thread-CPU time (the work, whatever the scheduler does) and the wall
   // periods between ticks longer than 1.5 ms (late answers).
-  metrics::DurationHistogram tick_cpu(std::chrono::microseconds(2));
+  metrics::DurationHistogram tick_cpu(std::chrono::microseconds(5));  // 5 us bins span 10 ms
   std::uint64_t long_periods = 0;
   std::int64_t previous_start_ns = 0;
   std::uint64_t seen = 0;

@@ -71,7 +71,7 @@ void fill_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_bo
       w.other_body_id(obstacle < obstacle_body_ids.size() ? obstacle_body_ids[obstacle] : 0u);
       ++obstacle;
     } else {
-      w.kind(c.kind == fem::ContactKind::kPenalty ? msg::CONTACT_PENALTY : msg::CONTACT_TOOL);
+      w.kind(c.kind == fem::ContactKind::kForceOnly ? msg::CONTACT_FORCE_ONLY : msg::CONTACT_TOOL);
       w.other_body_id(tool_body_id);
     }
     w.state(wire_state(c.state));

@@ -7,9 +7,16 @@
 namespace fahr::haptic_service {
 namespace {
 
-// Tissue spheres in contact with the anatomy per state: the tongue resting on
-// the floor of the mouth touches ~100 of them; a full buffer is flagged.
-constexpr std::size_t kObstacleContactCapacity = 256;
+// Tissue spheres in contact with (or within the margin of) the anatomy per
+// state: the tongue resting on the floor of the mouth and pressed against
+// the jaw reaches ~300 of them; a full buffer is flagged. With the tool's
+// 64 rows and held spheres this stays within msg::MAX_CONTACTS (512).
+constexpr std::size_t kObstacleContactCapacity = 384;
+// Spheres this close to the anatomy are sent as constraints too (inactive
+// while they keep clear): the FEM projects a state the haptic service saw
+// one FEM step earlier, and with touching spheres alone the set flickers
+// between none and hundreds as the tongue settles on the jaw, m.
+constexpr double kObstacleMarginM = 0.5e-3;
 
 }  // namespace
 
@@ -28,7 +35,7 @@ TissueDigest::TissueDigest(const HapticSetup& setup)
   // Tissue against anatomy changes only with the FEM state, so the grid
   // distance is enough: off by a fraction of a cell at edges only.
   obstacle_query_.exact_narrow_phase = false;
-  obstacle_query_.candidate_margin_m = 0.0;
+  obstacle_query_.candidate_margin_m = kObstacleMarginM;
   // The anatomy is thick: the field's normal points the right way even with
   // the centre inside, so no approach memory (which visits every sphere
   // within the margin: most of the tongue's underside lies 0.37 mm off the jaw).
@@ -120,7 +127,7 @@ void TissueDigest::query_obstacles(TissueSnapshot& out) {
   }
   out.obstacle_count = 0;
   for (const haptic::SphereContact& s : obstacle_buffer_) {
-    if (s.candidate || s.depth_m <= 0.0) continue;
+    // Near ones too: the projection leaves a constraint that holds alone.
     fem::Contact& c = out.obstacle_contacts[out.obstacle_count];
     c.sphere_id = s.sphere_id;
     c.kind = fem::ContactKind::kObstacle;

@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 
+#include "fahr/common/clock.h"
 #include "fahr/scene/plan.h"
 #include "msg_conversion.h"
 
@@ -70,7 +71,11 @@ void StackSim::step() {
     digest_->digest(fem_->state(), tissue_);
     fem_published_ = false;
   }
-  if (k > 0) haptic_->tick(pose_, tissue_, next_command_, next_contacts_);
+  if (k > 0) {
+    const std::int64_t cpu0 = common::thread_cpu_now_ns();
+    haptic_->tick(pose_, tissue_, next_command_, next_contacts_);
+    haptic_tick_cpu_.record(std::chrono::nanoseconds(common::thread_cpu_now_ns() - cpu0));
+  }
   next_command_.header().seq(k + 1);
   next_command_.header().sim_step(k);
   next_command_.header().sim_time_ns(now_ns);

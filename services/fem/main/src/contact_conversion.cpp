@@ -16,7 +16,7 @@ void to_fem(const msg::ContactSet& wire, fem::ContactSet& out) {
     auto& c = out.contacts[i];
     c.sphere_id = w.sphere_id();
     c.kind = w.kind() == msg::CONTACT_OBSTACLE  ? fem::ContactKind::kObstacle
-             : w.kind() == msg::CONTACT_PENALTY ? fem::ContactKind::kPenalty
+             : w.kind() == msg::CONTACT_FORCE_ONLY ? fem::ContactKind::kForceOnly
                                                 : fem::ContactKind::kTool;
     c.state = w.state() == msg::CONSTRAINT_ACTIVE   ? fem::ContactState::kActive
               : w.state() == msg::CONSTRAINT_FROZEN ? fem::ContactState::kFrozen

@@ -11,7 +11,9 @@ namespace fahr::fem {
 enum class ContactKind : std::uint8_t {
   kTool,      // force-aware: active or frozen as the haptic side decides
   kObstacle,  // palate, jaw: always a hard non-penetration constraint
-  kPenalty,   // the penalty baseline's tool: force_n along n, never projected (Figure 7a)
+  // force_n along n, never projected: the penalty baseline's tool (Figure
+  // 7a), and a force-aware tool wedged past the limit (services/contact).
+  kForceOnly,
 };
 
 enum class ContactState : std::uint8_t {

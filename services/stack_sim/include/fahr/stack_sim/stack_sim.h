@@ -17,6 +17,7 @@
 #include "deformation_state.h"
 #include "device_pose.h"
 #include "fahr/common/lockstep.h"
+#include "fahr/metrics/duration_histogram.h"
 #include "fahr/device/servo_core.h"
 #include "fahr/device/simulated_backend.h"
 #include "fahr/device/trajectory.h"
@@ -71,6 +72,10 @@ class StackSim {
   const haptic_service::HapticSetup& haptic_setup() const { return haptic_setup_; }
   const scene::Scene& scene() const { return *scene_; }
 
+  // Thread-CPU time of each haptic tick so far (the tick alone: no digest,
+  // no transport), 1 us bins.
+  const metrics::DurationHistogram& haptic_tick_cpu() const { return haptic_tick_cpu_; }
+
   // Output hashes as the distributed lockstep computes them.
   std::uint64_t gateway_hash() const { return gateway_hash_.value(); }
   std::uint64_t haptic_hash() const { return haptic_hash_.value(); }
@@ -105,6 +110,7 @@ class StackSim {
   bool fem_published_ = false;
   std::uint64_t step_ = 0;
 
+  metrics::DurationHistogram haptic_tick_cpu_{std::chrono::microseconds(1)};
   common::OutputHash gateway_hash_;
   common::OutputHash haptic_hash_;
   common::OutputHash fem_hash_;
