@@ -9,7 +9,12 @@ namespace fahr::haptic_service::test {
 const NeonatalScene& neonatal_scene() {
   static const NeonatalScene loaded = [] {
     NeonatalScene s;
-    s.scene = scene::load_scene(FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml");
+    // The scene as shipped, with the tool's stop at the anatomy on (the
+    // shipped scene has it off while the FEM cannot take a wedged blade).
+    auto scene = std::make_shared<scene::Scene>(
+        *scene::load_scene(FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml"));
+    scene->contact.tool_stops_at_anatomy = true;
+    s.scene = scene;
     s.setup = set_up(*s.scene);
     return s;
   }();

@@ -73,6 +73,7 @@ TEST(SceneDefaults, MinimalSceneGetsEveryDefault) {
   EXPECT_EQ(scene->contact.force_aware_hysteresis, kDefaultForceAwareHysteresis);
   EXPECT_EQ(scene->contact.deformable_obstacle_margin_m, kDefaultDeformableObstacleMarginM);
   EXPECT_TRUE(scene->contact.include_pairs.empty());
+  EXPECT_TRUE(scene->contact.tool_stops_at_anatomy);
   EXPECT_TRUE(scene->qos.empty());
 }
 
@@ -135,7 +136,7 @@ TEST(SceneDefaults, ExplicitSettingsAreRead) {
                      "    workspace_m: [0.16, 0.12, 0.07]\n  motion_scale: 2") +
             "solver:\n  linear_solver: pcg\n  cg_tolerance: 1e-8\n  cg_max_iterations: 50\n"
             "  compliance: lagged\n  max_contact_age_ms: 2.5\n"
-            "contact:\n  response: penalty\n  coupling_stiffness_npm: 250\n"
+            "contact:\n  response: penalty\n  coupling_stiffness_npm: 250\n  tool_stops_at_anatomy: false\n"
             "dds:\n  vendor: fastdds\n  domain_id: 42\n"
             "qos:\n  DevicePose: {deadline_ms: 2, reliability: best_effort}\n"
             "  ContactSet:\n    history_depth: 4\n");
@@ -151,6 +152,7 @@ TEST(SceneDefaults, ExplicitSettingsAreRead) {
   EXPECT_EQ(scene->solver.max_contact_age, 2500us);
   EXPECT_EQ(scene->contact.response, ContactResponse::kPenalty);
   EXPECT_EQ(scene->contact.coupling_stiffness_npm, 250.0);
+  EXPECT_FALSE(scene->contact.tool_stops_at_anatomy);
   EXPECT_EQ(scene->dds.vendor, DdsVendor::kFastDds);
   EXPECT_EQ(scene->dds.domain_id, 42);
   ASSERT_EQ(scene->qos.size(), 2u);

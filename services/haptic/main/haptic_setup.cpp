@@ -101,7 +101,8 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision) {
   for (const auto& pair : plan.pairs) {
     if (pair.kind == scene::PairKind::kHard && pair.first == plan.fem_bodies.front()) {
       setup.tissue_obstacles.push_back(anatomy_index(pair.second));
-    } else if (pair.kind == scene::PairKind::kTool && pair.reason == scene::PairReason::kToolObstacle) {
+    } else if (pair.kind == scene::PairKind::kTool && pair.reason == scene::PairReason::kToolObstacle &&
+               scene.contact.tool_stops_at_anatomy) {
       setup.tool_obstacles.push_back(anatomy_index(pair.second));
     }
   }

@@ -35,6 +35,10 @@ struct ContactSettings {
   std::vector<BodyIndexPair> include_pairs;
   // Pairs never tested, whatever their roles.
   std::vector<BodyIndexPair> exclude_pairs;
+  // The tool against rigid anatomy: the proxy stops at bone (hard rows).
+  // false: the tool passes through rigid bodies (only the deformable body
+  // resists it), e.g. while the FEM cannot take a blade wedged against bone.
+  bool tool_stops_at_anatomy = true;
 };
 
 }  // namespace fahr::scene
