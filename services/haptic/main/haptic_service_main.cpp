@@ -6,7 +6,8 @@
 // digests DeformationStates beside the tick) or lockstep.
 //
 //   fahr_haptic_service --scene FILE [--dds V] [--domain N] [--dds-profile F]
-//                       [--duration-s S] [--mode realtime|lockstep]
+//                       [--duration-s S] [--mode realtime|lockstep] [--collision aist|triangle]
+//                       [--spin] [--rt-priority N]
 #include <CLI/CLI.hpp>
 
 #include <atomic>
@@ -18,6 +19,7 @@
 
 #include "fahr/common/lockstep.h"
 #include "fahr/common/publisher.h"
+#include "fahr/common/realtime.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/metrics/duration_histogram.h"
@@ -44,8 +46,17 @@ constexpr std::int64_t kLongPeriodNs = 1'500'000;
 // Ticks until the duration has passed or a signal asks to stop. Blocks only
 // between ticks, waiting for the next DevicePose; FEM states are digested
 // on the feed's thread.
+// How the real-time loop waits for the next DevicePose.
+struct WaitPolicy {
+  // Busy-poll instead of sleeping on the subscriber: the tick starts within
+  // a microsecond of the pose's arrival, at the price of a whole core.
+  bool spin = false;
+  // SCHED_FIFO priority of the tick thread, 0 = normal scheduling.
+  int rt_priority = 0;
+};
+
 void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop& loop, common::TickRecorder& recorder,
-                  double duration_s) {
+                  double duration_s, const WaitPolicy& wait) {
   common::Subscriber<msg::DevicePose> poses(participant);
   common::Publisher<msg::ForceCommand> commands(participant);
   common::Publisher<msg::ContactSet> contact_sets(participant);
@@ -60,13 +71,26 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
   metrics::DurationHistogram tick_cpu(std::chrono::microseconds(5));  // 5 us bins span 10 ms
   std::uint64_t long_periods = 0;
   std::int64_t previous_start_ns = 0;
+  if (wait.rt_priority > 0) {
+    // Opt-in; without the privilege the loop runs on as before.
+    const std::string refused = common::request_realtime_priority(wait.rt_priority);
+    std::printf("fahr_haptic_service: real-time priority %d: %s\n", wait.rt_priority,
+                refused.empty() ? "granted" : refused.c_str());
+  }
   std::uint64_t seen = 0;
   std::uint64_t tick = 0;
+  std::uint64_t polls = 0;
   while (!common::stop_requested()) {
-    if (duration_s > 0 && Clock::now() - start > duration) break;
-    // 50 ms: short enough to notice a stop request, long enough not to spin.
-    seen = poses.wait_for_samples(seen, 50ms);
-    if (!poses.fetch_newest()) continue;
+    if (wait.spin) {
+      // Check the clock and the stop flag every 4096 polls only.
+      if ((++polls & 4095u) == 0 && duration_s > 0 && Clock::now() - start > duration) break;
+      if (!poses.fetch_newest()) continue;
+    } else {
+      if (duration_s > 0 && Clock::now() - start > duration) break;
+      // 50 ms: short enough to notice a stop request, long enough not to spin.
+      seen = poses.wait_for_samples(seen, 50ms);
+      if (!poses.fetch_newest()) continue;
+    }
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
     loop.tick(poses.newest(), feed.newest(), command, contacts);
@@ -171,6 +195,11 @@ int run(int argc, char** argv) {
   app.add_option("--duration-s", duration_s, "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");
   app.add_option("--mode", mode, "realtime or lockstep (default: the scene's run.mode)")
       ->check(CLI::IsMember({"realtime", "lockstep"}));
+  WaitPolicy wait;
+  app.add_flag("--spin", wait.spin, "real time: busy-poll for DevicePoses (a core of its own) instead of sleeping");
+  app.add_option("--rt-priority", wait.rt_priority,
+                 "real time: SCHED_FIFO priority 1-99 for the tick thread (needs CAP_SYS_NICE; refused gracefully)")
+      ->check(CLI::Range(0, 99));
   std::string collision = "aist";
   app.add_option("--collision", collision,
                  "tool-tissue collision: aist (the paper's spheres) or triangle (the baseline it is measured against)")
@@ -215,7 +244,7 @@ int run(int argc, char** argv) {
               collision.c_str(), scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s);
   reporter.set_state(msg::SERVICE_RUNNING);
   const int status = lockstep ? run_lockstep(participant, setup, loop, recorder)
-                              : (run_realtime(participant, *feed, loop, recorder, duration_s), 0);
+                              : (run_realtime(participant, *feed, loop, recorder, duration_s, wait), 0);
   reporter.set_state(msg::SERVICE_STOPPING);
   reporter.report();
   const auto& m = loop.metrics();
