@@ -76,7 +76,9 @@ fem="$build/services/fem/main/fahr_fem_service"
 haptic="$build/services/haptic/main/fahr_haptic_service"
 summary="$build/tools/run_summary/fahr_run_summary"
 clock="$build/tools/lockstep_clock/fahr_lockstep_clock"
-for exe in "$gateway" "$fem" "$haptic" "$summary" "$clock"; do
+needed=("$gateway" "$fem" "$haptic" "$summary")
+[ "$mode" = lockstep ] && needed+=("$clock")
+for exe in "${needed[@]}"; do
   if [ ! -x "$exe" ]; then
     echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway_service fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock" >&2
     exit 2

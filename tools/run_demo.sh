@@ -15,7 +15,7 @@ build="${FAHR_BUILD_DIR:-$root/build}"
 
 bash "$root/tools/setup.sh"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
-cmake --build "$build" -j2 --target fahr_device_gateway_service fahr_fem_service fahr_haptic_service fahr_run_summary
+cmake --build "$build" -j2 --target fahr_device_gateway_service fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock
 
 echo "fahr demo: simulated neonatal intubation, gateway + FEM + haptic over DDS"
 bash "$root/deployment/run_local.sh" "$build" --duration-s "${FAHR_DEMO_SECONDS:-20}"
