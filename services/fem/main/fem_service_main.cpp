@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "fahr/common/lockstep.h"
+#include "fahr/runtime/service_options.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/scene/load_scene.h"
@@ -95,18 +96,11 @@ int run_lockstep(common::Participant& participant, ServiceStep& fem_step, const 
 
 int run(int argc, char** argv) {
   CLI::App app{"fahr FEM deformation service"};
-  std::string scene_path, dds, domain, profile, mode;
-  double duration_s = -1;
-  app.add_option("--scene", scene_path, "scene file")->required();
-  app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds, inprocess");
-  app.add_option("--domain", domain, "DDS domain id 0-230");
-  app.add_option("--dds-profile", profile, "vendor XML configuration");
-  app.add_option("--duration-s", duration_s, "stop after this long (default: the scene's run.duration_s)");
-  app.add_option("--mode", mode, "realtime or lockstep (default: the scene's run.mode)")
-      ->check(CLI::IsMember({"realtime", "lockstep"}));
+  runtime::ServiceOptions options;
+  runtime::add_service_options(app, options);
   CLI11_PARSE(app, argc, argv);
 
-  const auto scene = scene::load_scene(scene_path);
+  const auto scene = scene::load_scene(options.scene_path);
   const auto plan = scene::derive_plan(*scene);
   if (!plan.run_fem) {
     std::printf("fahr_fem_service: scene '%s' has no deformable body; nothing to do\n", scene->name.c_str());
@@ -117,13 +111,13 @@ int run(int argc, char** argv) {
                  scene->name.c_str(), plan.fem_bodies.size());
     return 2;
   }
-  const bool lockstep = mode.empty() ? scene->run.mode == scene::RunMode::kLockstep : mode == "lockstep";
-  if (duration_s < 0) duration_s = std::chrono::duration<double>(scene->run.duration).count();
+  const bool lockstep = options.lockstep(*scene);
+  const double duration_s = options.duration_or_scene_s(*scene);
 
   common::install_stop_handlers();
   FemBodySetup setup = set_up_body(*scene, scene->bodies[plan.fem_bodies.front()]);
   ServiceStep fem_step(setup);
-  common::Participant participant(runtime::transport_for(*scene, dds, domain, profile, "fem"));
+  common::Participant participant(runtime::transport_for(*scene, options.dds, options.domain, options.profile, "fem"));
   common::TickRecorder recorder;
   common::ServiceReporter reporter(participant, {"fem", scene->rates.fem_hz, scene->rates.status_period() > 0ns ?
                                                  std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period()) : 250ms},

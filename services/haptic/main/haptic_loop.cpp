@@ -42,6 +42,19 @@ void relaxed_add(std::atomic<T>& a, T v) {
   a.fetch_add(v, std::memory_order_relaxed);
 }
 
+// Puts the `keep` deepest of indices[0, n) first (indices into `contacts`,
+// each with a depth_m) when there are more than that; returns how many were
+// dropped. In place, allocation-free.
+template <class Contact>
+std::size_t keep_deepest(std::vector<std::uint32_t>& indices, std::size_t n, std::size_t keep,
+                         const Contact& contacts) {
+  if (n <= keep) return 0;
+  std::partial_sort(indices.begin(), indices.begin() + static_cast<std::ptrdiff_t>(keep),
+                    indices.begin() + static_cast<std::ptrdiff_t>(n),
+                    [&](std::uint32_t a, std::uint32_t b) { return contacts[a].depth_m > contacts[b].depth_m; });
+  return n - keep;
+}
+
 }  // namespace
 
 HapticLoop::HapticLoop(const HapticSetup& setup)
@@ -104,14 +117,8 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
   const std::size_t n = tool_contacts_.size();
   std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
   const std::size_t keep = std::min(n, tissue_row_budget_);
-  if (n > keep) {
-    // More than W can cover: keep the deepest (touching before candidates).
-    std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(keep),
-                      order_.begin() + static_cast<std::ptrdiff_t>(n), [&](std::uint32_t a, std::uint32_t b) {
-                        return tool_contacts_[a].depth_m > tool_contacts_[b].depth_m;
-                      });
-    relaxed_add<std::uint64_t>(metrics_.rows_dropped, n - keep);
-  }
+  // More than W can cover: keep the deepest (touching before candidates).
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, keep_deepest(order_, n, keep, tool_contacts_));
   // (The penalty baseline's forces are part of the FEM's step, so it reads
   // the published centres.)
   const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
@@ -160,13 +167,7 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
   }
   for (std::size_t k = 0; k < slots; ++k) row_of_sphere_[slot_sphere_[k]] = -1;
   const std::size_t keep = std::min(slots, tissue_row_budget_);
-  if (slots > keep) {
-    std::partial_sort(sphere_contact_.begin(), sphere_contact_.begin() + static_cast<std::ptrdiff_t>(keep),
-                      sphere_contact_.begin() + static_cast<std::ptrdiff_t>(slots), [&](std::uint32_t a, std::uint32_t b) {
-                        return triangle_contacts_[a].depth_m > triangle_contacts_[b].depth_m;
-                      });
-    relaxed_add<std::uint64_t>(metrics_.rows_dropped, slots - keep);
-  }
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, keep_deepest(sphere_contact_, slots, keep, triangle_contacts_));
   // (The penalty baseline's forces are part of the FEM's step, so it reads
   // the published centres.)
   const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
@@ -197,13 +198,7 @@ void HapticLoop::collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool) 
   }
   const std::size_t keep = std::min({n, kMaxAnatomyRows, rows_.size() - row_count_});
   std::iota(anatomy_order_.begin(), anatomy_order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
-  if (n > keep) {
-    std::partial_sort(anatomy_order_.begin(), anatomy_order_.begin() + static_cast<std::ptrdiff_t>(keep),
-                      anatomy_order_.begin() + static_cast<std::ptrdiff_t>(n), [&](std::uint32_t a, std::uint32_t b) {
-                        return anatomy_contacts_[a].depth_m > anatomy_contacts_[b].depth_m;
-                      });
-    relaxed_add<std::uint64_t>(metrics_.rows_dropped, n - keep);
-  }
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, keep_deepest(anatomy_order_, n, keep, anatomy_contacts_));
   for (std::size_t r = 0; r < keep; ++r) {
     const haptic::SurfaceContact& c = anatomy_contacts_[anatomy_order_[r]];
     contact::ContactRow& row = rows_[row_count_++];

@@ -26,6 +26,7 @@
 #include "fahr/common/subscriber.h"
 #include "fahr/runtime/scene_transport.h"
 #include "fahr/runtime/service_main.h"
+#include "fahr/runtime/service_options.h"
 #include "fahr/scene/load_scene.h"
 #include "haptic_loop.h"
 #include "haptic_setup.h"
@@ -186,15 +187,8 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
 
 int run(int argc, char** argv) {
   CLI::App app{"fahr haptic/contact service"};
-  std::string scene_path, dds, domain, profile, mode;
-  double duration_s = -1;
-  app.add_option("--scene", scene_path, "scene file")->required();
-  app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds, inprocess");
-  app.add_option("--domain", domain, "DDS domain id 0-230");
-  app.add_option("--dds-profile", profile, "vendor XML configuration");
-  app.add_option("--duration-s", duration_s, "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");
-  app.add_option("--mode", mode, "realtime or lockstep (default: the scene's run.mode)")
-      ->check(CLI::IsMember({"realtime", "lockstep"}));
+  runtime::ServiceOptions options;
+  runtime::add_service_options(app, options);
   WaitPolicy wait;
   app.add_flag("--spin", wait.spin, "real time: busy-poll for DevicePoses (a core of its own) instead of sleeping");
   app.add_option("--rt-priority", wait.rt_priority,
@@ -207,9 +201,9 @@ int run(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // log lines reach a launcher's log file as they happen
 
-  const auto scene = scene::load_scene(scene_path);
-  const bool lockstep = mode.empty() ? scene->run.mode == scene::RunMode::kLockstep : mode == "lockstep";
-  if (duration_s < 0) duration_s = std::chrono::duration<double>(scene->run.duration).count();
+  const auto scene = scene::load_scene(options.scene_path);
+  const bool lockstep = options.lockstep(*scene);
+  const double duration_s = options.duration_or_scene_s(*scene);
   common::install_stop_handlers();
 
   const auto setup_start = Clock::now();
@@ -218,7 +212,7 @@ int run(int argc, char** argv) {
   HapticLoop loop(setup);
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
 
-  common::Participant participant(runtime::transport_for(*scene, dds, domain, profile, "haptic"));
+  common::Participant participant(runtime::transport_for(*scene, options.dds, options.domain, options.profile, "haptic"));
   common::TickRecorder recorder;
   // Real time: FEM states are digested on the feed's own thread.
   std::unique_ptr<TissueFeed> feed;

@@ -1,0 +1,27 @@
+// The options every scene-driven service takes (see service_options.h).
+#include "fahr/runtime/service_options.h"
+
+#include <chrono>
+
+namespace fahr::runtime {
+
+bool ServiceOptions::lockstep(const scene::Scene& scene) const {
+  return mode.empty() ? scene.run.mode == scene::RunMode::kLockstep : mode == "lockstep";
+}
+
+double ServiceOptions::duration_or_scene_s(const scene::Scene& scene) const {
+  return duration_s < 0 ? std::chrono::duration<double>(scene.run.duration).count() : duration_s;
+}
+
+void add_service_options(CLI::App& app, ServiceOptions& o) {
+  app.add_option("--scene", o.scene_path, "scene file")->required();
+  app.add_option("--dds", o.dds, "DDS vendor: fastdds, cyclonedds, inprocess");
+  app.add_option("--domain", o.domain, "DDS domain id 0-230");
+  app.add_option("--dds-profile", o.profile, "vendor XML configuration");
+  app.add_option("--duration-s", o.duration_s,
+                 "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");
+  app.add_option("--mode", o.mode, "realtime or lockstep (default: the scene's run.mode)")
+      ->check(CLI::IsMember({"realtime", "lockstep"}));
+}
+
+}  // namespace fahr::runtime
