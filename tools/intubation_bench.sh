@@ -7,7 +7,7 @@
 # tongue; prints the haptic tick's thread-CPU time (median, p99, p99.9,
 # max over the whole run) and the number of tick periods longer than 1.5 ms.
 #
-#   tools/intubation_bench.sh [BUILD_DIR] [--seconds 60] [--dds cyclonedds]
+#   tools/intubation_bench.sh [BUILD_DIR] [--seconds 60] [--dds cyclonedds] [--scene FILE]
 #
 # The script lasts 13 s; the gateway repeats it. Numbers depend on what
 # else the machine runs (three processes share its cores): compare the two
@@ -17,10 +17,12 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 build="$repo/build"
 seconds=60
 dds=cyclonedds
+scene_flags=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
     --dds) dds="$2"; shift 2 ;;
+    --scene) scene_flags=(--scene "$2"); shift 2 ;;
     -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     -*) echo "intubation_bench: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
@@ -32,7 +34,7 @@ trap 'rm -rf "$out"' EXIT
 for collision in aist triangle; do
   echo "intubation_bench: $collision, ${seconds} s ..." >&2
   FAHR_RUN_LOG_DIR="$out/$collision" bash "$repo/deployment/run_local.sh" "$build" --dds "$dds" \
-    --duration-s "$seconds" --haptic-collision "$collision" >"$out/$collision.txt" 2>&1 ||
+    --duration-s "$seconds" --haptic-collision "$collision" "${scene_flags[@]}" >"$out/$collision.txt" 2>&1 ||
     { cat "$out/$collision.txt" >&2; exit 1; }
 done
 
