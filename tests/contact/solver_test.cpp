@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <random>
+#include <vector>
 
 #include "fahr/contact/contact_solver.h"
 #include "fahr/contact/coupling.h"
 #include "fahr/contact/pgs.h"
+
 #include "synthetic.h"
 
 namespace fahr::contact {
@@ -17,10 +20,52 @@ TEST(Pgs, SolvesAKnownComplementarityProblem) {
   const double s[4] = {2, 1, 1, 2};
   const double b[2] = {1, -1};
   double lambda[2] = {0, 0};
-  const PgsReport report = solve_pgs(s, 2, 2, b, lambda, PgsSettings{});
+  double residual[2];
+  const PgsReport report = solve_pgs(s, 2, 2, b, lambda, residual, PgsSettings{});
   EXPECT_TRUE(report.converged);
   EXPECT_NEAR(lambda[0], 0.5, 1e-9);
   EXPECT_EQ(lambda[1], 0.0);
+}
+
+// Many coupled rows, like a blade on a tongue: S = G G^T + small diagonal
+// from random directions (strongly coupled, as neighbouring spheres are),
+// half the right-hand sides separating. The solution satisfies the
+// complementarity conditions, and the residual handed back is b - S lambda.
+TEST(Pgs, CoupledRowsMeetTheComplementarityConditions) {
+  constexpr std::size_t k = 48;
+  constexpr std::size_t stride = 50;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<double> g(k * 6);
+  for (double& v : g) v = uniform(random);
+  std::vector<double> s(k * stride, 0.0);
+  for (std::size_t i = 0; i < k; ++i) {
+    for (std::size_t j = 0; j < k; ++j) {
+      double dot = i == j ? 0.05 : 0.0;
+      for (std::size_t d = 0; d < 6; ++d) dot += g[i * 6 + d] * g[j * 6 + d];
+      s[i * stride + j] = 1e-3 * dot;  // m/N
+    }
+  }
+  std::vector<double> b(k), lambda(k, 0.0), residual(k);
+  for (double& v : b) v = 1e-3 * uniform(random);  // m
+  PgsSettings settings;
+  settings.max_sweeps = 5000;
+  const PgsReport report = solve_pgs(s.data(), stride, k, b.data(), lambda.data(), residual.data(), settings);
+  EXPECT_TRUE(report.converged);
+  int active = 0;
+  for (std::size_t i = 0; i < k; ++i) {
+    double w = -b[i];  // S lambda - b: the gap left open, m
+    for (std::size_t j = 0; j < k; ++j) w += s[i * stride + j] * lambda[j];
+    EXPECT_GE(lambda[i], 0.0);
+    EXPECT_GT(w, -1e-7) << "row " << i;
+    if (lambda[i] > 0.0) {
+      ++active;
+      EXPECT_NEAR(w, 0.0, 1e-7) << "row " << i;
+    }
+    EXPECT_NEAR(residual[i], -w, 1e-12) << "row " << i;
+  }
+  EXPECT_GT(active, 2);
+  EXPECT_LT(active, static_cast<int>(k));
 }
 
 TEST(ContactSolver, OneRowBalancesTheCouplingAgainstTheTissue) {

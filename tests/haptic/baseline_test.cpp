@@ -45,6 +45,33 @@ TEST(TriangleBaseline, BlockOnASlabAfterDeformation) {
   EXPECT_EQ(tissue_contacts, sunk);
 }
 
+// A blade edge poking into a tongue face between its vertices: no tissue
+// vertex is inside the tool, so only tool-vertex contacts exist; each acts on
+// the nearest corner of the tongue face it is behind, pushing it inward.
+TEST(TriangleBaseline, ToolVertexContactsActOnTheNearestFaceCorner) {
+  const auto mesh = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 4);  // 2.5 mm grid
+  std::vector<geometry::Index> surface_to_node;
+  const geometry::SurfaceMesh tissue = mesh.boundary_surface(&surface_to_node);
+  // A 1.8 mm square peg whose bottom is 0.1 mm below the top face (y = 10 mm).
+  const geometry::SurfaceMesh peg = test::box_surface({0.0031, 0.0099, 0.0031}, {0.0049, 0.02, 0.0049});
+  TriangleBaseline baseline(tissue, surface_to_node, peg);
+  std::vector<TriangleContact> contacts;
+  baseline.collide(Eigen::Isometry3d::Identity(), contacts);
+  ASSERT_FALSE(contacts.empty());
+  for (const auto& c : contacts) {
+    EXPECT_LT(c.tissue_vertex, 0);
+    ASSERT_GE(c.tool_vertex, 0);
+    ASSERT_GE(c.acting_tissue_vertex, 0);
+    EXPECT_NEAR(c.depth_m, 1e-4, 1e-12);
+    EXPECT_NEAR(c.normal.y(), -1.0, 1e-12);
+    const Eigen::Vector3d corner = tissue.vertices()[static_cast<std::size_t>(c.acting_tissue_vertex)];
+    EXPECT_NEAR(corner.y(), 0.01, 1e-12);
+    // The 2.5 mm grid vertex nearest the peg's corner.
+    EXPECT_NEAR(corner.x(), c.point_m.x() < 0.004 ? 0.0025 : 0.005, 1e-12);
+    EXPECT_NEAR(corner.z(), c.point_m.z() < 0.004 ? 0.0025 : 0.005, 1e-12);
+  }
+}
+
 TEST(TriangleBaseline, EmptyOrMismatchedInputIsRefused) {
   const geometry::SurfaceMesh box = test::box_surface({0, 0, 0}, {0.01, 0.01, 0.01});
   EXPECT_THROW(TriangleBaseline(geometry::SurfaceMesh{}, {}, box), std::invalid_argument);

@@ -7,8 +7,10 @@
 //   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--seconds 4]
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <vector>
 
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
@@ -31,8 +33,25 @@ int main(int argc, char** argv) {
     const auto steps = static_cast<std::uint64_t>(seconds * 1000.0 + 0.5);
     const auto start = std::chrono::steady_clock::now();
     double peak_force = 0.0;
+    // The contact solve's share of a tick: PGS row visits x rows (the cost
+    // in k-long dot products) and solves per tick, and how many hit the cap.
+    std::vector<double> pgs_cost;
+    std::vector<double> pgs_solves;
+    std::vector<double> rows;
+    std::uint64_t unconverged = 0;
+    // Wall time of the tick's phases (a preempted tick shows in the tail).
+    std::vector<double> tissue_query_us, anatomy_query_us, response_us;
     for (std::uint64_t k = 0; k < steps; ++k) {
       sim.step();
+      const auto& report = sim.haptic().response().report();
+      pgs_cost.push_back(static_cast<double>(report.pgs_work.row_visits) * static_cast<double>(report.load.rows));
+      pgs_solves.push_back(report.pgs_work.solves);
+      rows.push_back(static_cast<double>(report.load.rows));
+      unconverged += report.pgs_work.unconverged;
+      const auto& phases = sim.haptic().last_phases();
+      tissue_query_us.push_back(phases.tissue_query_us);
+      anatomy_query_us.push_back(phases.anatomy_query_us);
+      response_us.push_back(phases.response_us);
       const auto& f = sim.command().force_n();
       peak_force = std::max(peak_force, std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z()));
     }
@@ -47,6 +66,24 @@ int main(int argc, char** argv) {
     const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
     std::printf("stack_sim: haptic tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f\n", us(cpu.percentile(0.5)),
                 us(cpu.percentile(0.99)), us(cpu.percentile(0.999)), us(cpu.max()));
+    const auto quantile = [](std::vector<double> v, double q) {
+      if (v.empty()) return 0.0;
+      const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(i), v.end());
+      return v[i];
+    };
+    std::printf("stack_sim: rows per tick p50 %.0f p99 %.0f max %.0f; PGS solves per tick p99 %.0f max %.0f; "
+                "PGS row visits x rows p50 %.0f p99 %.0f p99.9 %.0f max %.0f; unconverged solves %llu\n",
+                quantile(rows, 0.5), quantile(rows, 0.99), quantile(rows, 1.0), quantile(pgs_solves, 0.99),
+                quantile(pgs_solves, 1.0), quantile(pgs_cost, 0.5), quantile(pgs_cost, 0.99), quantile(pgs_cost, 0.999),
+                quantile(pgs_cost, 1.0), static_cast<unsigned long long>(unconverged));
+    const auto print_phase = [&](const char* name, const std::vector<double>& wall_us) {
+      std::printf("stack_sim: tick phase %-14s wall us p50 %.1f p99 %.1f p99.9 %.1f\n", name, quantile(wall_us, 0.5),
+                  quantile(wall_us, 0.99), quantile(wall_us, 0.999));
+    };
+    print_phase("tissue query", tissue_query_us);
+    print_phase("anatomy query", anatomy_query_us);
+    print_phase("response", response_us);
     std::printf("lockstep_clock: hash device_gateway %016llx\n", static_cast<unsigned long long>(sim.gateway_hash()));
     std::printf("lockstep_clock: hash fem %016llx\n", static_cast<unsigned long long>(sim.fem_hash()));
     std::printf("lockstep_clock: hash haptic %016llx\n", static_cast<unsigned long long>(sim.haptic_hash()));

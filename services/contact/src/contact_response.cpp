@@ -252,6 +252,7 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
 const ForceOutput& ContactResponse::tick(const TickInput& input) {
   const DeviceSample& device = input.device;
   report_ = TickReport{};
+  solver_.reset_work();
   const Eigen::Vector3d p0 = proxy_.position_m;
   const EffectiveCoupling coupling = effective_coupling(settings_.coupling, device.max_stiffness_npm, device.dt_s,
                                                         device.position_m, device.velocity_mps, p0);
@@ -308,6 +309,7 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   out.active_contacts = 0;
   for (std::size_t i = 0; i < solver_.size(); ++i) out.active_contacts += solver_.lambda(i) > 0.0 ? 1u : 0u;
   out.fem_step = input.compliance.fem_step;
+  report_.pgs_work = solver_.work();
   previous_reaction_n_ = solved_reaction;
 
   // The FEM sees the tool where the proxy is; the naive loop's tool is the

@@ -38,6 +38,7 @@ ContactSolver::ContactSolver(std::size_t capacity)
       b_(capacity, 0.0),
       depth_(capacity, 0.0),
       lambda_(capacity, 0.0),
+      residual_(capacity, 0.0),
       fallback_diagonal_(capacity, 0.0),
       previous_keys_(capacity, 0),
       previous_lambda_(capacity, 0.0),
@@ -89,6 +90,7 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows, const Tis
       a_[i * capacity_ + j] = value;
     }
   }
+  report.rows = k_;
   // Warm start: the previous tick's lambda of the same (kind, id).
   for (std::size_t i = 0; i < k_; ++i) {
     const std::uint64_t key = row_key(rows_[i]);
@@ -119,7 +121,8 @@ Eigen::Vector3d ContactSolver::solve_coupled(double k_eff_npm, const Eigen::Vect
     }
     b_[i] = depth_[i] + ni.dot(target_offset_m);
   }
-  report_ = solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), settings);
+  report_ = solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), residual_.data(), settings);
+  work_.add(report_, k_);
   Eigen::Vector3d push = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < k_; ++i) push += rows_[i].normal * lambda_[i];
   return target_offset_m - push * inverse_k;
@@ -130,7 +133,8 @@ void ContactSolver::solve_pinned(const Eigen::Vector3d& proxy_offset_m, const Pg
     for (std::size_t j = 0; j < k_; ++j) s_[i * capacity_ + j] = a_[i * capacity_ + j];
     b_[i] = depth_[i] + rows_[i].normal.dot(proxy_offset_m);
   }
-  report_ = solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), settings);
+  report_ = solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), residual_.data(), settings);
+  work_.add(report_, k_);
 }
 
 bool ContactSolver::has_obstacle_rows() const {
@@ -154,7 +158,7 @@ Eigen::Vector3d ContactSolver::project_on_obstacles(const Eigen::Vector3d& step_
   }
   double deepest = 0.0;
   for (std::size_t a = 0; a < n; ++a) deepest = std::max(deepest, projection_b_[a]);
-  solve_pgs(projection_s_.data(), capacity_, n, projection_b_.data(), projection_mu_.data(), settings);
+  work_.add(solve_pgs(projection_s_.data(), capacity_, n, projection_b_.data(), projection_mu_.data(), residual_.data(), settings), n);
   Eigen::Vector3d push = Eigen::Vector3d::Zero();
   for (std::size_t a = 0; a < n; ++a) push += rows_[obstacle_rows_[a]].normal * projection_mu_[a];
   // Rows pinching the tool from opposite sides have no common solution and

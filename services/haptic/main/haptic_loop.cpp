@@ -141,21 +141,22 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
   }
 }
 
-// The baseline's vertex-face contacts as rows of the same response: each
-// penetrating tongue vertex speaks for the sphere nearest it at rest (its
-// compliance, its ContactSet entry), the deepest vertex per sphere. The
-// vertex comes from the published (projected) positions; it is moved by its
-// sphere's free-motion offset, as the AIST rows use the free centres.
-// Contacts where a tool vertex is inside the tissue have no tissue vertex
-// and give no row (they are found, and timed, all the same).
+// The baseline's vertex-face contacts as rows of the same response, both
+// kinds: a tongue vertex behind a blade face, and a blade vertex (the edge of
+// the blade's tip, its flange) behind a tongue face. Each acts on a tongue
+// vertex (the penetrating one, or the nearest corner of the face), which
+// speaks for the sphere nearest it at rest (its compliance, its ContactSet
+// entry); the deepest contact per sphere is kept. The tissue point comes
+// from the published (projected) positions; it is moved by its sphere's
+// free-motion offset, as the AIST rows use the free centres.
 void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
   tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_);
   const auto& vertex_sphere = setup_.triangles->vertex_sphere;
   std::size_t slots = 0;
   for (std::size_t i = 0; i < triangle_contacts_.size() && slots < sphere_contact_.size(); ++i) {
     const haptic::TriangleContact& c = triangle_contacts_[i];
-    if (c.tissue_vertex < 0) continue;
-    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.tissue_vertex)];
+    if (c.acting_tissue_vertex < 0) continue;
+    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.acting_tissue_vertex)];
     const std::int32_t slot = row_of_sphere_[sphere];
     if (slot < 0) {
       row_of_sphere_[sphere] = static_cast<std::int32_t>(slots);
@@ -173,13 +174,15 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
   const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
   for (std::size_t r = 0; r < keep; ++r) {
     const haptic::TriangleContact& c = triangle_contacts_[sphere_contact_[r]];
-    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.tissue_vertex)];
+    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.acting_tissue_vertex)];
     contact::ContactRow& row = rows_[row_count_++];
     row.kind = contact::RowKind::kTissue;
     row.id = sphere;
     row.normal = c.normal;
     row.tool_point_m = c.point_m;
-    row.other_point_m = c.point_m - c.depth_m * c.normal;  // the vertex: depth = -(v - q) . n
+    // The tissue point: the vertex, or the tool vertex's foot on the face;
+    // either way depth = -(p - q) . n.
+    row.other_point_m = c.point_m - c.depth_m * c.normal;
     row.radius_m = 0.0;
     row.compliance_index = tissue.compliance_index[sphere];
     if (free_centres && row.compliance_index >= 0) {
@@ -234,6 +237,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   const Eigen::Vector3d tool_at = setup_.penalty ? device.position_m : response_.proxy().position_m;
   tool_body_.world_from_body = Eigen::Translation3d(tool_at) * device.orientation;
   row_count_ = 0;
+  const auto query_start = std::chrono::steady_clock::now();
   if (setup_.collision == CollisionMethod::kTriangle && tissue.triangles) {
     collect_triangle_rows(tissue);
   } else {
@@ -244,7 +248,9 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
     collect_tissue_rows(tissue);
   }
   const std::size_t tissue_rows = row_count_;
+  const auto anatomy_start = std::chrono::steady_clock::now();
   collect_anatomy_rows(tool_body_.world_from_body);
+  const auto response_start = std::chrono::steady_clock::now();
 
   const contact::ForceOutput* output = nullptr;
   if (setup_.penalty) {
@@ -258,6 +264,11 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
     output = &response_.tick(input);
   }
   const contact::ForceOutput& out = *output;
+  const auto response_end = std::chrono::steady_clock::now();
+  using Micro = std::chrono::duration<double, std::micro>;
+  phases_.tissue_query_us = Micro(anatomy_start - query_start).count();
+  phases_.anatomy_query_us = Micro(response_start - anatomy_start).count();
+  phases_.response_us = Micro(response_end - response_start).count();
 
   fill_command(out, pose.device_id(), command);
   command.header().sim_step(pose.servo_tick());

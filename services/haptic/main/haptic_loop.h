@@ -48,6 +48,16 @@ struct LoopMetrics {
   std::atomic<double> tick_us_peak{0.0};
 };
 
+// Where the last tick's time went (steady clock, us): finding the tool's
+// contacts with the tissue (AIST query or triangle baseline, and the row
+// selection), with the rigid anatomy, and the contact response (solve,
+// decision, ContactSet). Read in the loop's thread (benchmarks, stack_sim).
+struct TickPhases {
+  double tissue_query_us = 0.0;
+  double anatomy_query_us = 0.0;
+  double response_us = 0.0;
+};
+
 // Rows the tool may have against rigid anatomy per tick: one per sample
 // leaf touching (~5 mm of blade each), the deepest kept.
 inline constexpr std::size_t kMaxAnatomyRows = 16;
@@ -62,6 +72,7 @@ class HapticLoop {
 
   const contact::ContactResponse& response() const { return response_; }
   const LoopMetrics& metrics() const { return metrics_; }
+  const TickPhases& last_phases() const { return phases_; }
   // Also resets the per-report maxima (reporter thread).
   void append_metrics(std::vector<std::pair<std::string, double>>& out);
 
@@ -105,6 +116,7 @@ class HapticLoop {
   std::uint64_t last_servo_tick_ = 0;
   std::uint64_t tick_ = 0;
   LoopMetrics metrics_;
+  TickPhases phases_;
 };
 
 }  // namespace fahr::haptic_service

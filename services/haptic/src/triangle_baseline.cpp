@@ -52,6 +52,7 @@ struct Best {
   double depth = std::numeric_limits<double>::infinity();
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  std::int32_t acting_tissue_vertex = -1;
 };
 
 }  // namespace
@@ -128,14 +129,15 @@ void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::ve
   m.touched_tissue.clear();
   m.touched_tool.clear();
   auto offer = [&](std::vector<Best>& best, std::vector<std::uint32_t>& stamp, std::vector<std::uint32_t>& touched,
-                   std::uint32_t vertex, double depth, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
+                   std::uint32_t vertex, double depth, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                   std::int32_t acting_tissue_vertex) {
     if (stamp[vertex] != m.stamp) {
       stamp[vertex] = m.stamp;
       best[vertex] = Best{};
       touched.push_back(vertex);
     }
     // The smallest depth among faces the vertex is behind: the way out.
-    if (depth < best[vertex].depth) best[vertex] = Best{depth, point, normal};
+    if (depth < best[vertex].depth) best[vertex] = Best{depth, point, normal, acting_tissue_vertex};
   };
   for (int k = 0; k < m.pairs.size(); ++k) {
     const auto& tt = m.tissue.triangles[static_cast<std::size_t>(m.pairs[k].m_index1)];
@@ -149,7 +151,8 @@ void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::ve
     for (int v = 0; v < 3; ++v) {  // tissue vertices behind the tool face
       const double d = sn.dot(t[v] - s[0]);
       if (d < 0.0 && d > -kMaxFaceDepthM && in_prism(t[v], s[0], s[1], s[2], sn)) {
-        offer(m.tissue_best, m.tissue_stamp, m.touched_tissue, static_cast<std::uint32_t>(tt[v]), -d, t[v] - d * sn, sn);
+        offer(m.tissue_best, m.tissue_stamp, m.touched_tissue, static_cast<std::uint32_t>(tt[v]), -d, t[v] - d * sn, sn,
+              static_cast<std::int32_t>(tt[v]));
       }
     }
     if (tn_len <= 0.0) continue;  // a collapsed tissue triangle has no side
@@ -157,17 +160,22 @@ void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::ve
     for (int v = 0; v < 3; ++v) {  // tool vertices behind the tissue face
       const double d = tn.dot(s[v] - t[0]);
       if (d < 0.0 && d > -kMaxFaceDepthM && in_prism(s[v], t[0], t[1], t[2], tn)) {
-        offer(m.tool_best, m.tool_stamp, m.touched_tool, static_cast<std::uint32_t>(st[v]), -d, s[v], -tn);
+        int nearest = 0;
+        for (int c = 1; c < 3; ++c) {
+          if ((t[c] - s[v]).squaredNorm() < (t[nearest] - s[v]).squaredNorm()) nearest = c;
+        }
+        offer(m.tool_best, m.tool_stamp, m.touched_tool, static_cast<std::uint32_t>(st[v]), -d, s[v], -tn,
+              static_cast<std::int32_t>(tt[nearest]));
       }
     }
   }
   for (const std::uint32_t v : m.touched_tissue) {
     const Best& b = m.tissue_best[v];
-    out.push_back({b.point, b.normal, b.depth, static_cast<std::int32_t>(v), -1});
+    out.push_back({b.point, b.normal, b.depth, static_cast<std::int32_t>(v), -1, b.acting_tissue_vertex});
   }
   for (const std::uint32_t v : m.touched_tool) {
     const Best& b = m.tool_best[v];
-    out.push_back({b.point, b.normal, b.depth, -1, static_cast<std::int32_t>(v)});
+    out.push_back({b.point, b.normal, b.depth, -1, static_cast<std::int32_t>(v), b.acting_tissue_vertex});
   }
 }
 

@@ -73,6 +73,7 @@ struct TickReport {
   TrackingState state = TrackingState::kTracking;
   SolverLoadReport load;
   PgsReport pgs;
+  PgsWork pgs_work;  // all of this tick's solves
   bool contacts_overflow = false;  // ContactSet entries dropped
   bool holds_overflow = false;     // spheres not held while frozen
   bool catch_up_limited = false;   // the proxy moved at the catch-up speed bound

@@ -17,6 +17,7 @@
 namespace fahr::contact {
 
 struct SolverLoadReport {
+  std::size_t rows = 0;          // rows loaded
   bool overflow = false;         // more rows than capacity: the extra rows were dropped
   int missing_compliance = 0;    // tissue rows without a W block: fallback compliance used
   int degenerate_normals = 0;    // rows whose normal is not unit length: dropped
@@ -77,6 +78,9 @@ class ContactSolver {
   // motion of row i's sphere centre under the solved forces, m.
   Eigen::Vector3d predicted_motion(std::size_t i, const TissueCompliance& compliance) const;
   const PgsReport& last_report() const { return report_; }
+  // PGS work since the last reset_work() (every solve and projection).
+  const PgsWork& work() const { return work_; }
+  void reset_work() { work_ = PgsWork{}; }
 
  private:
   std::size_t capacity_;
@@ -87,6 +91,7 @@ class ContactSolver {
   std::vector<double> b_;       // right-hand side, m
   std::vector<double> depth_;   // d at p0, m
   std::vector<double> lambda_;  // N
+  std::vector<double> residual_;  // PGS workspace, m
   std::vector<double> fallback_diagonal_;  // per row: 1 if A_ii came from the fallback
   std::vector<std::uint64_t> previous_keys_;
   std::vector<double> previous_lambda_;
@@ -99,6 +104,7 @@ class ContactSolver {
   std::vector<double> projection_b_;
   std::vector<double> projection_mu_;
   PgsReport report_;
+  PgsWork work_;
 };
 
 }  // namespace fahr::contact

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 namespace fahr::contact {
 
@@ -26,9 +27,25 @@ struct PgsReport {
   double last_change_m = 0.0;  // largest S_ii |d lambda_i| of the last sweep, m
 };
 
-// s: k x k, row stride `stride` (>= k), m/N. b: k, m. lambda: k, N, holds
-// the warm start on entry and the solution on exit.
+// PGS work over several solves (a tick runs one to a dozen): a row visit
+// costs one k-long dot product, so row visits x k is the tick's PGS cost.
+struct PgsWork {
+  std::uint32_t solves = 0;
+  std::uint32_t sweeps = 0;
+  std::uint32_t unconverged = 0;  // solves that hit max_sweeps
+  std::uint64_t row_visits = 0;
+  void add(const PgsReport& report, std::size_t k) {
+    ++solves;
+    sweeps += static_cast<std::uint32_t>(report.sweeps);
+    unconverged += report.converged ? 0u : 1u;
+    row_visits += static_cast<std::uint64_t>(report.sweeps) * k;
+  }
+};
+
+// s: k x k, symmetric, row stride `stride` (>= k), m/N. b: k, m. lambda: k,
+// N, holds the warm start on entry and the solution on exit. residual: k
+// doubles of workspace (b - S lambda on exit).
 PgsReport solve_pgs(const double* s, std::size_t stride, std::size_t k, const double* b, double* lambda,
-                    const PgsSettings& settings);
+                    double* residual, const PgsSettings& settings);
 
 }  // namespace fahr::contact

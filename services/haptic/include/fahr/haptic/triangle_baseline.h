@@ -24,6 +24,9 @@ struct TriangleContact {
   double depth_m = 0.0;                               // > 0, m
   std::int32_t tissue_vertex = -1;  // the penetrating tissue vertex, or -1
   std::int32_t tool_vertex = -1;    // the penetrating tool vertex, or -1
+  // The tissue vertex the contact acts on: the penetrating one, or for a
+  // tool vertex the nearest corner of the tissue face it is behind.
+  std::int32_t acting_tissue_vertex = -1;
 };
 
 class TriangleBaseline {
