@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
     std::uint64_t unconverged = 0;
     // Wall time of the tick's phases (a preempted tick shows in the tail).
     std::vector<double> tissue_query_us, anatomy_query_us, response_us;
+    std::vector<double> query_nodes, query_spheres, query_contacts;  // the AIST query's work per tick
     for (std::uint64_t k = 0; k < steps; ++k) {
       sim.step();
       const auto& report = sim.haptic().response().report();
@@ -52,6 +53,9 @@ int main(int argc, char** argv) {
       tissue_query_us.push_back(phases.tissue_query_us);
       anatomy_query_us.push_back(phases.anatomy_query_us);
       response_us.push_back(phases.response_us);
+      query_nodes.push_back(phases.tissue_query.nodes_visited);
+      query_spheres.push_back(phases.tissue_query.spheres_tested);
+      query_contacts.push_back(phases.tissue_query.contacts);
       const auto& f = sim.command().force_n();
       peak_force = std::max(peak_force, std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z()));
     }
@@ -84,6 +88,11 @@ int main(int argc, char** argv) {
     print_phase("tissue query", tissue_query_us);
     print_phase("anatomy query", anatomy_query_us);
     print_phase("response", response_us);
+    std::printf("stack_sim: AIST query per tick: tree nodes p50 %.0f p99 %.0f, spheres tested p50 %.0f p99 %.0f, "
+                "contacts p50 %.0f p99 %.0f max %.0f\n",
+                quantile(query_nodes, 0.5), quantile(query_nodes, 0.99), quantile(query_spheres, 0.5),
+                quantile(query_spheres, 0.99), quantile(query_contacts, 0.5), quantile(query_contacts, 0.99),
+                quantile(query_contacts, 1.0));
     std::printf("lockstep_clock: hash device_gateway %016llx\n", static_cast<unsigned long long>(sim.gateway_hash()));
     std::printf("lockstep_clock: hash fem %016llx\n", static_cast<unsigned long long>(sim.fem_hash()));
     std::printf("lockstep_clock: hash haptic %016llx\n", static_cast<unsigned long long>(sim.haptic_hash()));

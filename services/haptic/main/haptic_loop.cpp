@@ -238,6 +238,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   tool_body_.world_from_body = Eigen::Translation3d(tool_at) * device.orientation;
   row_count_ = 0;
   const auto query_start = std::chrono::steady_clock::now();
+  phases_.tissue_query = {};
   if (setup_.collision == CollisionMethod::kTriangle && tissue.triangles) {
     collect_triangle_rows(tissue);
   } else {
@@ -245,6 +246,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
     const auto stats =
         haptic::query_spheres(tissue.tree, tissue.spheres, tool_body_, tool_query_, tool_memory_, tool_contacts_);
     if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
+    phases_.tissue_query = stats;
     collect_tissue_rows(tissue);
   }
   const std::size_t tissue_rows = row_count_;

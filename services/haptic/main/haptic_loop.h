@@ -56,6 +56,7 @@ struct TickPhases {
   double tissue_query_us = 0.0;
   double anatomy_query_us = 0.0;
   double response_us = 0.0;
+  haptic::QueryStats tissue_query;  // the AIST query's work (zero with the triangle baseline)
 };
 
 // Rows the tool may have against rigid anatomy per tick: one per sample
