@@ -72,6 +72,27 @@ TEST(TriangleBaseline, ToolVertexContactsActOnTheNearestFaceCorner) {
   }
 }
 
+// A tongue resting 0.5 mm above a 1.2 mm blade plate is behind the plate's
+// underside (1.7 mm, within the faces' depth range) but in front of its top
+// face, which is nearer: no contact, and with a 1 mm candidate margin a
+// candidate 0.5 mm away on the top face.
+TEST(TriangleBaseline, AVertexInFrontOfTheNearestFaceIsOutside) {
+  const auto mesh = test::block_tet_mesh({0, 0.0005, 0}, {0.01, 0.0105, 0.01}, 4);
+  std::vector<geometry::Index> surface_to_node;
+  const geometry::SurfaceMesh tissue = mesh.boundary_surface(&surface_to_node);
+  const geometry::SurfaceMesh plate = test::box_surface({-0.01, -0.0012, -0.01}, {0.02, 0.0, 0.02});
+  TriangleBaseline baseline(tissue, surface_to_node, plate);
+  std::vector<TriangleContact> contacts;
+  baseline.collide(Eigen::Isometry3d::Identity(), contacts);
+  EXPECT_TRUE(contacts.empty()) << contacts.size() << " contacts, the first " << contacts.front().depth_m << " m deep";
+  baseline.collide(Eigen::Isometry3d::Identity(), contacts, 1e-3);
+  ASSERT_FALSE(contacts.empty());
+  for (const auto& c : contacts) {
+    EXPECT_NEAR(c.depth_m, -0.5e-3, 1e-12);
+    EXPECT_NEAR(c.normal.y(), 1.0, 1e-12);
+  }
+}
+
 TEST(TriangleBaseline, EmptyOrMismatchedInputIsRefused) {
   const geometry::SurfaceMesh box = test::box_surface({0, 0, 0}, {0.01, 0.01, 0.01});
   EXPECT_THROW(TriangleBaseline(geometry::SurfaceMesh{}, {}, box), std::invalid_argument);

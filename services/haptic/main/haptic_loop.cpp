@@ -148,9 +148,11 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
 // speaks for the sphere nearest it at rest (its compliance, its ContactSet
 // entry); the deepest contact per sphere is kept. The tissue point comes
 // from the published (projected) positions; it is moved by its sphere's
-// free-motion offset, as the AIST rows use the free centres.
+// free-motion offset, as the AIST rows use the free centres. Vertices within
+// the candidate margin in front of a face are candidate rows, as the AIST's.
 void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
-  tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_);
+  // The AIST rows' candidate margin: both methods hand the solve the same kind of rows.
+  tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_, tool_query_.candidate_margin_m);
   const auto& vertex_sphere = setup_.triangles->vertex_sphere;
   std::size_t slots = 0;
   for (std::size_t i = 0; i < triangle_contacts_.size() && slots < sphere_contact_.size(); ++i) {

@@ -21,7 +21,7 @@ namespace fahr::haptic {
 struct TriangleContact {
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  // on the tool surface, world, m
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // from the tool toward the tissue, world
-  double depth_m = 0.0;                               // > 0, m
+  double depth_m = 0.0;  // > 0 touching; in (-candidate margin, 0] a candidate (a gap), m
   std::int32_t tissue_vertex = -1;  // the penetrating tissue vertex, or -1
   std::int32_t tool_vertex = -1;    // the penetrating tool vertex, or -1
   // The tissue vertex the contact acts on: the penetrating one, or for a
@@ -44,7 +44,12 @@ class TriangleBaseline {
   // refits the tissue tree.
   void update(std::span<const double> positions_m);
   // Contacts with the tool at world_from_tool into `out` (cleared first).
-  void collide(const Eigen::Isometry3d& world_from_tool, std::vector<TriangleContact>& out);
+  // candidate_margin_m, [0, kMaxFaceDepthM): vertices this close in front of
+  // a face are reported too, as candidates (the AIST query's candidates: the
+  // contact solve sees them before they touch). A vertex behind some face is
+  // never reported as another face's candidate.
+  void collide(const Eigen::Isometry3d& world_from_tool, std::vector<TriangleContact>& out,
+               double candidate_margin_m = 0.0);
 
   std::uint64_t refit_count() const;
   std::uint64_t rebuild_count() const;       // builds after construction: stays 0
