@@ -43,6 +43,29 @@ TEST(Projection, CentreMovesExactlyByCorrectionAndHeavyNodesMoveLess) {
   EXPECT_FALSE(move_sphere_centre(0, links, all_fixed, dc, positions));
 }
 
+TEST(Projection, TranslationSpreadMovesEveryFreeNodeAlike) {
+  SphereLinks links;
+  const std::array<std::uint32_t, 4> nodes = {0, 1, 2, 3};
+  const std::array<double, 4> weights = {0.1, 0.2, 0.3, 0.4};
+  ASSERT_EQ(links.add_sphere(nodes, weights, 0.001), "");
+  std::vector<double> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const std::vector<double> start = positions;
+  const std::vector<double> inverse_mass = {0.0, 1.0 / 0.002, 1.0 / 0.001, 1.0 / 0.01};  // node 0 fixed
+  const Eigen::Vector3d before = links.centre(0, positions.data());
+  const Eigen::Vector3d dc(0.003, -0.002, 0.0015);
+  ASSERT_TRUE(move_sphere_centre(0, links, inverse_mass, dc, positions, SphereSpread::kTranslation));
+  EXPECT_NEAR((links.centre(0, positions.data()) - before - dc).norm(), 0.0, 1e-15);
+  const Eigen::Vector3d expected = dc / 0.9;  // the free nodes carry 0.9 of the centre
+  for (int node = 1; node < 4; ++node) {
+    const Eigen::Vector3d moved(positions[3 * node] - start[3 * node], positions[3 * node + 1] - start[3 * node + 1],
+                                positions[3 * node + 2] - start[3 * node + 2]);
+    EXPECT_NEAR((moved - expected).norm(), 0.0, 1e-15) << node;
+  }
+  EXPECT_EQ(positions[0], 0.0);
+  const std::vector<double> all_fixed(4, 0.0);
+  EXPECT_FALSE(move_sphere_centre(0, links, all_fixed, dc, positions, SphereSpread::kTranslation));
+}
+
 TEST(Projection, FrozenConstraintHoldsExactly) {
   const TetMesh mesh = test::bar_mesh(2);
   BodySettings settings;

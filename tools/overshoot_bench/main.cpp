@@ -5,7 +5,17 @@
 // lockstep in this process (services/stack_sim). Printed side by side: the
 // force-aware response and the penalty baseline on the same script.
 //
-//   fahr_overshoot_bench [--scene FILE] [--factor 3] [--check]
+//   fahr_overshoot_bench [--scene FILE] [--factor 3] [--response both|force-aware|penalty]
+//                        [--fem-anatomy on|off] [--sphere-spread service|mass|translation]
+//                        [--trace FILE] [--check]
+//
+// --fem-anatomy off: the FEM leaves the anatomy to the haptic side's
+// obstacle contacts (as before the FEM kept its own nodes out of bone).
+// --sphere-spread: how the FEM shares a tool contact's correction among the
+// sphere's nodes (services/fem projection.h), instead of the service's choice.
+// --trace: one CSV line per FEM step of each run (FILE with the response's
+// name appended): inversions and where they are, the anatomy projection,
+// the tool's contacts.
 //
 // --check: exit 1 unless the force-aware run meets the targets
 // (no NaN, no inverted tet, tissue reaction within the limit + 5 % while
@@ -18,8 +28,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
+#include <string>
 
+#include "fahr/geometry/tet_quality.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
 
@@ -46,12 +59,18 @@ struct Result {
   double max_reengage_step_n = 0.0;
   double reengage_bound_n = 0.0;
   double max_penetration_m = 0.0;
+  double max_anatomy_depth_m = 0.0;  // deepest node into bone before the FEM moved it out
   int max_inverted = 0;
   double max_elastic_j = 0.0;
   double displacement_after_m = -1.0;  // 1 s after the blade left the tongue
   std::uint64_t lost_ticks = 0;
   bool finite = true;
   double wall_s = 0.0;
+  // Wall time of the base steps that ran a FEM step (the FEM step, the
+  // haptic tick and its digest together: an upper bound of the FEM's), ms.
+  double fem_base_step_mean_ms = 0.0, fem_base_step_max_ms = 0.0;
+  // Thread-CPU time of the FEM service's step alone, ms.
+  double fem_cpu_median_ms = 0.0, fem_cpu_p99_ms = 0.0, fem_cpu_max_ms = 0.0;
 };
 
 // Largest principal Green strain over the tets, |E| = |(F^T F - I) / 2|.
@@ -80,16 +99,108 @@ double max_displacement_m(const fem::Body& body) {
 
 Eigen::Vector3d vec(const msg::Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
-Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double factor) {
+// Inverted tets now, and how many of them lie within `near_m` of the
+// anatomy (a node that close to a bone's surface, or inside) and of the
+// blade at the proxy's pose (the tet's centroid).
+struct Inversions {
+  int count = 0;
+  int near_anatomy = 0;
+  int near_blade = 0;
+  double worst_rest_radius_ratio = 1.0;  // of the inverted tets at rest: are they the mesh's slivers?
+};
+
+Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
+  Inversions out;
+  const fem::Body& body = sim.body();
+  const geometry::TetMesh& mesh = sim.tongue_mesh();
+  const auto& proxy = sim.command().world_from_proxy();
+  const Eigen::Quaterniond q(proxy.orientation().w(), proxy.orientation().x(), proxy.orientation().y(),
+                             proxy.orientation().z());
+  const Eigen::Vector3d t = vec(proxy.position_m());
+  const auto& blade = *sim.haptic_setup().tool->sdf;
+  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+    const auto& tet = mesh.tets()[e];
+    Eigen::Matrix3d ds;
+    const Eigen::Vector3d x0 = body.position(tet[0]);
+    for (int c = 0; c < 3; ++c) ds.col(c) = body.position(tet[static_cast<std::size_t>(c) + 1]) - x0;
+    if ((ds * mesh.rest_data()[e].dm_inverse).determinant() > 0.0) continue;
+    ++out.count;
+    const auto& rest = mesh.rest_positions();
+    out.worst_rest_radius_ratio = std::min(
+        out.worst_rest_radius_ratio, geometry::tet_shape(rest[tet[0]], rest[tet[1]], rest[tet[2]], rest[tet[3]]).radius_ratio);
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    double nearest_bone = std::numeric_limits<double>::infinity();
+    for (const auto node : tet) {
+      const Eigen::Vector3d x = body.position(node);
+      centroid += 0.25 * x;
+      for (const auto& field : sim.fem().setup().anatomy) nearest_bone = std::min(nearest_bone, field->sample(x).distance_m);
+    }
+    if (nearest_bone < near_m) ++out.near_anatomy;
+    if (blade.query(q.conjugate() * (centroid - t)).distance_m < near_m) ++out.near_blade;
+  }
+  return out;
+}
+
+// Inverted tets of the FEM's free motion (the implicit step before any
+// projection): inversions the projection did not make.
+int inverted_free(const stack_sim::StackSim& sim) {
+  const auto x = sim.fem().contact_step().free_positions_m();
+  const geometry::TetMesh& mesh = sim.tongue_mesh();
+  const auto at = [&](std::size_t n) { return Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]); };
+  int count = 0;
+  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+    const auto& tet = mesh.tets()[e];
+    Eigen::Matrix3d ds;
+    for (int c = 0; c < 3; ++c) ds.col(c) = at(tet[static_cast<std::size_t>(c) + 1]) - at(tet[0]);
+    if ((ds * mesh.rest_data()[e].dm_inverse).determinant() <= 0.0) ++count;
+  }
+  return count;
+}
+
+struct ToolContacts {
+  int active = 0, frozen = 0, force_only = 0, obstacle = 0;
+};
+
+ToolContacts count_contacts(const msg::ContactSet& set) {
+  ToolContacts c;
+  for (const auto& contact : set.contacts()) {
+    if (contact.kind() == msg::CONTACT_OBSTACLE) {
+      ++c.obstacle;
+    } else if (contact.kind() == msg::CONTACT_FORCE_ONLY) {
+      ++c.force_only;
+    } else if (contact.state() == msg::CONSTRAINT_FROZEN) {
+      ++c.frozen;
+    } else if (contact.state() == msg::CONSTRAINT_ACTIVE) {
+      ++c.active;
+    }
+  }
+  return c;
+}
+
+Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double factor, bool fem_anatomy,
+           const std::string& spread, const std::string& trace_path) {
   auto variant = std::make_shared<scene::Scene>(*scene);
   variant->contact.response = penalty ? scene::ContactResponse::kPenalty : scene::ContactResponse::kForceAware;
   const auto start = std::chrono::steady_clock::now();
   stack_sim::StackOptions options;
   options.script = device::Script::kOvershoot;
   options.overshoot_factor = factor;
+  options.fem_anatomy = fem_anatomy;
+  if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
+  if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
   stack_sim::StackSim sim(variant, options);
   Result r;
   r.name = penalty ? "penalty" : "force-aware";
+  std::FILE* trace = nullptr;
+  if (!trace_path.empty()) {
+    const std::string path = trace_path + "." + r.name + ".csv";
+    trace = std::fopen(path.c_str(), "w");
+    if (trace == nullptr) throw std::runtime_error("cannot write " + path);
+    std::fprintf(trace,
+                 "t_s,inverted,inverted_near_anatomy,inverted_near_blade,anatomy_nodes,anatomy_depth_mm,"
+                 "anatomy_unresolved,anatomy_rounds,sweeps,tool_active,tool_frozen,force_only,obstacle_contacts,"
+                 "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,inverted_free,fem_cpu_ms\n");
+  }
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
   bool seen_1x = false, was_lost = false, reengaged = false, left = false;
@@ -97,8 +208,17 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
   Eigen::Vector3d freeze_proxy = Eigen::Vector3d::Zero(), previous_force = Eigen::Vector3d::Zero();
   Eigen::Vector3d previous_hand = Eigen::Vector3d::Zero(), previous_hand_v = Eigen::Vector3d::Zero();
   const auto steps = static_cast<std::uint64_t>((kScriptEndS + 1.5) * 1000.0);
+  double fem_step_total_ms = 0.0;
+  std::uint64_t fem_steps = 0;
   for (std::uint64_t k = 0; k < steps; ++k) {
+    const auto step_start = std::chrono::steady_clock::now();
     sim.step();
+    if (sim.fem_stepped()) {
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - step_start).count();
+      fem_step_total_ms += ms;
+      ++fem_steps;
+      r.fem_base_step_max_ms = std::max(r.fem_base_step_max_ms, ms);
+    }
     const msg::ForceCommand& c = sim.command();
     const msg::DevicePose& pose = sim.pose();
     const double limit = pose.renderable_force_n();
@@ -144,8 +264,22 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
     previous_hand = hand;
     if (sim.time_s() >= kHoldEndS && r.strain_3x == 0.0) r.strain_3x = max_green_strain(sim.body(), sim.tongue_mesh());
     if (sim.fem_stepped()) {
-      r.max_inverted = std::max(r.max_inverted, sim.fem().last_report().inverted_elements);
+      const fem::StepReport& report = sim.fem().last_report();
+      r.max_inverted = std::max(r.max_inverted, report.inverted_elements);
       r.max_elastic_j = std::max(r.max_elastic_j, sim.body().energy().elastic_j);
+      r.max_anatomy_depth_m = std::max(r.max_anatomy_depth_m, report.projection.obstacle_deepest_m);
+      if (trace != nullptr) {
+        // 1 mm: a tet that close to bone or blade is pressed by it.
+        const Inversions inv = locate_inversions(sim, 1e-3);
+        const ToolContacts tc = count_contacts(sim.contacts());
+        std::fprintf(trace, "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f\n", sim.time_s(), inv.count,
+                     inv.near_anatomy, inv.near_blade, report.projection.obstacle_nodes,
+                     1e3 * report.projection.obstacle_deepest_m, report.projection.obstacle_unresolved,
+                     report.projection.obstacle_rounds, report.projection.sweeps, tc.active, tc.frozen, tc.force_only,
+                     tc.obstacle, c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
+                     1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio, inverted_free(sim),
+                     1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()));
+      }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
     if (!left && sim.time_s() > kHoldEndS) {
@@ -161,6 +295,12 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
     if (left && k == left_step + 1000) r.displacement_after_m = max_displacement_m(sim.body());
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (fem_steps > 0) r.fem_base_step_mean_ms = fem_step_total_ms / static_cast<double>(fem_steps);
+  const auto ms = [](std::chrono::nanoseconds d) { return 1e-6 * static_cast<double>(d.count()); };
+  r.fem_cpu_median_ms = ms(sim.fem_step_cpu().percentile(0.5));
+  r.fem_cpu_p99_ms = ms(sim.fem_step_cpu().percentile(0.99));
+  r.fem_cpu_max_ms = ms(sim.fem_step_cpu().max());
+  if (trace != nullptr) std::fclose(trace);
   return r;
 }
 
@@ -171,7 +311,18 @@ int main(int argc, char** argv) {
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
   double factor = 3.0;
   bool check = false;
+  std::string response = "both";
+  std::string fem_anatomy = "on";
+  std::string trace_path;
+  std::string spread = "service";
   app.add_option("--scene", scene_path, "scene file");
+  app.add_option("--sphere-spread", spread, "how the FEM spreads a sphere's correction (default: the service's)")
+      ->check(CLI::IsMember({"service", "mass", "translation"}));
+  app.add_option("--response", response, "which response to run")
+      ->check(CLI::IsMember({"both", "force-aware", "penalty"}));
+  app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--trace", trace_path, "per-FEM-step CSV, FILE.<response>.csv");
   app.add_option("--factor", factor, "overshoot: the hand's pull as a multiple of the device's peak force")
       ->check(CLI::Range(1.0, 10.0));
   app.add_flag("--check", check, "exit 1 unless the force-aware run meets the targets");
@@ -179,8 +330,9 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     const auto scene = scene::load_scene(scene_path);
-    const Result fa = run(scene, false, factor);
-    const Result pe = run(scene, true, factor);
+    const bool anatomy = fem_anatomy == "on";
+    const Result fa = response != "penalty" ? run(scene, false, factor, anatomy, spread, trace_path) : Result{};
+    const Result pe = response != "force-aware" ? run(scene, true, factor, anatomy, spread, trace_path) : Result{};
     const auto mm = [](double m) { return 1e3 * m; };
     std::printf("## Overshoot on the neonatal tongue (%.0fx the device's peak force, hold 5 s)\n\n", factor);
     std::printf("| figure | force-aware | penalty |\n|---|---:|---:|\n");
@@ -195,13 +347,21 @@ int main(int argc, char** argv) {
     std::printf("| largest force step in 50 ms of re-engagement N (bound) | %.3f (%.3f) | - |\n",
                 fa.max_reengage_step_n, fa.reengage_bound_n);
     std::printf("| deepest tool penetration mm | %.2f | %.2f |\n", mm(fa.max_penetration_m), mm(pe.max_penetration_m));
+    std::printf("| deepest tongue node into the anatomy before the FEM moved it out mm | %.2f | %.2f |\n",
+                mm(fa.max_anatomy_depth_m), mm(pe.max_anatomy_depth_m));
     std::printf("| most inverted tets | %d | %d |\n", fa.max_inverted, pe.max_inverted);
     std::printf("| largest elastic energy mJ | %.2f | %.2f |\n", 1e3 * fa.max_elastic_j, 1e3 * pe.max_elastic_j);
     std::printf("| tongue displacement 1 s after the blade left mm | %.2f | %.2f |\n", mm(fa.displacement_after_m),
                 mm(pe.displacement_after_m));
     std::printf("| all finite | %s | %s |\n", fa.finite ? "yes" : "no", pe.finite ? "yes" : "no");
     std::printf("| wall time s | %.1f | %.1f |\n", fa.wall_s, pe.wall_s);
+    std::printf("| base step with a FEM step (FEM + haptic tick + digest) ms mean / max | %.2f / %.2f | %.2f / %.2f |\n",
+                fa.fem_base_step_mean_ms, fa.fem_base_step_max_ms, pe.fem_base_step_mean_ms, pe.fem_base_step_max_ms);
+    std::printf("| FEM step CPU ms median / p99 / max (period %.1f) | %.2f / %.2f / %.2f | %.2f / %.2f / %.2f |\n",
+                1e3 / scene->rates.fem_hz, fa.fem_cpu_median_ms, fa.fem_cpu_p99_ms, fa.fem_cpu_max_ms,
+                pe.fem_cpu_median_ms, pe.fem_cpu_p99_ms, pe.fem_cpu_max_ms);
     if (!check) return 0;
+    if (response == "penalty") throw std::runtime_error("--check needs the force-aware run");
     int failures = 0;
     const auto expect = [&](bool ok, const char* what) {
       std::printf("%s: %s\n", ok ? "ok" : "FAIL", what);

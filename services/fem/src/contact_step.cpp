@@ -19,13 +19,15 @@ bool carries_force(const Contact& c) {
 }  // namespace
 
 ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStepSettings& settings)
-    : body_(body), links_(links), settings_(settings) {
+    : body_(body), links_(links), settings_(settings), projection_settings_(body.settings().projection) {
+  projection_settings_.spread = settings_.spread;
   const std::size_t dofs = 3 * body.node_count();
   const std::size_t k = settings_.max_compliance_spheres;
   carry_n_.assign(dofs, 0.0);
   force_n_.assign(dofs, 0.0);
   free_positions_.assign(body.positions_m().begin(), body.positions_m().end());
   projected_.assign(dofs, 0.0);
+  start_positions_.assign(body.positions_m().begin(), body.positions_m().end());
   spheres_.reserve(k);
   lambda_n_.reserve(k);
   normals_.reserve(k);
@@ -57,7 +59,14 @@ bool ContactStep::fix_compliance_spheres(std::span<const std::uint32_t> spheres)
   return compliance_valid_;
 }
 
+void ContactStep::set_obstacles(std::span<const ObstacleField* const> fields,
+                                const ObstacleProjectionSettings& settings) {
+  obstacles_ = fields.empty() ? nullptr : std::make_unique<ObstacleProjection>(fields, body_.node_count(), settings);
+  projection_settings_.project_obstacle_contacts = obstacles_ == nullptr;
+}
+
 bool ContactStep::reset() {
+  if (obstacles_) obstacles_->forget_clearances();
   std::fill(carry_n_.begin(), carry_n_.end(), 0.0);
   std::fill(lambda_n_.begin(), lambda_n_.end(), 0.0);
   const auto x = body_.positions_m();
@@ -184,10 +193,38 @@ void ContactStep::update_free_centres() {
   }
 }
 
-void ContactStep::project(const ContactSet& contacts) {
+// Gauss-Seidel between the tool and the bone: the ContactSet's projection,
+// then the anatomy's pass; again while the anatomy's moves broke a tool
+// constraint, up to the round limit. The anatomy always has the last word.
+void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
+  const auto inverse_mass = body_.inverse_mass_per_kg();
+  const bool tool = contacts != nullptr && !contacts->contacts.empty();
+  const int rounds = obstacles_ ? obstacles_->settings().max_rounds : 1;
+  ProjectionReport anatomy;
+  int sweeps = 0;
+  if (obstacles_) obstacles_->begin_step();
+  for (int round = 0; round < rounds; ++round) {
+    if (tool) {
+      projection_ = project_contacts(*contacts, links_, inverse_mass, projection_settings_, projected_);
+      sweeps += projection_.sweeps;
+      // The anatomy's last pass moved nothing the tool constraints needed.
+      if (round > 0 && projection_.sweeps <= 1 && projection_.converged) break;
+    }
+    if (!obstacles_) break;
+    ++anatomy.obstacle_rounds;
+    if (obstacles_->project(projected_, inverse_mass, anatomy, start_positions_) == 0 || !tool) break;
+  }
+  projection_.sweeps = sweeps;
+  projection_.obstacle_rounds = anatomy.obstacle_rounds;
+  projection_.obstacle_nodes = anatomy.obstacle_nodes;
+  projection_.obstacle_unresolved = anatomy.obstacle_unresolved;
+  projection_.obstacle_non_finite = anatomy.obstacle_non_finite;
+  projection_.obstacle_deepest_m = anatomy.obstacle_deepest_m;
+}
+
+void ContactStep::project(const ContactSet* contacts) {
   std::copy(free_positions_.begin(), free_positions_.end(), projected_.begin());
-  projection_ = project_contacts(contacts, links_, body_.inverse_mass_per_kg(), body_.settings().projection,
-                                 projected_);
+  alternate_with_anatomy(contacts);
   const double h2 = body_.time_step_s() * body_.time_step_s();
   const auto mass = body_.mass_kg();
   for (std::size_t n = 0; n < body_.node_count(); ++n) {
@@ -205,13 +242,15 @@ void ContactStep::project(const ContactSet& contacts) {
 StepReport ContactStep::step(const ContactSet* contacts, std::span<const double> extra_forces_n) {
   collect(contacts);
   apply_forces(extra_forces_n);
+  const auto start = body_.positions_m();
+  std::copy(start.begin(), start.end(), start_positions_.begin());
   StepReport report = body_.step(nullptr, nullptr);
   const auto x = body_.positions_m();
   std::copy(x.begin(), x.end(), free_positions_.begin());
   update_compliance(report.refactorised);
   update_free_centres();
   projection_ = {};
-  if (contacts != nullptr && !contacts->contacts.empty()) project(*contacts);
+  if (obstacles_ || (contacts != nullptr && !contacts->contacts.empty())) project(contacts);
   report.projection = projection_;
   report.contacts_applied = contacts != nullptr;
   return report;

@@ -10,6 +10,24 @@ namespace {
 // normalised reliably (c == q at the haptic side) and is skipped.
 constexpr double kMinNormalLength = 1e-9;
 
+bool translate_sphere_nodes(std::size_t sphere, const SphereLinks& links, std::span<const double> inverse_mass_per_node,
+                            const Eigen::Vector3d& dc_m, std::span<double> positions_m) {
+  const auto nodes = links.nodes(sphere);
+  const auto weights = links.weights(sphere);
+  double free_weight = 0.0;  // the share of the centre the free nodes carry
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    if (inverse_mass_per_node[nodes[k]] > 0.0) free_weight += weights[k];
+  }
+  if (!(free_weight > 0.0)) return false;
+  const Eigen::Vector3d move = dc_m / free_weight;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    if (inverse_mass_per_node[nodes[k]] > 0.0) {
+      Eigen::Map<Eigen::Vector3d>(positions_m.data() + 3 * std::size_t{nodes[k]}) += move;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool contact_is_frozen(const Contact& contact) {
@@ -20,9 +38,17 @@ bool contact_is_projected(const Contact& contact) {
   return contact.state != ContactState::kCandidate && contact.kind != ContactKind::kForceOnly;
 }
 
+bool contact_is_projected(const Contact& contact, const ProjectionSettings& settings) {
+  if (contact.kind == ContactKind::kObstacle && !settings.project_obstacle_contacts) return false;
+  return contact_is_projected(contact);
+}
+
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
                         std::span<const double> inverse_mass_per_node, const Eigen::Vector3d& dc_m,
-                        std::span<double> positions_m) {
+                        std::span<double> positions_m, SphereSpread spread) {
+  if (spread == SphereSpread::kTranslation) {
+    return translate_sphere_nodes(sphere, links, inverse_mass_per_node, dc_m, positions_m);
+  }
   const auto nodes = links.nodes(sphere);
   const auto weights = links.weights(sphere);
   double denominator = 0.0;  // sum_j w_j^2 / m_j, 1/kg
@@ -43,7 +69,7 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
                                   const ProjectionSettings& settings, std::span<double> positions_m) {
   ProjectionReport report;
   for (const Contact& contact : contacts.contacts) {
-    if (contact_is_projected(contact)) ++report.constraints;
+    if (contact_is_projected(contact, settings)) ++report.constraints;
   }
   if (report.constraints == 0) return report;
   report.converged = false;
@@ -53,7 +79,7 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
     report.degenerate_normals = 0;
     report.unknown_spheres = 0;
     for (const Contact& contact : contacts.contacts) {
-      if (!contact_is_projected(contact)) continue;
+      if (!contact_is_projected(contact, settings)) continue;
       if (contact.sphere_id >= links.size()) {
         ++report.unknown_spheres;
         continue;
@@ -73,7 +99,7 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
         if (gap >= 0.0) continue;  // inequality satisfied: no correction
         dc = -gap * n;
       }
-      if (!move_sphere_centre(contact.sphere_id, links, inverse_mass_per_node, dc, positions_m)) {
+      if (!move_sphere_centre(contact.sphere_id, links, inverse_mass_per_node, dc, positions_m, settings.spread)) {
         ++report.unmovable;
         continue;
       }

@@ -6,28 +6,12 @@
 #include <stdexcept>
 #include <string>
 
-#include "fahr/geometry/surface_loader.h"
 #include "fahr/haptic/fill_spheres.h"
 #include "fahr/runtime/scene_bodies.h"
 #include "fahr/scene/plan.h"
 
 namespace fahr::haptic_service {
 namespace {
-
-std::unique_ptr<RigidField> rigid_field(const scene::Body& body) {
-  auto field = std::make_unique<RigidField>();
-  field->scene_body = &body;
-  field->surface = geometry::load_surface(body.mesh_path, body.mesh_scale);
-  geometry::SdfOptions options;
-  options.cell_size_m = body.rigid ? body.rigid->sdf_cell_m : options.cell_size_m;
-  try {
-    field->sdf = std::make_unique<geometry::SignedDistanceField>(field->surface, options);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("body '" + body.name + "' (" + body.mesh_path.string() + "): signed distance field: " +
-                             e.what());
-  }
-  return field;
-}
 
 contact::ResponseSettings response_settings(const scene::Scene& scene) {
   contact::ResponseSettings s;
@@ -83,7 +67,7 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision) {
   } catch (const std::exception& e) {
     throw std::runtime_error("body '" + setup.deformable->name + "': AIST: " + e.what());
   }
-  setup.tool = rigid_field(scene.bodies[*plan.tool_body]);
+  setup.tool = runtime::load_rigid_field(scene.bodies[*plan.tool_body]);
   try {
     setup.tool_samples = haptic::SurfaceSamples(setup.tool->surface, haptic::SurfaceSampleSettings{});
   } catch (const std::exception& e) {
@@ -94,7 +78,7 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision) {
   const auto anatomy_index = [&](std::size_t body) {
     if (anatomy_of_body[body] == SIZE_MAX) {
       anatomy_of_body[body] = setup.anatomy.size();
-      setup.anatomy.push_back(rigid_field(scene.bodies[body]));
+      setup.anatomy.push_back(runtime::load_rigid_field(scene.bodies[body]));
     }
     return anatomy_of_body[body];
   };

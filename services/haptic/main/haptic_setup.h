@@ -17,17 +17,14 @@
 #include "fahr/haptic/fill_settings.h"
 #include "fahr/haptic/sphere_layout.h"
 #include "fahr/haptic/surface_samples.h"
+#include "fahr/runtime/rigid_field.h"
 #include "fahr/scene/scene.h"
 
 namespace fahr::haptic_service {
 
-// A rigid body's surface and its field. Held through a pointer so the field
-// (which refers to the surface's triangles) never sees its surface move.
-struct RigidField {
-  const scene::Body* scene_body = nullptr;
-  geometry::SurfaceMesh surface;  // body frame, m
-  std::unique_ptr<geometry::SignedDistanceField> sdf;
-};
+// A rigid body's surface and its field, built as the FEM service builds the
+// same anatomy's (services/runtime).
+using RigidField = runtime::RigidField;
 
 // How the tool's contacts with the deformable body are found.
 enum class CollisionMethod {

@@ -42,6 +42,8 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   haptic_ = std::make_unique<haptic_service::HapticLoop>(haptic_setup_);
   digest_ = std::make_unique<haptic_service::TissueDigest>(haptic_setup_);
   tissue_ = digest_->make_snapshot();
+  fem_setup_.enforce_anatomy = options.fem_anatomy;
+  if (options.sphere_spread) fem_setup_.sphere_spread = *options.sphere_spread;
   fem_ = std::make_unique<fem_service::ServiceStep>(fem_setup_);
   contacts_.contacts().reserve(msg::MAX_CONTACTS);
   next_contacts_.contacts().reserve(msg::MAX_CONTACTS);
@@ -87,7 +89,10 @@ void StackSim::step() {
   fem_stepped_ = common::executes_at(k, fem_period_);
   if (fem_stepped_) {
     if (k > 0) fem_->take(contacts_, contacts_.header().seq());
+    const std::int64_t cpu0 = common::thread_cpu_now_ns();
     fem_->step();
+    last_fem_step_cpu_ = std::chrono::nanoseconds(common::thread_cpu_now_ns() - cpu0);
+    fem_step_cpu_.record(last_fem_step_cpu_);
     fem_->state().header().sim_step(k);
     fem_->state().header().sim_time_ns(now_ns);
     fem_hash_.add(fem_->state());

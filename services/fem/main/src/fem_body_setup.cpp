@@ -77,6 +77,7 @@ FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body) {
   auto created = fem::Body::create(setup.settings, setup.mesh.rest_positions(), tets, setup.fixed_nodes);
   if (!created.body) throw std::runtime_error("body '" + body.name + "': " + created.error);
   setup.body = std::move(created.body);
+  setup.anatomy = load_anatomy_fields(scene, body);
   return setup;
 }
 

@@ -11,8 +11,14 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
     : setup_(setup),
       contact_step_(*setup.body, setup.links,
                     fem::ContactStepSettings{.apply_contact_forces = true,
-                                             .max_compliance_spheres = setup.settings.max_compliance_spheres}) {
+                                             .max_compliance_spheres = setup.settings.max_compliance_spheres,
+                                             .spread = setup.sphere_spread}) {
   const std::size_t cap = setup.settings.max_compliance_spheres;
+  std::vector<const fem::ObstacleField*> anatomy;
+  if (setup.enforce_anatomy) {
+    for (const auto& field : setup.anatomy) anatomy.push_back(field.get());
+  }
+  contact_step_.set_obstacles(anatomy, setup.anatomy_settings);
   contacts_.contacts.reserve(msg::MAX_CONTACTS);
   state_.positions_m().reserve(3 * setup.mesh.node_count());
   state_.velocities_mps().reserve(3 * setup.mesh.node_count());
@@ -34,6 +40,7 @@ void ServiceStep::step() {
   if (have_contacts_ && !usable) ++stale_sets_;
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
   inverted_max_ = std::max<std::uint64_t>(inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
+  anatomy_depth_max_m_ = std::max(anatomy_depth_max_m_, last_report_.projection.obstacle_deepest_m);
   fill_state(*setup_.body, setup_.scene_body->id, state_);
   state_.stale_contact_sets(static_cast<std::uint32_t>(stale_sets_));
   state_.applied_contact_seq(usable ? applied_contact_seq_ : 0);
@@ -58,6 +65,9 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("compliance_reuses", static_cast<double>(contact_step_.compliance_reuses()));
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));
   out.emplace_back("projection_sweeps_last", static_cast<double>(last_report_.projection.sweeps));
+  out.emplace_back("anatomy_nodes_last", static_cast<double>(last_report_.projection.obstacle_nodes));
+  out.emplace_back("anatomy_depth_mm_max", 1e3 * anatomy_depth_max_m_);
+  out.emplace_back("anatomy_unresolved_last", static_cast<double>(last_report_.projection.obstacle_unresolved));
   out.emplace_back("solver_iterations_last", static_cast<double>(last_report_.solver_iterations));
   out.emplace_back("asleep", setup_.body->asleep() ? 1.0 : 0.0);
   out.emplace_back("nodes", static_cast<double>(setup_.mesh.node_count()));

@@ -12,7 +12,11 @@
 //   3. the Algorithm 1 projection of the ContactSet on the free motion,
 //      written back to the body; its velocity correction (x~ - x_free)/h is
 //      carried into the next step as the nodal force m (x~ - x_free)/h^2, so
-//      the next right-hand side M (v + dx/h) + h f is exactly Algorithm 1's.
+//      the next right-hand side M (v + dx/h) + h f is exactly Algorithm 1's;
+//   4. with obstacles set, the body's own non-penetration of the static
+//      anatomy on these positions (obstacle_projection.h), alternated with
+//      the ContactSet's projection so the tool cannot press a node into bone;
+//      its moves join the same carried correction.
 // The projection is done here, not by Body::step, because step 2 needs the
 // motion before it. Staleness of a ContactSet is the caller's decision.
 // Capacities are fixed at construction: nothing allocates per step once the
@@ -21,11 +25,14 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "fahr/fem/body.h"
 #include "fahr/fem/contact_set.h"
+#include "fahr/fem/obstacle_field.h"
+#include "fahr/fem/obstacle_projection.h"
 #include "fahr/fem/projection.h"
 #include "fahr/fem/sphere_links.h"
 
@@ -39,6 +46,9 @@ struct ContactStepSettings {
   bool apply_contact_forces = true;
   // Spheres in the compliance block at most (a DeformationState carries 64).
   std::size_t max_compliance_spheres = 64;
+  // How the ContactSet's sphere corrections are shared by the nodes
+  // (projection.h); overrides the body's projection setting.
+  SphereSpread spread = SphereSpread::kMassWeighted;
 };
 
 class ContactStep {
@@ -54,6 +64,13 @@ class ContactStep {
   // to the capacity. Allocates: call at set-up. False (and no block) if a
   // sphere is unknown, there are more than the capacity, or the solve fails.
   bool fix_compliance_spheres(std::span<const std::uint32_t> spheres);
+
+  // The static anatomy (fields in the body's frame, each outliving this
+  // object) the body keeps out of by itself in every step, ContactSet or
+  // not; the ContactSet's kObstacle entries are then not projected.
+  // Allocates: call at set-up.
+  void set_obstacles(std::span<const ObstacleField* const> fields, const ObstacleProjectionSettings& settings = {});
+  bool has_obstacles() const { return obstacles_ != nullptr; }
 
   // One step. `contacts` may be null (no usable ContactSet); `extra_forces_n`
   // (3 per node, N, empty for none) acts in this step only (the penalty
@@ -83,7 +100,10 @@ class ContactStep {
   void apply_forces(std::span<const double> extra_forces_n);
   void update_compliance(bool refactorised);
   void update_free_centres();
-  void project(const ContactSet& contacts);
+  // The ContactSet's projection (may be null) and the anatomy's, then the
+  // positions and the carried correction written back.
+  void project(const ContactSet* contacts);
+  void alternate_with_anatomy(const ContactSet* contacts);
 
   Body& body_;
   const SphereLinks& links_;
@@ -93,6 +113,7 @@ class ContactStep {
   std::vector<double> force_n_;         // this step's contact and carried force, N per DOF
   std::vector<double> free_positions_;  // x_free, m per DOF
   std::vector<double> projected_;       // projection workspace, m per DOF
+  std::vector<double> start_positions_; // x^n, where the step started, m per DOF
   std::vector<std::uint32_t> spheres_;
   std::vector<std::int32_t> slot_of_sphere_;  // fixed spheres: index in spheres_, or -1
   // Contact force applied per compliance sphere: magnitude along a unit
@@ -105,6 +126,8 @@ class ContactStep {
   std::uint64_t compliance_reuses_ = 0;
   std::uint64_t compliance_solves_ = 0;
   std::vector<Eigen::Vector3d> free_centres_;
+  ProjectionSettings projection_settings_;
+  std::unique_ptr<ObstacleProjection> obstacles_;
   ProjectionReport projection_;
 };
 

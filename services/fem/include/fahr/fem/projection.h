@@ -2,12 +2,25 @@
 // constraints are projected on positions by Gauss-Seidel, in the given order.
 #pragma once
 
+#include <cstdint>
 #include <span>
 
 #include "fahr/fem/contact_set.h"
 #include "fahr/fem/sphere_links.h"
 
 namespace fahr::fem {
+
+// How a sphere's centre correction dc is shared by its nodes.
+enum class SphereSpread : std::uint8_t {
+  // Node i moves by (w_i / m_i) dc / sum_j (w_j^2 / m_j): the smallest
+  // mass-weighted move (Algorithm 1 as written). With weights that do not
+  // follow the nodal masses the lightest node takes nearly all of it.
+  kMassWeighted,
+  // Every free node of the sphere moves by the same dc / sum_free w_j: the
+  // sphere's nodes translate together, so no tet among them is deformed,
+  // let alone inverted, by its own sphere's correction, whatever its weights.
+  kTranslation,
+};
 
 struct ProjectionSettings {
   // Gauss-Seidel sweeps over all constraints at most (one sweep suffices for
@@ -16,6 +29,13 @@ struct ProjectionSettings {
   // A sweep whose largest centre correction is below this ends the loop, m.
   // 1 um is far below what a trainee sees or feels on a 3 cm tongue.
   double tolerance_m = 1e-6;
+  // Project the ContactSet's kObstacle entries. A body that keeps itself out
+  // of the anatomy (ObstacleProjection) turns this off: those entries are
+  // spheres against planes the haptic side found one FEM step earlier.
+  bool project_obstacle_contacts = true;
+  // kMassWeighted is the contract's; kTranslation made the neonatal
+  // overshoot run diverge (README, "The anatomy") and is kept to compare.
+  SphereSpread spread = SphereSpread::kMassWeighted;
 };
 
 struct ProjectionReport {
@@ -26,12 +46,20 @@ struct ProjectionReport {
   int unknown_spheres = 0;      // sphere ids not in the links, skipped
   double last_correction_m = 0; // largest |dc| of the last sweep, m
   bool converged = true;
+  // The body's own anatomy projection (obstacle_projection.h); all 0 when
+  // the body has no obstacles.
+  int obstacle_rounds = 0;         // tool / anatomy alternations this step
+  int obstacle_nodes = 0;          // distinct nodes moved out of the anatomy
+  int obstacle_unresolved = 0;     // nodes left inside the margin by the last pass
+  int obstacle_non_finite = 0;     // nodes with a non-finite position or sample, left alone
+  double obstacle_deepest_m = 0.0; // deepest node inside an obstacle before its move, m (>= 0)
 };
 
 // Whether the contact is projected, and how. Obstacles are always hard: a
 // frozen obstacle contact is treated as active.
 bool contact_is_frozen(const Contact& contact);
 bool contact_is_projected(const Contact& contact);
+bool contact_is_projected(const Contact& contact, const ProjectionSettings& settings);
 
 // Moves `positions_m` (3 per node) so that every active contact satisfies
 // (c' - q) . n >= r (the sphere, radius included, stays on its side of the
@@ -46,6 +74,6 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
 // its nodes are fixed (nothing can move).
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
                         std::span<const double> inverse_mass_per_node, const Eigen::Vector3d& dc_m,
-                        std::span<double> positions_m);
+                        std::span<double> positions_m, SphereSpread spread = SphereSpread::kMassWeighted);
 
 }  // namespace fahr::fem

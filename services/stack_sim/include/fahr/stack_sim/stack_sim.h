@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "contact_set.h"
 #include "deformation_state.h"
@@ -37,6 +38,12 @@ struct StackOptions {
   double overshoot_factor = 3.0;
   haptic_service::CollisionMethod collision = haptic_service::CollisionMethod::kAist;
   std::uint32_t device_id = 0;  // the gateway's default --device-id
+  // The FEM keeps its nodes out of the anatomy itself (the FEM service's
+  // default); false leaves that to the haptic side's obstacle contacts, as
+  // before, for comparison.
+  bool fem_anatomy = true;
+  // Overrides the FEM service's sphere spread (projection.h) when set.
+  std::optional<fem::SphereSpread> sphere_spread;
 };
 
 class StackSim {
@@ -75,6 +82,10 @@ class StackSim {
   // Thread-CPU time of each haptic tick so far (the tick alone: no digest,
   // no transport), 1 us bins.
   const metrics::DurationHistogram& haptic_tick_cpu() const { return haptic_tick_cpu_; }
+  // Thread-CPU time of each FEM service step so far (the step and its
+  // DeformationState, no transport), 10 us bins: against the FEM's period.
+  const metrics::DurationHistogram& fem_step_cpu() const { return fem_step_cpu_; }
+  std::chrono::nanoseconds last_fem_step_cpu() const { return last_fem_step_cpu_; }
 
   // Output hashes as the distributed lockstep computes them.
   std::uint64_t gateway_hash() const { return gateway_hash_.value(); }
@@ -111,6 +122,8 @@ class StackSim {
   std::uint64_t step_ = 0;
 
   metrics::DurationHistogram haptic_tick_cpu_{std::chrono::microseconds(1)};
+  metrics::DurationHistogram fem_step_cpu_{std::chrono::microseconds(10)};
+  std::chrono::nanoseconds last_fem_step_cpu_{0};
   common::OutputHash gateway_hash_;
   common::OutputHash haptic_hash_;
   common::OutputHash fem_hash_;

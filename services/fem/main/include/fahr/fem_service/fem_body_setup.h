@@ -1,7 +1,8 @@
 // Builds a scene's deformable body for the FEM service: the tet mesh in the
 // world frame, fixed nodes, FEM settings from the scene, and the AIST
 // sphere links the ContactSets refer to (the same deterministic filling the
-// haptic service computes, so sphere ids agree without a handshake).
+// haptic service computes, so sphere ids agree without a handshake), and the
+// rigid anatomy the body keeps its nodes out of.
 #pragma once
 
 #include <memory>
@@ -9,7 +10,9 @@
 #include <vector>
 
 #include "fahr/fem/body.h"
+#include "fahr/fem/obstacle_projection.h"
 #include "fahr/fem/sphere_links.h"
+#include "fahr/fem_service/anatomy_fields.h"
 #include "fahr/geometry/tet_mesh.h"
 #include "fahr/scene/scene.h"
 
@@ -22,6 +25,15 @@ struct FemBodySetup {
   fem::BodySettings settings;
   fem::SphereLinks links;
   std::unique_ptr<fem::Body> body;
+  // The obstacles of the scene's hard pairs with this body (world frame),
+  // enforced by the FEM step itself (services/fem/README.md, "The anatomy").
+  std::vector<std::unique_ptr<AnatomyField>> anatomy;
+  fem::ObstacleProjectionSettings anatomy_settings;
+  // false: the step leaves the anatomy to the ContactSet's obstacle entries
+  // (the fields stay loaded, for diagnostics); for comparisons.
+  bool enforce_anatomy = true;
+  // How a tool contact's correction moves the sphere's nodes (projection.h).
+  fem::SphereSpread sphere_spread = fem::SphereSpread::kMassWeighted;
 };
 
 // Throws std::runtime_error naming the body and what is wrong.

@@ -41,6 +41,8 @@ class ServiceStep {
   const FemBodySetup& setup() const { return setup_; }
   std::uint64_t stale_sets() const { return stale_sets_; }
   std::uint64_t inverted_max() const { return inverted_max_; }
+  // Deepest a node went into the anatomy before the step moved it out, m.
+  double anatomy_depth_max_m() const { return anatomy_depth_max_m_; }
 
   // The service's own ServiceStatus metrics.
   void metrics(std::vector<std::pair<std::string, double>>& out) const;
@@ -56,6 +58,7 @@ class ServiceStep {
   msg::DeformationState state_;
   fem::StepReport last_report_;
   std::uint64_t inverted_max_ = 0;
+  double anatomy_depth_max_m_ = 0.0;
   std::uint64_t stale_sets_ = 0;
 };
 

@@ -1,0 +1,106 @@
+// The FEM's own non-penetration of the static rigid anatomy: after the
+// implicit step, every free node closer to an obstacle than a margin is
+// moved out along the obstacle's normal to the margin, on the positions of
+// this very step. The haptic side's sphere contacts against the anatomy are
+// one FEM step late and see spheres, not the surface; pressed by the blade,
+// the tongue tunnelled through the jaw between two such steps
+// (services/fem/README.md, "The anatomy"). Nodes are enough: the tongue's
+// surface is its boundary nodes, and a face between two nodes that stay out
+// of the bone can only dip into it where the bone is sharper than an element.
+//
+// A node that was clear of an obstacle at the start of the step is put back
+// where its path first came within the margin (the path is sphere-traced
+// from its start), not at the surface nearest to where it ended: pushed
+// deeper than half a bone's thickness in one step, or right through a thin
+// bone, the nearest surface is the far side, and the node would tunnel
+// through (the neonatal tongue under the blade reached 7.7 mm into the jaw
+// in one 5 ms step).
+//
+// Fixed nodes (inverse mass 0) never move. Capacities are fixed at
+// construction; a pass allocates nothing. Each node keeps a lower bound of
+// its distance to every obstacle (the sampled distance minus how far it has
+// moved since: a signed distance is 1-Lipschitz), so a node far from bone is
+// not sampled again until it has travelled that far.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fahr/fem/obstacle_field.h"
+#include "fahr/fem/projection.h"
+
+namespace fahr::fem {
+
+struct ObstacleProjectionSettings {
+  // Nodes closer than this to an obstacle are moved out to it, m, [0, 0.01].
+  // 0.2 mm: thin enough not to show (a tenth of a tongue element), thick
+  // enough that a node resting on the bone is not inside it after the
+  // rounding of the distance field's closest-point normal.
+  double margin_m = 0.2e-3;
+  // A node left this little inside the margin counts as out, m (> 0).
+  double tolerance_m = 1e-6;
+  // Moves of one node against one obstacle per pass, >= 1: on a curved
+  // surface a move along the normal lands a little off the margin, so the
+  // node is sampled again after each move.
+  int max_moves_per_node = 3;
+  // Tool projection / anatomy projection alternations per step, >= 1
+  // (ContactStep): the anatomy's pass comes last, so bone wins over a tool
+  // constraint that would press a node into it.
+  int max_rounds = 4;
+};
+
+class ObstacleProjection {
+ public:
+  // `fields` (each must outlive this object) are static, in the body's
+  // frame; node_count is the body's.
+  ObstacleProjection(std::span<const ObstacleField* const> fields, std::size_t node_count,
+                     const ObstacleProjectionSettings& settings = {});
+
+  // Forgets which nodes moved this step; call before the step's first pass.
+  void begin_step();
+  // Forgets every clearance (every node is sampled in the next pass): after
+  // positions were set from outside (a reset to rest, a teleport).
+  void forget_clearances();
+
+  // One pass: moves every free node closer than the margin out of every
+  // obstacle, in place (3 per node, m). start_positions_m (3 per node, m, or
+  // empty): where the nodes were at the start of the step, for the entry
+  // point of a node that crossed a surface. Adds to report's obstacle fields
+  // and returns how many nodes this pass moved.
+  int project(std::span<double> positions_m, std::span<const double> inverse_mass_per_node,
+              ProjectionReport& report, std::span<const double> start_positions_m = {});
+
+  // Nodes moved since begin_step().
+  int nodes_moved() const { return nodes_moved_; }
+  std::size_t field_count() const { return fields_.size(); }
+  const ObstacleProjectionSettings& settings() const { return settings_; }
+
+ private:
+  enum class NodeOutcome { kClear, kMoved, kUnresolved, kNonFinite };
+  NodeOutcome project_node(std::size_t node, const Eigen::Vector3d* start, Eigen::Vector3d& x,
+                           ProjectionReport& report);
+  // Follows the path start -> x; if it meets the margin, moves x (and its
+  // sample s) there and returns how far, else returns 0.
+  double enter_along_path(const ObstacleField& field, const Eigen::Vector3d& start, Eigen::Vector3d& x,
+                          ObstacleSample& s, ProjectionReport& report) const;
+  // The point of the segment start -> x where the field's distance is
+  // `level` (start at or above it, x below it), by regula falsi.
+  Eigen::Vector3d entry_point(const ObstacleField& field, const Eigen::Vector3d& start, double start_distance_m,
+                              const Eigen::Vector3d& x, double distance_m, double level_m) const;
+  // Lowers every clearance of `node` by `distance_m` (it moved that far).
+  void spend_clearance(std::size_t node, double distance_m);
+
+  std::vector<const ObstacleField*> fields_;
+  ObstacleProjectionSettings settings_;
+  // Per node and field (node-major): a lower bound of the distance from
+  // sampled_at_m_[node] to the field, m; -inf until sampled.
+  std::vector<double> clearance_m_;
+  std::vector<Eigen::Vector3d> sampled_at_m_;  // per node, m
+  std::vector<std::uint8_t> moved_;            // per node: moved since begin_step()
+  int nodes_moved_ = 0;
+};
+
+}  // namespace fahr::fem
