@@ -15,9 +15,13 @@ TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
   const SphereLayout& layout = test::neonatal_layout();
   SphereState state(layout);
   SphereTree tree(layout);
+  std::vector<double> rest;
+  for (const auto& p : mesh.rest_positions()) rest.insert(rest.end(), {p.x(), p.y(), p.z()});
+  SphereState stretch_state(layout, rest);  // the smallest-stretch radius rule
   geometry::SdfOptions options;
   options.cell_size_m = 1e-3;
   const geometry::SignedDistanceField slab(test::box_surface({-0.06, -0.04, -0.02}, {0.0, -0.005, 0.02}), options);
+  const FieldGrid slab_grid(slab);
   RigidBody body{0, &slab, Eigen::Isometry3d::Identity()};
   PrePenetrationMemory memory(layout.size());
   ContactBuffer buffer(256);  // small on purpose: overflow must not allocate either
@@ -37,10 +41,14 @@ TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
   for (int tick = 0; tick < 50; ++tick) {
     x[1] -= 1e-5;  // a node moves: a new FEM state every tick
     state.update(layout, x);
-    tree.refit(state);
+    stretch_state.update(layout, x);
+    tree.refit(tick % 2 == 0 ? state : stretch_state);
     body.world_from_body.translation().y() = 1e-4 * tick;
     buffer.clear();
-    query_spheres(tree, state, body, tick % 3 == 0 ? exact : (tick % 3 == 1 ? grid : searched), memory, buffer);
+    // Every fourth tick through the body's FieldGrid.
+    body.grid = tick % 4 == 3 ? &slab_grid : nullptr;
+    const QuerySettings& settings = tick % 3 == 0 ? exact : (tick % 3 == 1 ? grid : searched);
+    query_spheres(tree, tick % 2 == 0 ? state : stretch_state, body, settings, memory, buffer);
     contacts += buffer.size();
   }
   const std::size_t allocations = test::disarm_allocation_counter();

@@ -48,6 +48,8 @@ class ContactMetrics {
   std::size_t aist_total_ = 0, aist_unmatched_ = 0;
   std::size_t contact_ticks_ = 0, ticks_both_ = 0;
   std::vector<double> aist_depth_error_m_, base_depth_error_m_, exact_depth_m_;
+  // Over every verified contact, tongue and blade vertices alike.
+  std::vector<double> all_exact_depth_m_, all_deepest_error_m_, all_nearest_error_m_;
 };
 
 }  // namespace fahr::aist_bench

@@ -1,5 +1,8 @@
 // aist_bench: prints Markdown tables. Sections: coverage, trajectory, sweep
-// (default: all). Usage: aist_bench [coverage|trajectory|sweep|all] [--ticks N] [--skin-mm S] [--spread W] [--sweep-steps N]
+// (default: all), detection (the trajectory with the FEM driven by node
+// contacts, both detectors judged on the same states). Usage: aist_bench
+// [coverage|trajectory|detection|sweep|all] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--spread W] [--sweep-steps N]
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -26,6 +29,10 @@ int main(int argc, char** argv) {
       options.approach_margin_m = 1e-3 * std::stod(argv[++i]);
     } else if (std::strcmp(argv[i], "--anchor") == 0 && i + 1 < argc) {
       options.anchor_depth_factor = std::stod(argv[++i]);
+    } else if (std::strcmp(argv[i], "--radius-rule") == 0 && i + 1 < argc) {
+      options.stretch_radius = std::strcmp(argv[++i], "stretch") == 0;
+    } else if (std::strcmp(argv[i], "--fem-every") == 0 && i + 1 < argc) {
+      options.fem_every = std::max(1, std::stoi(argv[++i]));
     } else if (std::strcmp(argv[i], "--sweep-steps") == 0 && i + 1 < argc) {
       options.sweep_steps = std::stoi(argv[++i]);
     } else {
@@ -41,6 +48,10 @@ int main(int argc, char** argv) {
     if (section == "coverage" || section == "all") coverage_table(*scene);
     if (section == "trajectory" || section == "all") trajectory_table(*scene, options);
     if (section == "sweep" || section == "all") sweep_table(*scene, options);
+    if (section == "detection") {
+      options.node_driven = true;
+      trajectory_table(*scene, options);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "aist_bench: %s\n", e.what());
     return 1;

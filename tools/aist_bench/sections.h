@@ -19,6 +19,13 @@ struct Options {
   double hugging_radius_fraction = haptic::FillSettings{}.hugging_radius_fraction;
   double approach_margin_m = haptic::QuerySettings{}.approach_margin_m;  // QuerySettings of the trajectory
   double anchor_depth_factor = haptic::FillSettings{}.hugging_anchor_depth_factor;
+  // true (section "detection"): the trajectory's FEM is driven by node
+  // contacts (node_contacts.h) instead of the AIST's, so both detectors are
+  // judged on states neither of them made.
+  bool node_driven = false;
+  // true (--radius-rule stretch): the trajectory's SphereState uses the
+  // smallest-stretch radius rule instead of the volume rule.
+  bool stretch_radius = false;
 };
 
 // Candidate margin of the benchmark's queries, m: the closure's tolerance,

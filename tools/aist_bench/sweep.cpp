@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "contact_metrics.h"
+#include "node_contacts.h"
 #include "fahr/haptic/coverage.h"
 #include "fahr/haptic/fill_spheres.h"
 #include "fahr/haptic/sphere_query.h"
@@ -35,45 +36,15 @@ fem::ContactSet& clear_set(fem::ContactSet& set, const fem::Body& body) {
   return set;
 }
 
-// The reference: every boundary node is a contact point of radius 0 (one
-// node, weight 1), projected out of the blade's exact field, with the normal
-// from the node's last position outside (the same rule as the spheres).
+// The reference: the FEM driven by node contacts (node_contacts.h).
 std::vector<double> reference_run(const Scene& scene, const Options& options) {
   auto body = make_tongue_body(scene);
-  fem::SphereLinks links;
-  std::vector<std::uint32_t> nodes;
-  for (const auto n : scene.surface_to_node) nodes.push_back(static_cast<std::uint32_t>(n));
-  std::sort(nodes.begin(), nodes.end());
-  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-  const double one = 1.0;
-  for (const auto n : nodes) links.add_sphere(std::span<const std::uint32_t>(&n, 1), std::span<const double>(&one, 1), 0.0);
-  std::vector<Eigen::Vector3d> outside(nodes.size(), Eigen::Vector3d::Zero());
-  std::vector<bool> remembered(nodes.size(), false);
+  NodeContacts driver(scene);
   fem::ContactSet set;
   for (int step = 0; step < options.sweep_steps; ++step) {
     const auto pose = blade_pose(scene, static_cast<double>(step) / (options.sweep_steps - 1), options.lever_depth_m);
-    const Eigen::Isometry3d inverse = pose.inverse();
-    clear_set(set, *body);
-    for (std::size_t k = 0; k < nodes.size(); ++k) {
-      const Eigen::Vector3d p = inverse * body->position(nodes[k]);
-      const auto s = scene.blade_sdf.query(p);
-      if (s.distance_m > 0.0) {
-        outside[k] = p;
-        remembered[k] = true;
-        continue;
-      }
-      const auto before = remembered[k] ? scene.blade_sdf.query(outside[k]) : s;
-      const Eigen::Vector3d from = remembered[k] ? outside[k] : p;
-      Eigen::Vector3d n = (from - before.closest_point_m);
-      n = n.norm() > 1e-12 ? Eigen::Vector3d(n.normalized()) : before.normal;
-      fem::Contact c;
-      c.sphere_id = static_cast<std::uint32_t>(k);
-      c.state = fem::ContactState::kActive;
-      c.plane_point_m = pose * before.closest_point_m;
-      c.normal = pose.linear() * n;
-      set.contacts.push_back(c);
-    }
-    body->step(&set, &links);
+    driver.fill(*body, pose, set);
+    body->step(&set, &driver.links());
   }
   const auto x = body->positions_m();
   return {x.begin(), x.end()};

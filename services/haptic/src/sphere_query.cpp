@@ -30,25 +30,49 @@ struct Frame {
   }
 };
 
-// The field's grid alone: trilinear distance, gradient by central
-// differences over half a cell, nearest point along it.
-// gradient_length: the length of the finite-difference gradient (1 where the
-// field is one plane's distance over the cells read).
-geometry::SdfSample grid_sample(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& p,
-                                double distance, double& gradient_length) noexcept {
+// The grid a query reads: the body's FieldGrid when it has one, else the
+// field's own. `error_m` bounds |value - true distance| (see kGridErrorCells).
+struct Grid {
+  const geometry::SignedDistanceField& sdf;
+  const FieldGrid* copy;
+  double error_m;
+  double distance(const Eigen::Vector3d& p) const noexcept {
+    return copy != nullptr ? copy->distance(p) : sdf.grid_distance(p);
+  }
+};
+
+// The sample of the grid at p from its value and gradient there: the
+// nearest point along the gradient.
+geometry::SdfSample from_gradient(const Eigen::Vector3d& p, double distance, const Eigen::Vector3d& gradient) noexcept {
   geometry::SdfSample s;
   s.distance_m = distance;
-  const double h = 0.5 * sdf.cell_size_m();
-  Eigen::Vector3d gradient;
-  for (int axis = 0; axis < 3; ++axis) {
-    const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(axis);
-    gradient[axis] = sdf.grid_distance(p + step) - sdf.grid_distance(p - step);
-  }
   const double norm = gradient.norm();
-  gradient_length = norm / (2.0 * h);
   s.normal = norm > 0.0 ? Eigen::Vector3d(gradient / norm) : Eigen::Vector3d::UnitZ();
   s.closest_point_m = p - distance * s.normal;
   return s;
+}
+
+// The grid alone: trilinear distance, its gradient, the nearest point along
+// it. From a FieldGrid the gradient is the interpolant's in p's cell (the same
+// 8 corners as the value); from the field, central differences over half a
+// cell (6 more trilinear reads).
+// gradient_length: the length of the gradient (1 where the field is one
+// plane's distance over the cells read).
+geometry::SdfSample grid_sample(const Grid& grid, const Eigen::Vector3d& p, double distance,
+                                double& gradient_length) noexcept {
+  Eigen::Vector3d gradient;
+  if (grid.copy != nullptr) {
+    distance = grid.copy->distance_gradient(p, gradient);
+    gradient_length = gradient.norm();
+  } else {
+    const double h = 0.5 * grid.sdf.cell_size_m();
+    for (int axis = 0; axis < 3; ++axis) {
+      const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(axis);
+      gradient[axis] = grid.sdf.grid_distance(p + step) - grid.sdf.grid_distance(p - step);
+    }
+    gradient_length = gradient.norm() / (2.0 * h);
+  }
+  return from_gradient(p, distance, gradient);
 }
 
 // The exact nearest point, searched only within `bound` (m, >= the true
@@ -74,14 +98,16 @@ geometry::SdfSample bounded_exact(const geometry::SignedDistanceField& sdf, cons
 
 // hint: a point of the body's surface (body frame) or null; |p - hint| bounds
 // the distance from above.
-geometry::SdfSample sample(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& p, double grid,
-                           double grid_error, const QuerySettings& settings, const Eigen::Vector3d* hint) noexcept {
+geometry::SdfSample sample(const Grid& field, const Eigen::Vector3d& p, double grid,
+                           const QuerySettings& settings, const Eigen::Vector3d* hint) noexcept {
+  const geometry::SignedDistanceField& sdf = field.sdf;
+  const double grid_error = field.error_m;
   double gradient_length = 0.0;
-  if (!settings.exact_narrow_phase) return grid_sample(sdf, p, grid, gradient_length);
+  if (!settings.exact_narrow_phase) return grid_sample(field, p, grid, gradient_length);
   // Too near the surface for the grid's sign: the field's pseudo-normal test.
   if (!(std::abs(grid) > grid_error)) return sdf.query(p);
   if (settings.flat_gradient_tolerance > 0.0) {
-    geometry::SdfSample s = grid_sample(sdf, p, grid, gradient_length);
+    geometry::SdfSample s = grid_sample(field, p, grid, gradient_length);
     if (std::abs(gradient_length - 1.0) <= settings.flat_gradient_tolerance) {
       return s;  // one plane's distance: trilinear interpolation reproduces it
     }
@@ -92,11 +118,10 @@ geometry::SdfSample sample(const geometry::SignedDistanceField& sdf, const Eigen
 }
 
 // The contact of one sphere whose exact sample at its centre is `s`.
-bool narrow_phase(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d* hint, double grid_error,
-                  double margin,
+bool narrow_phase(const Grid& field, const Eigen::Vector3d* hint, double margin,
                   const Eigen::Vector3d& centre_body,
                   double radius, const geometry::SdfSample& s, const QuerySettings& settings,
-                  const PrePenetrationMemory& memory, std::uint32_t sphere, std::uint64_t query,
+                  const PrePenetrationMemory& memory, std::uint32_t slot, std::uint64_t query,
                   Eigen::Vector3d& q, Eigen::Vector3d& n, double& depth, bool& no_history) noexcept {
   no_history = false;
   if (s.distance_m > 0.0) {
@@ -109,8 +134,8 @@ bool narrow_phase(const geometry::SignedDistanceField& sdf, const Eigen::Vector3
     return depth > -margin;
   }
   Eigen::Vector3d before;
-  if (memory.recall(sphere, query, settings.max_memory_age, before)) {
-    const geometry::SdfSample b = sample(sdf, before, sdf.grid_distance(before), grid_error, settings, hint);
+  if (memory.recall(slot, query, settings.max_memory_age, before)) {
+    const geometry::SdfSample b = sample(field, before, field.distance(before), settings, hint);
     q = b.closest_point_m;
     const Eigen::Vector3d d = before - q;
     const double len = d.norm();
@@ -134,14 +159,20 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   const auto& nodes = tree.nodes();
   if (nodes.empty() || tree.order().empty() || body.sdf == nullptr) return stats;
   const geometry::SignedDistanceField& sdf = *body.sdf;
-  const double grid_error = kGridErrorCells * sdf.cell_size_m();
+  // The broad phase and the leaf test read the copy in both narrow phases;
+  // the exact one still searches the triangles (and near the surface asks the
+  // field itself), so its contacts do not change.
+  const FieldGrid* copy = body.grid != nullptr && !body.grid->empty() ? body.grid : nullptr;
+  const double grid_error =
+      kGridErrorCells * sdf.cell_size_m() + (copy != nullptr ? copy->storage_error_m() : 0.0);
+  const Grid field{sdf, copy, grid_error};
   const Eigen::Isometry3d body_from_world = body.world_from_body.inverse();
   const Frame frame{body_from_world.linear(), body_from_world.translation()};
   const Eigen::Matrix3d world_rotation = body.world_from_body.linear();
   const std::uint64_t query = memory.next_query();
-  const auto& centres = state.centres_m();
-  const auto& radii = state.radii_m();
+  const auto& slots = tree.slot_spheres();
   const auto& order = tree.order();
+  if (slots.size() != state.centres_m().size()) return stats;  // a tree of another layout
 
   std::array<std::int32_t, SphereTree::kMaxDepth + 1> stack{};
   int top = 0;
@@ -153,7 +184,7 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     const double half_diagonal =
         0.5 * (node.box_max_m - node.box_min_m).norm() + settings.contact_skin_m + settings.candidate_margin_m;
     // Lower bound of the distance from any point of the box to the body.
-    const double bound = sdf.grid_distance(frame.to_body(centre)) - grid_error - half_diagonal;
+    const double bound = field.distance(frame.to_body(centre)) - grid_error - half_diagonal;
     if (!(bound <= settings.approach_margin_m)) {  // NaN-safe: a NaN pose touches nothing
       if (&node == &nodes[0]) stats.body_skipped = true;
       continue;
@@ -165,25 +196,35 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     }
     for (std::int32_t k = 0; k < node.count; ++k) {
       const std::uint32_t sphere = order[node.first + k];
-      const Eigen::Vector3d p = frame.to_body(centres[sphere]);
-      const double r = radii[sphere] + settings.contact_skin_m;
+      // The memory is kept by slot (leaf order): read in sequence, not at random.
+      const auto slot = static_cast<std::uint32_t>(node.first + k);
+      const Eigen::Vector4d& world = slots[static_cast<std::size_t>(node.first + k)];
+      const Eigen::Vector3d p = frame.to_body(world.head<3>());
+      const double r = world[3] + settings.contact_skin_m;
       ++stats.spheres_tested;
-      const double grid = sdf.grid_distance(p);
+      // With a FieldGrid and the grid narrow phase one read gives the value
+      // and the gradient the narrow phase needs.
+      Eigen::Vector3d gradient;
+      const bool one_read = copy != nullptr && !settings.exact_narrow_phase;
+      const double grid = one_read ? copy->distance_gradient(p, gradient) : field.distance(p);
       if (grid - grid_error > r + settings.candidate_margin_m) {
-        if (grid - grid_error > 0.0) memory.remember(sphere, p, query);
+        if (grid - grid_error > 0.0) memory.remember(slot, p, query);
         continue;
       }
       ++stats.exact_queries;
       Eigen::Vector3d last_nearest;
-      const Eigen::Vector3d* hint = memory.recall_nearest(sphere, last_nearest) ? &last_nearest : nullptr;
-      const geometry::SdfSample s = sample(sdf, p, grid, grid_error, settings, hint);
-      if (s.distance_m > 0.0) memory.remember(sphere, p, query);
-      if (s.exact) memory.remember_nearest(sphere, s.closest_point_m);
+      // Only the exact search uses the hint: the grid narrow phase does not read it.
+      const Eigen::Vector3d* hint =
+          settings.exact_narrow_phase && memory.recall_nearest(slot, last_nearest) ? &last_nearest : nullptr;
+      const geometry::SdfSample s =
+          one_read ? from_gradient(p, grid, gradient) : sample(field, p, grid, settings, hint);
+      if (s.distance_m > 0.0) memory.remember(slot, p, query);
+      if (s.exact) memory.remember_nearest(slot, s.closest_point_m);
       Eigen::Vector3d q, n;
       double depth = 0.0;
       bool no_history = false;
-      if (!narrow_phase(sdf, hint, grid_error, settings.candidate_margin_m, p, r, s,
-                        settings, memory, sphere, query, q, n, depth, no_history)) {
+      if (!narrow_phase(field, hint, settings.candidate_margin_m, p, r, s,
+                        settings, memory, slot, query, q, n, depth, no_history)) {
         continue;
       }
       ++stats.contacts;

@@ -13,6 +13,7 @@ SphereTree::SphereTree(const SphereLayout& layout) {
   // A binary tree over n leaves of up to kLeafSize has fewer than 2n nodes.
   nodes_.reserve(2 * layout.size() + 1);
   nodes_.emplace_back();
+  slot_spheres_.assign(layout.size(), Eigen::Vector4d::Zero());
   if (n > 0) build(0, 0, n, 1, layout);
   SphereState rest(layout);
   refit(rest);
@@ -66,6 +67,10 @@ void SphereTree::refit(const SphereState& state) {
         const std::uint32_t s = order_[node.first + i];
         node.box_min_m = node.box_min_m.cwiseMin(centres[s] - Eigen::Vector3d::Constant(radii[s]));
         node.box_max_m = node.box_max_m.cwiseMax(centres[s] + Eigen::Vector3d::Constant(radii[s]));
+      }
+      for (std::int32_t i = 0; i < node.count; ++i) {
+        const std::uint32_t s = order_[node.first + i];
+        slot_spheres_[static_cast<std::size_t>(node.first + i)] << centres[s], radii[s];
       }
     } else if (k > 0 || !order_.empty()) {
       const SphereTreeNode& a = nodes_[node.first];

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "fahr/geometry/signed_distance_field.h"
+#include "fahr/haptic/field_grid.h"
 
 namespace fahr::haptic {
 
@@ -14,6 +15,10 @@ struct RigidBody {
   const geometry::SignedDistanceField* sdf = nullptr;
   // Pose: world_from_body maps body-frame points (m) to the world frame.
   Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
+  // Optional, borrowed like the field: a FieldGrid of that field. With it the
+  // queries read the grid there (the grid narrow phase one cell per sphere
+  // instead of seven, tools/aist_bench/README.md); without it, the field's own.
+  const FieldGrid* grid = nullptr;
 };
 
 }  // namespace fahr::haptic

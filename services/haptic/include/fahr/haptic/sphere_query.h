@@ -64,49 +64,52 @@ struct QuerySettings {
   double candidate_margin_m = 0.0;
 };
 
-// Per (sphere set, rigid body): the last centre seen outside the body, in the
-// body's frame. Capacity fixed at construction.
+// Per (sphere tree, rigid body): the last centre seen outside the body, in the
+// body's frame. Capacity fixed at construction. Indexed by the sphere's slot
+// in SphereTree::order(), not its id, and a sphere's entries share one cache
+// line: the query visits spheres leaf by leaf, so memory kept by id (in
+// separate arrays) cost cache misses at random (tools/aist_bench/README.md).
+// A memory therefore belongs to one tree.
 class PrePenetrationMemory {
  public:
   PrePenetrationMemory() = default;
-  explicit PrePenetrationMemory(std::size_t sphere_count)
-      : centre_body_m_(sphere_count, Eigen::Vector3d::Zero()),
-        query_index_(sphere_count, 0),
-        nearest_body_m_(sphere_count, Eigen::Vector3d::Zero()),
-        has_nearest_(sphere_count, 0) {}
-  void remember(std::uint32_t sphere, const Eigen::Vector3d& centre_body_m, std::uint64_t query) noexcept {
-    centre_body_m_[sphere] = centre_body_m;
-    query_index_[sphere] = query;
+  explicit PrePenetrationMemory(std::size_t sphere_count) : slots_(sphere_count) {}
+  void remember(std::uint32_t slot, const Eigen::Vector3d& centre_body_m, std::uint64_t query) noexcept {
+    slots_[slot].centre_body_m = centre_body_m;
+    slots_[slot].query_index = query;
   }
   // True and the centre when remembered within max_age queries of `query`.
-  bool recall(std::uint32_t sphere, std::uint64_t query, std::uint64_t max_age,
+  bool recall(std::uint32_t slot, std::uint64_t query, std::uint64_t max_age,
               Eigen::Vector3d& centre_body_m) const noexcept {
-    const std::uint64_t when = query_index_[sphere];
+    const std::uint64_t when = slots_[slot].query_index;
     if (when == 0 || query - when > max_age) return false;
-    centre_body_m = centre_body_m_[sphere];
+    centre_body_m = slots_[slot].centre_body_m;
     return true;
   }
-  // The last nearest surface point found for a sphere, body frame. Any point
+  // The last nearest surface point found for a slot's sphere, body frame. Any point
   // of the rigid surface bounds the distance from above, however old, so the
   // exact search of the next query starts from |c - q_last| and visits only
   // the triangles that can beat it.
-  void remember_nearest(std::uint32_t sphere, const Eigen::Vector3d& point_body_m) noexcept {
-    nearest_body_m_[sphere] = point_body_m;
-    has_nearest_[sphere] = 1;
+  void remember_nearest(std::uint32_t slot, const Eigen::Vector3d& point_body_m) noexcept {
+    slots_[slot].nearest_body_m = point_body_m;
+    slots_[slot].has_nearest = 1;
   }
-  bool recall_nearest(std::uint32_t sphere, Eigen::Vector3d& point_body_m) const noexcept {
-    if (has_nearest_[sphere] == 0) return false;
-    point_body_m = nearest_body_m_[sphere];
+  bool recall_nearest(std::uint32_t slot, Eigen::Vector3d& point_body_m) const noexcept {
+    if (slots_[slot].has_nearest == 0) return false;
+    point_body_m = slots_[slot].nearest_body_m;
     return true;
   }
-  std::size_t size() const { return query_index_.size(); }
+  std::size_t size() const { return slots_.size(); }
   std::uint64_t next_query() noexcept { return ++queries_; }  // 1-based, 0 = never
 
  private:
-  std::vector<Eigen::Vector3d> centre_body_m_;
-  std::vector<std::uint64_t> query_index_;
-  std::vector<Eigen::Vector3d> nearest_body_m_;
-  std::vector<std::uint8_t> has_nearest_;
+  struct alignas(64) Slot {
+    Eigen::Vector3d centre_body_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d nearest_body_m = Eigen::Vector3d::Zero();
+    std::uint64_t query_index = 0;
+    std::uint8_t has_nearest = 0;
+  };
+  std::vector<Slot> slots_;
   std::uint64_t queries_ = 0;
 };
 
@@ -120,6 +123,8 @@ struct QueryStats {
 };
 
 // Appends the contacts of `state`'s spheres with `body` to `out` (not cleared).
+// The centres and radii are read from the tree's copy (SphereTree::refit), so
+// `tree` must have been refitted to `state`.
 QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const RigidBody& body,
                          const QuerySettings& settings, PrePenetrationMemory& memory,
                          ContactBuffer& out) noexcept;

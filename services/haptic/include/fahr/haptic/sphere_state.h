@@ -16,10 +16,21 @@ class SphereState {
  public:
   SphereState() = default;
   explicit SphereState(const SphereLayout& layout);
+  // The smallest-stretch radius rule (see update()): rest_positions_m, 3 per
+  // node (m), the layout's rest mesh. Throws std::invalid_argument when too
+  // short or a linked tet is flat at rest.
+  SphereState(const SphereLayout& layout, std::span<const double> rest_positions_m);
 
   // positions_m: 3 per node (x, y, z), m, the FEM's flat layout. Centres are
   // c = sum w_i x_i; radii r = r0 cbrt(V / V0) over the linked tets, so a
-  // compressed region's spheres shrink with it. A linked volume that collapsed
+  // compressed region's spheres shrink with it. With the smallest-stretch
+  // rule (constructed with rest positions) r = r0 min over the linked tets of
+  // the smallest singular value of their deformation gradient: an affine map
+  // takes a ball of radius r0 to an ellipsoid whose smallest semi-axis is that,
+  // so the sphere stays inside its rest sphere's image. Soft tissue keeps its
+  // volume, so under a blade the volume rule keeps r0 while the tissue is
+  // squashed toward the surface and the sphere stands out of it
+  // (tools/aist_bench/README.md, detection). A linked volume that collapsed
   // or inverted (V <= 0) keeps kMinVolumeScale of the rest radius rather than
   // vanishing, and a stretch beyond kMaxVolumeScale is capped. Returns false (state unchanged past the first bad node) if a
   // position is not finite or the span is too short.
@@ -44,6 +55,10 @@ class SphereState {
   std::vector<Eigen::Vector3d> centres_m_;
   std::vector<double> radii_m_;
   std::vector<double> six_volume_m3_;  // per tet, scratch of update()
+  // The smallest-stretch rule: per tet the inverse rest edge matrix, and the
+  // smallest singular value (scratch of update()). Empty: the volume rule.
+  std::vector<Eigen::Matrix3d> rest_inverse_;
+  std::vector<double> smallest_stretch_;
   std::uint64_t version_ = 0;
 };
 

@@ -37,6 +37,10 @@ class SphereTree {
 
   const std::vector<SphereTreeNode>& nodes() const { return nodes_; }
   const std::vector<std::uint32_t>& order() const { return order_; }  // sphere ids, leaf order
+  // The last refit's centre (x, y, z) and radius per slot of order(), m: the
+  // query reads spheres leaf by leaf, so a copy in that order is read
+  // sequentially where the state's arrays (by sphere id) are read at random.
+  const std::vector<Eigen::Vector4d>& slot_spheres() const { return slot_spheres_; }
   int depth() const { return depth_; }
   std::uint64_t refit_count() const { return refits_; }
   // Builds after construction. Nothing in the library rebuilds, so this stays 0.
@@ -48,6 +52,7 @@ class SphereTree {
 
   std::vector<SphereTreeNode> nodes_;
   std::vector<std::uint32_t> order_;
+  std::vector<Eigen::Vector4d> slot_spheres_;
   int depth_ = 0;
   std::uint64_t builds_ = 1;
   std::uint64_t refits_ = 0;
