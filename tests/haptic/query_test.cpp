@@ -1,8 +1,11 @@
 // Sphere-tree refit and queries against analytic fields (a plane, a sphere, a thin plate).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <vector>
 
 #include "fahr/geometry/signed_distance_field.h"
 #include "fahr/haptic/fill_spheres.h"
@@ -151,6 +154,40 @@ TEST(Query, SphereContactsMatchTheAnalyticDistance) {
     expected += b.state.radii_m()[i] - d > kIcosphereToleranceM ? 1 : 0;
   }
   EXPECT_GE(buffer.size(), expected);
+}
+
+// The haptic tick keeps the k deepest contacts: the deepest-first walk finds
+// exactly those (the same depths as the full query's k deepest) and tests
+// fewer spheres. A ball pressed 2 mm into the block touches many spheres at
+// many depths, as a blade on the tongue does.
+TEST(Query, DeepestOnlyFindsTheDeepestContactsOfTheFullQuery) {
+  Block& b = block();
+  const Eigen::Vector3d o(0.004, 0.006, -0.003);
+  const auto ball = field(test::icosphere(Eigen::Vector3d::Zero(), 5e-3, 4));
+  RigidBody body{1, &ball, Eigen::Isometry3d::Identity()};
+  body.world_from_body.translation() = o;
+  QuerySettings settings;
+  settings.exact_narrow_phase = false;
+  settings.candidate_margin_m = 1e-3;
+  PrePenetrationMemory full_memory(b.layout.size());
+  ContactBuffer full(8192);
+  const QueryStats full_stats = query_spheres(b.tree, b.state, body, settings, full_memory, full);
+  constexpr std::size_t k = 16;
+  ASSERT_GT(full.size(), 4 * k);
+  settings.deepest_only = k;
+  PrePenetrationMemory memory(b.layout.size());
+  ContactBuffer limited(8192);
+  const QueryStats stats = query_spheres(b.tree, b.state, body, settings, memory, limited);
+  ASSERT_GE(limited.size(), k);
+  EXPECT_LT(stats.spheres_tested, full_stats.spheres_tested / 2);
+  auto deepest = [&](const ContactBuffer& buffer) {
+    std::vector<double> depths;
+    for (const SphereContact& c : buffer) depths.push_back(c.depth_m);
+    std::sort(depths.begin(), depths.end(), std::greater<>());
+    depths.resize(k);
+    return depths;
+  };
+  EXPECT_EQ(deepest(limited), deepest(full));
 }
 
 TEST(Query, NormalComesFromThePrePenetrationCentreThroughAThinPlate) {

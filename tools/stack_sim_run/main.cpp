@@ -4,7 +4,7 @@
 // fahr_lockstep_clock does for the same run over DDS, and a few figures.
 // Equal hashes show that the in-process run is the distributed one.
 //
-//   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--seconds 4]
+//   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle] [--seconds 4]
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -23,12 +23,17 @@ int main(int argc, char** argv) {
   double seconds = 4.0;
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--script", script, "the simulated hand's script")->check(CLI::IsMember({"intubation", "overshoot"}));
+  std::string collision = "aist";
+  app.add_option("--collision", collision, "the haptic service's collision method")
+      ->check(CLI::IsMember({"aist", "triangle"}));
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     stack_sim::StackOptions options;
     options.script = script == "overshoot" ? device::Script::kOvershoot : device::Script::kIntubation;
+    options.collision =
+        collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;
     stack_sim::StackSim sim(scene::load_scene(scene_path), options);
     const auto steps = static_cast<std::uint64_t>(seconds * 1000.0 + 0.5);
     const auto start = std::chrono::steady_clock::now();

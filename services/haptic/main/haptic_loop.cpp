@@ -78,6 +78,7 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
   }
   tool_body_.id = setup.tool->scene_body->id;
   tool_body_.sdf = setup.tool->sdf.get();
+  tool_body_.grid = setup.tool_grid.get();
   // Spheres within 1 mm of the blade are sent as candidates, so the FEM
   // computes their compliance before they touch.
   tool_query_.candidate_margin_m = 1e-3;
@@ -141,15 +142,17 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
   }
 }
 
-// The baseline's vertex-face contacts as rows of the same response, both
-// kinds: a tongue vertex behind a blade face, and a blade vertex (the edge of
-// the blade's tip, its flange) behind a tongue face. Each acts on a tongue
-// vertex (the penetrating one, or the nearest corner of the face), which
-// speaks for the sphere nearest it at rest (its compliance, its ContactSet
-// entry); the deepest contact per sphere is kept. The tissue point comes
-// from the published (projected) positions; it is moved by its sphere's
-// free-motion offset, as the AIST rows use the free centres. Vertices within
-// the candidate margin in front of a face are candidate rows, as the AIST's.
+// The baseline's vertex-face contacts as rows of the same response: each
+// tongue vertex behind a blade face (or within the candidate margin in front
+// of it: a candidate row, as the AIST's) speaks for the sphere nearest it at
+// rest (its compliance, its ContactSet entry); the deepest contact per sphere
+// is kept. The vertex comes from the published (projected) positions; it is
+// moved by its sphere's free-motion offset, as the AIST rows use the free
+// centres. Blade vertices behind a tongue face (the tip's edge) are found,
+// and timed, but give no row: as rows on the face's nearest corner sphere
+// they drove the intubation's tongue to thousands of inverted tets within
+// 20 s (fahr_stack_sim_run --collision triangle), since the FEM projects that
+// sphere, radius included, onto the plane through a blade vertex.
 void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
   // The AIST rows' candidate margin: both methods hand the solve the same kind of rows.
   tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_, tool_query_.candidate_margin_m);
@@ -157,8 +160,8 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
   std::size_t slots = 0;
   for (std::size_t i = 0; i < triangle_contacts_.size() && slots < sphere_contact_.size(); ++i) {
     const haptic::TriangleContact& c = triangle_contacts_[i];
-    if (c.acting_tissue_vertex < 0) continue;
-    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.acting_tissue_vertex)];
+    if (c.tissue_vertex < 0) continue;
+    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.tissue_vertex)];
     const std::int32_t slot = row_of_sphere_[sphere];
     if (slot < 0) {
       row_of_sphere_[sphere] = static_cast<std::int32_t>(slots);
@@ -176,15 +179,13 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
   const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
   for (std::size_t r = 0; r < keep; ++r) {
     const haptic::TriangleContact& c = triangle_contacts_[sphere_contact_[r]];
-    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.acting_tissue_vertex)];
+    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.tissue_vertex)];
     contact::ContactRow& row = rows_[row_count_++];
     row.kind = contact::RowKind::kTissue;
     row.id = sphere;
     row.normal = c.normal;
     row.tool_point_m = c.point_m;
-    // The tissue point: the vertex, or the tool vertex's foot on the face;
-    // either way depth = -(p - q) . n.
-    row.other_point_m = c.point_m - c.depth_m * c.normal;
+    row.other_point_m = c.point_m - c.depth_m * c.normal;  // the vertex: depth = -(v - q) . n
     row.radius_m = 0.0;
     row.compliance_index = tissue.compliance_index[sphere];
     if (free_centres && row.compliance_index >= 0) {

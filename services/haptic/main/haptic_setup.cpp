@@ -68,6 +68,7 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision) {
     throw std::runtime_error("body '" + setup.deformable->name + "': AIST: " + e.what());
   }
   setup.tool = runtime::load_rigid_field(scene.bodies[*plan.tool_body]);
+  setup.tool_grid = std::make_unique<haptic::FieldGrid>(*setup.tool->sdf);
   try {
     setup.tool_samples = haptic::SurfaceSamples(setup.tool->surface, haptic::SurfaceSampleSettings{});
   } catch (const std::exception& e) {

@@ -14,6 +14,7 @@
 #include "fahr/geometry/signed_distance_field.h"
 #include "fahr/geometry/surface_mesh.h"
 #include "fahr/geometry/tet_mesh.h"
+#include "fahr/haptic/field_grid.h"
 #include "fahr/haptic/fill_settings.h"
 #include "fahr/haptic/sphere_layout.h"
 #include "fahr/haptic/surface_samples.h"
@@ -48,6 +49,9 @@ struct HapticSetup {
   geometry::TetMesh mesh;  // world frame, m (the FEM service's frame too)
   haptic::SphereLayout layout;
   std::unique_ptr<RigidField> tool;
+  // The tool field's grid in the compact form the tick's AIST query reads
+  // (one cell per sphere, single precision: haptic/field_grid.h).
+  std::unique_ptr<haptic::FieldGrid> tool_grid;
   // Points on the tool's surface (tool frame) tested against the anatomy.
   haptic::SurfaceSamples tool_samples;
   // Every rigid body either side touches, loaded once.

@@ -1,6 +1,7 @@
 // Spheres against a rigid body's signed distance field (see sphere_query.h).
 #include "fahr/haptic/sphere_query.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -174,26 +175,31 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   const auto& order = tree.order();
   if (slots.size() != state.centres_m().size()) return stats;  // a tree of another layout
 
-  std::array<std::int32_t, SphereTree::kMaxDepth + 1> stack{};
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const SphereTreeNode& node = nodes[stack[--top]];
-    ++stats.nodes_visited;
-    const Eigen::Vector3d centre = 0.5 * (node.box_min_m + node.box_max_m);
-    const double half_diagonal =
-        0.5 * (node.box_max_m - node.box_min_m).norm() + settings.contact_skin_m + settings.candidate_margin_m;
-    // Lower bound of the distance from any point of the box to the body.
-    const double bound = field.distance(frame.to_body(centre)) - grid_error - half_diagonal;
-    if (!(bound <= settings.approach_margin_m)) {  // NaN-safe: a NaN pose touches nothing
-      if (&node == &nodes[0]) stats.body_skipped = true;
-      continue;
+  // Lower bound of the distance from any point of a node's spheres (grown by
+  // the skin and the candidate margin) to the body, m: the field at the box's
+  // middle less the node's reach (a distance is 1-Lipschitz).
+  auto node_bound = [&](const SphereTreeNode& node) noexcept {
+    const Eigen::Vector3d middle = 0.5 * (node.box_min_m + node.box_max_m);
+    const double reach = node.reach_m + settings.contact_skin_m + settings.candidate_margin_m;
+    return field.distance(frame.to_body(middle)) - grid_error - reach;
+  };
+  // The deepest k contacts found so far, as a min-heap of depths (deepest_only).
+  const std::size_t keep = std::min(settings.deepest_only, kMaxDeepest);
+  std::array<double, kMaxDeepest> kept_depths;
+  std::size_t kept = 0;
+  const auto deeper_first = [](double a, double b) { return a > b; };  // min-heap
+  auto note_depth = [&](double depth) noexcept {
+    if (keep == 0) return;
+    if (kept < keep) {
+      kept_depths[kept++] = depth;
+      std::push_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept), deeper_first);
+    } else if (depth > kept_depths[0]) {
+      std::pop_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept), deeper_first);
+      kept_depths[kept - 1] = depth;
+      std::push_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept), deeper_first);
     }
-    if (node.count == 0) {
-      stack[top++] = node.first;
-      stack[top++] = node.first + 1;
-      continue;
-    }
+  };
+  auto test_leaf = [&](const SphereTreeNode& node) noexcept {
     for (std::int32_t k = 0; k < node.count; ++k) {
       const std::uint32_t sphere = order[node.first + k];
       // The memory is kept by slot (leaf order): read in sequence, not at random.
@@ -237,7 +243,68 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       contact.normal_without_history = no_history;
       contact.candidate = depth <= 0.0;
       if (!out.push(contact)) stats.overflowed = true;
+      note_depth(depth);
     }
+  };
+
+  if (keep == 0) {
+    std::array<std::int32_t, SphereTree::kMaxDepth + 1> stack{};
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const SphereTreeNode& node = nodes[stack[--top]];
+      ++stats.nodes_visited;
+      if (!(node_bound(node) <= settings.approach_margin_m)) {  // NaN-safe: a NaN pose touches nothing
+        if (&node == &nodes[0]) stats.body_skipped = true;
+        continue;
+      }
+      if (node.count == 0) {
+        stack[top++] = node.first;
+        stack[top++] = node.first + 1;
+        continue;
+      }
+      test_leaf(node);
+    }
+    return stats;
+  }
+
+  // Deepest first: the frontier is a heap on the bound (the smallest, i.e.
+  // the deepest a sphere in it can be, on top). A sphere of a node with bound
+  // b reads at most -b - margin + grid error deep: its depth r + skin -
+  // grid(c) is at most reach + skin - d(middle) + grid error, as |c - middle|
+  // + r <= reach.
+  std::vector<PrePenetrationMemory::Frontier>& frontier = memory.frontier();
+  frontier.clear();
+  if (frontier.capacity() < nodes.size()) return stats;  // a memory of another tree: never allocate here
+  const auto nearer_first = [](const PrePenetrationMemory::Frontier& a, const PrePenetrationMemory::Frontier& b) {
+    return a.bound_m > b.bound_m;
+  };
+  auto offer_node = [&](std::int32_t index) noexcept {
+    const double bound = node_bound(nodes[static_cast<std::size_t>(index)]);
+    ++stats.nodes_visited;
+    if (!(bound <= settings.approach_margin_m)) {
+      if (index == 0) stats.body_skipped = true;
+      return;
+    }
+    frontier.push_back({bound, index});
+    std::push_heap(frontier.begin(), frontier.end(), nearer_first);
+  };
+  offer_node(0);
+  while (!frontier.empty()) {
+    std::pop_heap(frontier.begin(), frontier.end(), nearer_first);
+    const PrePenetrationMemory::Frontier next = frontier.back();
+    frontier.pop_back();
+    const SphereTreeNode& node = nodes[static_cast<std::size_t>(next.node)];
+    if (kept == keep) {
+      const double deepest_possible = -next.bound_m - settings.candidate_margin_m + grid_error;
+      if (kept_depths[0] >= deepest_possible) break;  // nothing left can beat the k kept
+    }
+    if (node.count == 0) {
+      offer_node(node.first);
+      offer_node(node.first + 1);
+      continue;
+    }
+    test_leaf(node);
   }
   return stats;
 }

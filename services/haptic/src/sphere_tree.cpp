@@ -68,15 +68,24 @@ void SphereTree::refit(const SphereState& state) {
         node.box_min_m = node.box_min_m.cwiseMin(centres[s] - Eigen::Vector3d::Constant(radii[s]));
         node.box_max_m = node.box_max_m.cwiseMax(centres[s] + Eigen::Vector3d::Constant(radii[s]));
       }
+      const Eigen::Vector3d middle = 0.5 * (node.box_min_m + node.box_max_m);
+      node.reach_m = 0.0;
       for (std::int32_t i = 0; i < node.count; ++i) {
         const std::uint32_t s = order_[node.first + i];
         slot_spheres_[static_cast<std::size_t>(node.first + i)] << centres[s], radii[s];
+        node.reach_m = std::max(node.reach_m, (centres[s] - middle).norm() + radii[s]);
       }
     } else if (k > 0 || !order_.empty()) {
       const SphereTreeNode& a = nodes_[node.first];
       const SphereTreeNode& b = nodes_[node.first + 1];
       node.box_min_m = a.box_min_m.cwiseMin(b.box_min_m);
       node.box_max_m = a.box_max_m.cwiseMax(b.box_max_m);
+      // Both bound every sphere point's distance from the box's middle.
+      const Eigen::Vector3d middle = 0.5 * (node.box_min_m + node.box_max_m);
+      const double through_children =
+          std::max((0.5 * (a.box_min_m + a.box_max_m) - middle).norm() + a.reach_m,
+                   (0.5 * (b.box_min_m + b.box_max_m) - middle).norm() + b.reach_m);
+      node.reach_m = std::min(through_children, 0.5 * (node.box_max_m - node.box_min_m).norm());
     }
   }
   ++refits_;

@@ -62,7 +62,21 @@ struct QuerySettings {
   // touching; the contact solve wants their compliance, and a response that
   // has just cleared a sphere leaves it at depth 0, still resting on the tool).
   double candidate_margin_m = 0.0;
+  // 0: every contact. k > 0 (at most kMaxDeepest): the caller keeps only the
+  // k deepest (the haptic tick's rows), so the tree is walked deepest-first,
+  // by each subtree's bound on how deep a sphere in it can be, and the walk
+  // stops once k contacts are found that no unvisited subtree can beat. The
+  // k deepest are then among the contacts reported (more may be). A blade
+  // pressed into the tongue touches ~500 spheres, of which 64 are kept.
+  // Approximation: a sphere whose depth comes from its pre-penetration centre
+  // (pushed through a thin blade) can be deeper than its subtree's bound,
+  // which reads the field; such a sphere may be missed when k others beat the
+  // bound. Spheres not visited are not remembered outside in that query.
+  std::size_t deepest_only = 0;
 };
+
+// Most contacts QuerySettings::deepest_only can ask for.
+inline constexpr std::size_t kMaxDeepest = 256;
 
 // Per (sphere tree, rigid body): the last centre seen outside the body, in the
 // body's frame. Capacity fixed at construction. Indexed by the sphere's slot
@@ -73,7 +87,9 @@ struct QuerySettings {
 class PrePenetrationMemory {
  public:
   PrePenetrationMemory() = default;
-  explicit PrePenetrationMemory(std::size_t sphere_count) : slots_(sphere_count) {}
+  explicit PrePenetrationMemory(std::size_t sphere_count) : slots_(sphere_count) {
+    frontier_.reserve(2 * sphere_count + 2);
+  }
   void remember(std::uint32_t slot, const Eigen::Vector3d& centre_body_m, std::uint64_t query) noexcept {
     slots_[slot].centre_body_m = centre_body_m;
     slots_[slot].query_index = query;
@@ -102,6 +118,15 @@ class PrePenetrationMemory {
   std::size_t size() const { return slots_.size(); }
   std::uint64_t next_query() noexcept { return ++queries_; }  // 1-based, 0 = never
 
+  // Workspace of the deepest-first walk: subtrees to visit, keyed by their
+  // distance bound. Sized at construction for any tree over these spheres
+  // (a binary tree with at least one sphere per leaf has < 2n nodes).
+  struct Frontier {
+    double bound_m;
+    std::int32_t node;
+  };
+  std::vector<Frontier>& frontier() noexcept { return frontier_; }
+
  private:
   struct alignas(64) Slot {
     Eigen::Vector3d centre_body_m = Eigen::Vector3d::Zero();
@@ -110,6 +135,7 @@ class PrePenetrationMemory {
     std::uint8_t has_nearest = 0;
   };
   std::vector<Slot> slots_;
+  std::vector<Frontier> frontier_;
   std::uint64_t queries_ = 0;
 };
 

@@ -22,6 +22,10 @@ struct SphereTreeNode {
   // reverse sweep refits bottom-up.
   std::int32_t first = 0;
   std::int32_t count = 0;
+  // Radius of a ball about the box's middle that holds every sphere of the
+  // node, m (<= the box's half diagonal, tighter for round clusters): the
+  // queries' bound on how near the body a sphere of the node can reach.
+  double reach_m = 0.0;
 };
 
 class SphereTree {
