@@ -32,6 +32,7 @@
 #include <memory>
 #include <string>
 
+#include "fahr/common/solver_threads.h"
 #include "fahr/geometry/tet_quality.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
@@ -307,6 +308,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
 }  // namespace
 
 int main(int argc, char** argv) {
+  fahr::common::run_solver_libraries_on_one_thread(argv);
   CLI::App app{"fahr overshoot benchmark (paper Figure 7, neonatal tongue)"};
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
   double factor = 3.0;

@@ -4,7 +4,8 @@
 // fahr_lockstep_clock does for the same run over DDS, and a few figures.
 // Equal hashes show that the in-process run is the distributed one.
 //
-//   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle] [--seconds 4]
+//   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
+//                      [--fem-anatomy on|off] [--seconds 4]
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -12,10 +13,12 @@
 #include <cstdio>
 #include <vector>
 
+#include "fahr/common/solver_threads.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
 
 int main(int argc, char** argv) {
+  fahr::common::run_solver_libraries_on_one_thread(argv);
   using namespace fahr;
   CLI::App app{"fahr in-process lockstep run"};
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
@@ -24,6 +27,9 @@ int main(int argc, char** argv) {
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--script", script, "the simulated hand's script")->check(CLI::IsMember({"intubation", "overshoot"}));
   std::string collision = "aist";
+  std::string fem_anatomy = "on";
+  app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")
+      ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--collision", collision, "the haptic service's collision method")
       ->check(CLI::IsMember({"aist", "triangle"}));
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
@@ -32,6 +38,7 @@ int main(int argc, char** argv) {
   try {
     stack_sim::StackOptions options;
     options.script = script == "overshoot" ? device::Script::kOvershoot : device::Script::kIntubation;
+    options.fem_anatomy = fem_anatomy == "on";
     options.collision =
         collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;
     stack_sim::StackSim sim(scene::load_scene(scene_path), options);
@@ -72,6 +79,11 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(sim.fem().stale_sets()),
                 static_cast<unsigned long long>(sim.fem().inverted_max()));
     const auto& cpu = sim.haptic_tick_cpu();
+    const auto& fem_cpu = sim.fem_step_cpu();
+    std::printf("stack_sim: FEM step CPU ms median %.2f p99 %.2f max %.2f\n",
+                1e-6 * static_cast<double>(fem_cpu.percentile(0.5).count()),
+                1e-6 * static_cast<double>(fem_cpu.percentile(0.99).count()),
+                1e-6 * static_cast<double>(fem_cpu.max().count()));
     const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
     std::printf("stack_sim: haptic tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f\n", us(cpu.percentile(0.5)),
                 us(cpu.percentile(0.99)), us(cpu.percentile(0.999)), us(cpu.max()));

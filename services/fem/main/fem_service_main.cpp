@@ -15,6 +15,7 @@
 #include "fahr/common/lockstep.h"
 #include "fahr/runtime/service_options.h"
 #include "fahr/common/service_reporter.h"
+#include "fahr/common/solver_threads.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/runtime/scene_transport.h"
@@ -142,5 +143,6 @@ int run(int argc, char** argv) {
 }  // namespace fahr::fem_service
 
 int main(int argc, char** argv) {
+  fahr::common::run_solver_libraries_on_one_thread(argv);
   return fahr::runtime::run_service_main("fahr_fem_service", fahr::fem_service::run, argc, argv);
 }

@@ -83,7 +83,7 @@ class StackSim {
   // no transport), 5 us bins (up to 10 ms: the triangle baseline reaches ms).
   const metrics::DurationHistogram& haptic_tick_cpu() const { return haptic_tick_cpu_; }
   // Thread-CPU time of each FEM service step so far (the step and its
-  // DeformationState, no transport), 10 us bins: against the FEM's period.
+  // DeformationState, no transport), 50 us bins (up to 100 ms): against the FEM's period.
   const metrics::DurationHistogram& fem_step_cpu() const { return fem_step_cpu_; }
   std::chrono::nanoseconds last_fem_step_cpu() const { return last_fem_step_cpu_; }
 
@@ -122,7 +122,7 @@ class StackSim {
   std::uint64_t step_ = 0;
 
   metrics::DurationHistogram haptic_tick_cpu_{std::chrono::microseconds(5)};
-  metrics::DurationHistogram fem_step_cpu_{std::chrono::microseconds(10)};
+  metrics::DurationHistogram fem_step_cpu_{std::chrono::microseconds(50)};
   std::chrono::nanoseconds last_fem_step_cpu_{0};
   common::OutputHash gateway_hash_;
   common::OutputHash haptic_hash_;
