@@ -1,6 +1,7 @@
 // Re-execution with the solver libraries held to one thread (see solver_threads.h).
 #include "fahr/common/solver_threads.h"
 
+#include <limits.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -12,10 +13,19 @@ namespace fahr::common {
 void run_solver_libraries_on_one_thread(char** argv) {
   const char* choice = std::getenv("FAHR_SOLVER_THREADS");
   if (std::getenv("OMP_THREAD_LIMIT") != nullptr || (choice != nullptr && std::strcmp(choice, "any") == 0)) return;
-  setenv("OMP_THREAD_LIMIT", "1", 1);
-  setenv("OMP_WAIT_POLICY", "passive", 1);
-  setenv("OPENBLAS_NUM_THREADS", "1", 1);
-  execv("/proc/self/exe", argv);
+  // The program's own path, not /proc/self/exe: exec'ing that link would
+  // rename the process "exe" for ps, pgrep and killall.
+  char path[PATH_MAX];
+  const ssize_t length = readlink("/proc/self/exe", path, sizeof(path) - 1);
+  // FAHR_SOLVER_THREADS=any in the child as well: should the environment
+  // not take the limits, the child runs as is instead of re-executing again.
+  if (length <= 0 || setenv("OMP_THREAD_LIMIT", "1", 1) != 0 || setenv("OMP_WAIT_POLICY", "passive", 1) != 0 ||
+      setenv("OPENBLAS_NUM_THREADS", "1", 1) != 0 || setenv("FAHR_SOLVER_THREADS", "any", 1) != 0) {
+    std::fprintf(stderr, "fahr: cannot hold the solver libraries to one thread; running as is\n");
+    return;
+  }
+  path[length] = '\0';
+  execv(path, argv);
   std::perror("fahr: re-executing with the solver libraries on one thread failed; running as is");
 }
 

@@ -74,10 +74,12 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows, const Tis
   }
   // A_ij = n_i^T W_ij n_j for tissue rows with blocks; a fallback diagonal
   // for tissue rows without; zero for obstacles (rigid).
+  // Filled for j <= i and mirrored: W's stored blocks are symmetric only to
+  // float rounding, and the PGS relies on an exactly symmetric S.
   for (std::size_t i = 0; i < k_; ++i) {
     const ContactRow& ri = rows_[i];
     fallback_diagonal_[i] = 0.0;
-    for (std::size_t j = 0; j < k_; ++j) {
+    for (std::size_t j = 0; j <= i; ++j) {
       const ContactRow& rj = rows_[j];
       double value = 0.0;
       if (ri.compliance_index != kNoCompliance && rj.compliance_index != kNoCompliance) {
@@ -88,6 +90,7 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows, const Tis
         fallback_diagonal_[i] = 1.0;
       }
       a_[i * capacity_ + j] = value;
+      a_[j * capacity_ + i] = value;
     }
   }
   report.rows = k_;

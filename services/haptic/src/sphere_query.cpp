@@ -175,13 +175,27 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   const auto& order = tree.order();
   if (slots.size() != state.centres_m().size()) return stats;  // a tree of another layout
 
-  // Lower bound of the distance from any point of a node's spheres (grown by
-  // the skin and the candidate margin) to the body, m: the field at the box's
-  // middle less the node's reach (a distance is 1-Lipschitz).
+  // Lower bound of the grid value at any point of a node's spheres (grown by
+  // the skin and the candidate margin), m. On the grid: the grid at the box's
+  // middle less the node's reach (a distance is 1-Lipschitz), less the grid's
+  // error twice (the grid is within it of the distance at the middle and at
+  // the sphere). Off the grid the field extends its border value by the
+  // distance to the border, which can exceed the distance; there the bound is
+  // the distance to the surface's box, which the grid surrounds by at least
+  // the exact band plus two cells (SignedDistanceField), less one error.
+  const Eigen::Vector3d grid_low = sdf.grid_origin_m();
+  const Eigen::Vector3d grid_high =
+      grid_low + sdf.cell_size_m() * (sdf.grid_dimensions() - Eigen::Vector3i::Ones()).cast<double>();
+  const Eigen::Vector3d inset = Eigen::Vector3d::Constant(sdf.band_m() + 2.0 * sdf.cell_size_m());
+  const Eigen::Vector3d surface_low = grid_low + inset;
+  const Eigen::Vector3d surface_high = grid_high - inset;
   auto node_bound = [&](const SphereTreeNode& node) noexcept {
-    const Eigen::Vector3d middle = 0.5 * (node.box_min_m + node.box_max_m);
+    const Eigen::Vector3d middle = frame.to_body(0.5 * (node.box_min_m + node.box_max_m));
     const double reach = node.reach_m + settings.contact_skin_m + settings.candidate_margin_m;
-    return field.distance(frame.to_body(middle)) - grid_error - reach;
+    const bool on_grid = (middle.array() >= grid_low.array()).all() && (middle.array() <= grid_high.array()).all();
+    if (on_grid) return field.distance(middle) - 2.0 * grid_error - reach;
+    const double to_surface_box = (middle - middle.cwiseMax(surface_low).cwiseMin(surface_high)).norm();
+    return to_surface_box - grid_error - reach;  // a NaN pose gives NaN: the caller prunes it
   };
   // The deepest k contacts found so far, as a min-heap of depths (deepest_only).
   const std::size_t keep = std::min(settings.deepest_only, kMaxDeepest);
@@ -270,12 +284,14 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
 
   // Deepest first: the frontier is a heap on the bound (the smallest, i.e.
   // the deepest a sphere in it can be, on top). A sphere of a node with bound
-  // b reads at most -b - margin + grid error deep: its depth r + skin -
-  // grid(c) is at most reach + skin - d(middle) + grid error, as |c - middle|
-  // + r <= reach.
+  // b reads at most -b - margin deep: its depth r + skin - grid(c) is at most
+  // reach + skin - grid(middle) + 2 grid error, as |c - middle| + r <= reach.
   std::vector<PrePenetrationMemory::Frontier>& frontier = memory.frontier();
   frontier.clear();
-  if (frontier.capacity() < nodes.size()) return stats;  // a memory of another tree: never allocate here
+  if (frontier.capacity() < nodes.size()) {  // a memory of another tree (or a copy): never allocate here
+    stats.overflowed = true;
+    return stats;
+  }
   const auto nearer_first = [](const PrePenetrationMemory::Frontier& a, const PrePenetrationMemory::Frontier& b) {
     return a.bound_m > b.bound_m;
   };
@@ -296,7 +312,7 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     frontier.pop_back();
     const SphereTreeNode& node = nodes[static_cast<std::size_t>(next.node)];
     if (kept == keep) {
-      const double deepest_possible = -next.bound_m - settings.candidate_margin_m + grid_error;
+      const double deepest_possible = -next.bound_m - settings.candidate_margin_m;
       if (kept_depths[0] >= deepest_possible) break;  // nothing left can beat the k kept
     }
     if (node.count == 0) {

@@ -121,7 +121,9 @@ void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::ve
                                double candidate_margin_m) {
   Impl& m = *impl_;
   // Beyond the tool boxes' growth a candidate's pair would not be found.
-  const double margin = std::clamp(candidate_margin_m, 0.0, 0.99 * kMaxFaceDepthM);
+  // (A NaN margin is none.)
+  const double margin =
+      std::isfinite(candidate_margin_m) ? std::clamp(candidate_margin_m, 0.0, 0.99 * kMaxFaceDepthM) : 0.0;
   out.clear();
   m.pairs.resizeNoInitialize(0);  // keeps the capacity; resize() would copy an uninitialised pair
   btTransform tool_pose;

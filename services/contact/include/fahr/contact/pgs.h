@@ -28,7 +28,8 @@ struct PgsReport {
 };
 
 // PGS work over several solves (a tick runs one to a dozen): a row visit
-// costs one k-long dot product, so row visits x k is the tick's PGS cost.
+// costs at most one k-long column update (none when its lambda stays), so
+// row visits x k bounds the tick's PGS cost.
 struct PgsWork {
   std::uint32_t solves = 0;
   std::uint32_t sweeps = 0;
