@@ -18,17 +18,25 @@ SphereLinks links_for_tets(const TetMesh& mesh, std::initializer_list<std::size_
   return links;
 }
 
-TEST(Projection, CentreMovesExactlyByCorrectionAndHeavyNodesMoveLess) {
+// One sphere on the unit tet's four nodes with unequal weights; node 0 is
+// fixed (inverse mass 0), node 3 ten times heavier than node 2.
+struct OneSphere {
   SphereLinks links;
-  const std::array<std::uint32_t, 4> nodes = {0, 1, 2, 3};
-  const std::array<double, 4> weights = {0.1, 0.2, 0.3, 0.4};
-  ASSERT_EQ(links.add_sphere(nodes, weights, 0.001), "");
   std::vector<double> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
   const std::vector<double> start = positions;
-  // Node 0 is fixed (inverse mass 0); node 3 is ten times heavier than node 2.
   const std::vector<double> inverse_mass = {0.0, 1.0 / 0.002, 1.0 / 0.001, 1.0 / 0.01};
+  const Eigen::Vector3d dc{0.003, -0.002, 0.0015};
+  OneSphere() {
+    const std::array<std::uint32_t, 4> nodes = {0, 1, 2, 3};
+    const std::array<double, 4> weights = {0.1, 0.2, 0.3, 0.4};
+    EXPECT_EQ(links.add_sphere(nodes, weights, 0.001), "");
+  }
+};
+
+TEST(Projection, CentreMovesExactlyByCorrectionAndHeavyNodesMoveLess) {
+  OneSphere one;
+  auto& [links, positions, start, inverse_mass, dc] = one;
   const Eigen::Vector3d before = links.centre(0, positions.data());
-  const Eigen::Vector3d dc(0.003, -0.002, 0.0015);
   ASSERT_TRUE(move_sphere_centre(0, links, inverse_mass, dc, positions));
   const Eigen::Vector3d after = links.centre(0, positions.data());
   EXPECT_NEAR((after - before - dc).norm(), 0.0, 1e-15);
@@ -44,15 +52,9 @@ TEST(Projection, CentreMovesExactlyByCorrectionAndHeavyNodesMoveLess) {
 }
 
 TEST(Projection, TranslationSpreadMovesEveryFreeNodeAlike) {
-  SphereLinks links;
-  const std::array<std::uint32_t, 4> nodes = {0, 1, 2, 3};
-  const std::array<double, 4> weights = {0.1, 0.2, 0.3, 0.4};
-  ASSERT_EQ(links.add_sphere(nodes, weights, 0.001), "");
-  std::vector<double> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
-  const std::vector<double> start = positions;
-  const std::vector<double> inverse_mass = {0.0, 1.0 / 0.002, 1.0 / 0.001, 1.0 / 0.01};  // node 0 fixed
+  OneSphere one;
+  auto& [links, positions, start, inverse_mass, dc] = one;
   const Eigen::Vector3d before = links.centre(0, positions.data());
-  const Eigen::Vector3d dc(0.003, -0.002, 0.0015);
   ASSERT_TRUE(move_sphere_centre(0, links, inverse_mass, dc, positions, SphereSpread::kTranslation));
   EXPECT_NEAR((links.centre(0, positions.data()) - before - dc).norm(), 0.0, 1e-15);
   const Eigen::Vector3d expected = dc / 0.9;  // the free nodes carry 0.9 of the centre
