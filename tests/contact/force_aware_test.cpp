@@ -2,6 +2,8 @@
 // hold, release with hysteresis, catch up without a force step.
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "fahr/contact/contact_response.h"
 #include "synthetic.h"
 
@@ -78,6 +80,47 @@ TEST(ForceAware, DisabledNeverFreezes) {
   ContactResponse response(settings);
   response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
   EXPECT_FALSE(press(response, patch, 0.5, -0.012).froze);
+}
+
+// A blade sunk into tissue that closes over it: one row below the tool and
+// one above, both deep in the FEM's free motion (which lies far beyond the
+// blade once the tongue is pressed in: tools/overshoot_bench saw 22 mm). The
+// resultant is the small difference of two large forces, and backing off
+// along it makes one row deeper: no back-off within the rows' depth brings it
+// under the limit. A held proxy must not be thrown there in one tick (it was:
+// 23 mm through the tongue).
+TEST(ForceAware, ATickNeverThrowsAHeldToolFartherThanAFastHandMoves) {
+  const double radius = 1e-3, compliance = 1e-3;  // m, m/N: a 1 kN/m tissue spring
+  ContactRow below, above;
+  below.id = 0;
+  below.normal = Eigen::Vector3d(0, -1, 0);
+  below.radius_m = radius;
+  below.other_point_m = Eigen::Vector3d(0, 0.019, 0);  // depth 20 mm
+  below.compliance_index = 0;
+  above.id = 1;
+  above.normal = Eigen::Vector3d(0, 1, 0);
+  above.radius_m = radius;
+  above.other_point_m = Eigen::Vector3d(0, -0.021, 0);  // depth 22 mm
+  above.compliance_index = 1;
+  const ContactRow rows[] = {below, above};
+  const std::uint32_t ids[] = {0, 1};
+  std::vector<float> w(36, 0.0f);
+  for (int d = 0; d < 6; ++d) w[static_cast<std::size_t>(7 * d)] = static_cast<float>(compliance);
+  ASSERT_NEAR(rows[0].penetration_m(), 0.020, 1e-12);
+  ASSERT_NEAR(rows[1].penetration_m(), 0.022, 1e-12);
+
+  ContactResponse response{ResponseSettings{}};
+  response.reset(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity());
+  TickInput in;
+  in.device.renderable_force_n = 0.2;
+  in.rows = rows;
+  in.compliance.sphere_ids = ids;
+  in.compliance.w_mpn = w;
+  const ForceOutput& out = response.tick(in);
+  // The coupled solve's resultant (about 0.3 N) is past the limit: held.
+  ASSERT_TRUE(out.lost_track);
+  EXPECT_LE(out.proxy_position_m.norm(), 1e-3 + 1e-9);
+  EXPECT_TRUE(out.proxy_position_m.allFinite());
 }
 
 }  // namespace

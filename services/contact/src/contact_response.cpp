@@ -13,9 +13,15 @@ namespace {
 // the reaction is nearly linear in the back-off, so a few reach the
 // tolerance; 8 bound the rare strongly curved case.
 constexpr int kMaxYieldIterations = 8;
-// How much farther than its deepest row a backing-off or stepping proxy may
-// go, m: 1 mm, a tick of a fast hand.
+// How much farther than its deepest row a stepping proxy may go, m: 1 mm,
+// a tick of a fast hand.
 constexpr double kYieldCapMarginM = 1e-3;
+// How far a held proxy may back off in one tick, m: 1 mm, a tick of a fast
+// hand. The rows' depths are those of the FEM's free motion, which lies far
+// beyond the blade once the tongue is pressed in deep (22 mm in
+// tools/overshoot_bench); a back-off bounded by them threw the blade 23 mm
+// through the tongue in one tick.
+constexpr double kMaxYieldStepM = 1e-3;
 // A tissue reaction above this multiple of the limit is not the force-aware
 // decision's rounding but a wedge (see tick()): the 5 % band.
 constexpr double kWedgeBand = 1.05;
@@ -75,27 +81,28 @@ void ContactResponse::capture_holds(const TissueCompliance& compliance) {
 // never receives more than the device can render. The reaction falls
 // monotonically as the tool backs off, so the back-off s is bracketed in
 // [0, cap] and found by regula falsi (Illinois) on the pinned solve. The cap
-// bounds it by the deepest tissue row plus a millimetre: an unconverged
-// reaction (a huge lambda) can then not throw the proxy across the mouth.
+// is a tick of a fast hand (kMaxYieldStepM). When even the cap leaves the
+// reaction over the limit, the tissue holds the blade from more than one side
+// (the blade sunk into a tongue that closes over it: the resultant then need
+// not point out of the tissue at all) and no back-off along it is a remedy:
+// the proxy stays, and tick() scales what the tissue receives to the limit.
 Eigen::Vector3d ContactResponse::yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n) {
   const Eigen::Vector3d reaction = solver_.resultant(RowKind::kTissue);
   const double r0 = reaction.norm();
   if (!(r0 > limit_n)) return offset_m;
   report_.yielded = true;
   const Eigen::Vector3d out = -reaction / r0;  // the tissue pushes the tool this way
-  double deepest = 0.0;
-  for (std::size_t i = 0; i < solver_.size(); ++i) {
-    if (solver_.row(i).kind != RowKind::kTissue) continue;
-    deepest = std::max(deepest, solver_.penetration(i) + solver_.row(i).normal.dot(offset_m));
-  }
   const auto excess = [&](double s) {
     solver_.solve_pinned(offset_m + s * out, settings_.pgs);
     return solver_.resultant(RowKind::kTissue).norm() - limit_n;
   };
   double lo = 0.0, f_lo = r0 - limit_n;
-  double hi = deepest + kYieldCapMarginM;
+  double hi = kMaxYieldStepM;
   double f_hi = excess(hi);
-  if (f_hi > 0.0) return offset_m + hi * out;  // the most the cap allows
+  if (f_hi > 0.0) {
+    excess(0.0);  // hold: leave the solver at the proxy's own pose
+    return offset_m;
+  }
   int stale_side = 0;  // Illinois: halve the value kept twice in a row
   for (int iteration = 0; iteration < kMaxYieldIterations; ++iteration) {
     const double s = hi - f_hi * (hi - lo) / (f_hi - f_lo);
