@@ -34,9 +34,10 @@ TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
   QuerySettings exact, grid, searched;
   grid.exact_narrow_phase = false;
   searched.flat_gradient_tolerance = 0.0;  // every narrow-phase sphere searches the triangles
+  searched.surface_probe = QuerySettings::SurfaceProbe::kAnchor;  // both surface probes
   grid.candidate_margin_m = 0.25e-3;
   grid.contact_skin_m = 0.1e-3;
-  std::size_t contacts = 0;
+  std::size_t contacts = 0, with_surface = 0;
   test::arm_allocation_counter();
   for (int tick = 0; tick < 50; ++tick) {
     x[1] -= 1e-5;  // a node moves: a new FEM state every tick
@@ -50,10 +51,12 @@ TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
     const QuerySettings& settings = tick % 3 == 0 ? exact : (tick % 3 == 1 ? grid : searched);
     query_spheres(tree, tick % 2 == 0 ? state : stretch_state, body, settings, memory, buffer);
     contacts += buffer.size();
+    for (const SphereContact& c : buffer) with_surface += c.has_surface ? 1 : 0;
   }
   const std::size_t allocations = test::disarm_allocation_counter();
   EXPECT_EQ(allocations, 0u);
   EXPECT_GT(contacts, 0u) << "the slab touches the tongue: the narrow phase ran";
+  EXPECT_EQ(with_surface, contacts) << "every sphere of the default layout has a surface anchor";
   EXPECT_EQ(tree.rebuild_count(), 0u);
 }
 

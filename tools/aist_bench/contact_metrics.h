@@ -50,6 +50,19 @@ class ContactMetrics {
   std::vector<double> aist_depth_error_m_, base_depth_error_m_, exact_depth_m_;
   // Over every verified contact, tongue and blade vertices alike.
   std::vector<double> all_exact_depth_m_, all_deepest_error_m_, all_nearest_error_m_;
+  // The surface depth (SphereContact::surface_depth_m) at every verified
+  // contact, per kind of contact (0: tongue vertex, 1: blade vertex, 2: all):
+  // of the nearest sphere as above, and of the reporting sphere in whose
+  // region the point lies whose surface point is nearest the point (the
+  // surface that measures there), also with candidates' surface points, and
+  // the blade's exact field at that surface point (a diagnostic); the
+  // distance of that surface point from the point.
+  static constexpr int kKinds = 3;
+  std::vector<double> nearest_surface_error_m_[kKinds], anchor_error_m_[kKinds], anchor_field_error_m_[kKinds];
+  std::vector<double> anchor_candidates_error_m_[kKinds];  // candidates' anchors too
+  std::vector<double> sphere_nearest_error_m_[kKinds];  // the old figure, split by kind
+  std::vector<double> anchor_distance_m_;
+  std::size_t base_recalled_surface_ = 0;  // a reporting sphere, or a candidate whose anchor is inside
 };
 
 }  // namespace fahr::aist_bench

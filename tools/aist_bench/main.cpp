@@ -1,7 +1,7 @@
 // aist_bench: prints Markdown tables. Sections: coverage, trajectory, sweep
 // (default: all), detection (the trajectory with the FEM driven by node
 // contacts, both detectors judged on the same states). Usage: aist_bench
-// [coverage|trajectory|detection|sweep|all] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--spread W] [--sweep-steps N]
+// [coverage|trajectory|detection|sweep|all] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe anchor|face] [--spread W] [--sweep-steps N]
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -19,6 +19,16 @@ int main(int argc, char** argv) {
       options.ticks = std::stoi(argv[++i]);
     } else if (std::strcmp(argv[i], "--spread") == 0 && i + 1 < argc) {
       options.weight_spread = std::stod(argv[++i]);
+    } else if (std::strcmp(argv[i], "--surface-probe") == 0 && i + 1 < argc) {
+      const std::string probe = argv[++i];
+      if (probe != "anchor" && probe != "face") {
+        std::fprintf(stderr, "aist_bench: --surface-probe takes anchor or face, not %s\n", probe.c_str());
+        return 2;
+      }
+      options.surface_probe = probe == "anchor" ? fahr::haptic::QuerySettings::SurfaceProbe::kAnchor
+                                                : fahr::haptic::QuerySettings::SurfaceProbe::kFacePoint;
+    } else if (std::strcmp(argv[i], "--anchor-gap-mm") == 0 && i + 1 < argc) {
+      options.anchor_gap_m = 1e-3 * std::stod(argv[++i]);
     } else if (std::strcmp(argv[i], "--skin-mm") == 0 && i + 1 < argc) {
       options.skin_m = 1e-3 * std::stod(argv[++i]);
     } else if (std::strcmp(argv[i], "--hugging-tolerance-mm") == 0 && i + 1 < argc) {

@@ -44,14 +44,21 @@ void NodeMetrics::add_tick(const haptic::ContactBuffer& aist, const haptic::Sphe
     const double exact = -scene_.blade_sdf.query(blade_from_world * p).distance_m;
     if (!(exact > 0.0)) continue;
     bool recalled = false, near = false;
-    double aist_depth = 0.0;
+    double aist_depth = 0.0, surface_depth = 0.0, anchor_gap = std::numeric_limits<double>::infinity();
     for (const auto& a : aist) {
-      if ((p - centres[a.sphere_id]).norm() > radii[a.sphere_id] + ContactMetrics::kRegionSlackM) continue;
+      const double gap = (p - centres[a.sphere_id]).norm() - radii[a.sphere_id];
+      if (gap > ContactMetrics::kRegionSlackM) continue;
       near = true;
       if (a.candidate) continue;
       recalled = true;
       aist_depth = std::max(aist_depth, a.depth_m);
+      const double to_anchor = a.has_surface ? (p - a.surface_point_m).norm() : gap;
+      if (to_anchor < anchor_gap) {
+        anchor_gap = to_anchor;
+        surface_depth = a.has_surface ? a.surface_depth_m : a.depth_m;
+      }
     }
+    surface_error_m_.push_back(std::abs(std::max(surface_depth, 0.0) - exact));
     const auto vertex = static_cast<std::size_t>(node_to_vertex_[node]);
     const bool by_base = base_stamp_[vertex] == tick_;
     for (int c = 0; c < kClasses; ++c) {
@@ -110,6 +117,7 @@ void NodeMetrics::print() const {
   };
   row("AIST", aist_error_m_);
   row("AIST, recalled nodes", recalled_error_m_);
+  row("AIST surface depth (nearest surface point)", surface_error_m_);
   row("baseline", base_error_m_);
 }
 

@@ -42,6 +42,9 @@ class NodeMetrics {
   std::size_t miss_candidate_ = 0, miss_standoff_ = 0, miss_detached_ = 0;
   std::vector<double> exact_m_, aist_error_m_, aist_signed_error_m_, base_error_m_;
   std::vector<double> recalled_error_m_;  // AIST error over recalled nodes only
+  // The surface depth of the reporting sphere holding the node whose surface
+  // point is nearest it (SphereContact::surface_depth_m; 0 when none).
+  std::vector<double> surface_error_m_;
 };
 
 }  // namespace fahr::aist_bench

@@ -19,6 +19,8 @@ struct Options {
   double hugging_radius_fraction = haptic::FillSettings{}.hugging_radius_fraction;
   double approach_margin_m = haptic::QuerySettings{}.approach_margin_m;  // QuerySettings of the trajectory
   double anchor_depth_factor = haptic::FillSettings{}.hugging_anchor_depth_factor;
+  double anchor_gap_m = haptic::FillSettings{}.anchor_gap_m;  // FillSettings::anchor_gap_m
+  haptic::QuerySettings::SurfaceProbe surface_probe = haptic::QuerySettings{}.surface_probe;  // --surface-probe anchor|face
   // true (section "detection"): the trajectory's FEM is driven by node
   // contacts (node_contacts.h) instead of the AIST's, so both detectors are
   // judged on states neither of them made.

@@ -96,6 +96,7 @@ void trajectory_table(const Scene& scene, const Options& options) {
   fill.hugging_tolerance_m = options.hugging_tolerance_m;
   fill.hugging_radius_fraction = options.hugging_radius_fraction;
   fill.hugging_anchor_depth_factor = options.anchor_depth_factor;
+  fill.anchor_gap_m = options.anchor_gap_m;
   const haptic::SphereLayout layout = haptic::fill_spheres(scene.tongue, fill);
   const fem::SphereLinks links = to_fem_links(layout, options.skin_m);
   auto body = make_tongue_body(scene);
@@ -108,6 +109,7 @@ void trajectory_table(const Scene& scene, const Options& options) {
   exact_settings.contact_skin_m = options.skin_m;
   exact_settings.candidate_margin_m = kCandidateMarginM;
   exact_settings.approach_margin_m = options.approach_margin_m;
+  exact_settings.surface_probe = options.surface_probe;
   haptic::QuerySettings grid_settings = exact_settings;
   grid_settings.exact_narrow_phase = false;
   // The first two are the AIST as the library is meant to be used (with the
@@ -266,11 +268,13 @@ void trajectory_table(const Scene& scene, const Options& options) {
   std::printf("\n## %s: Miller 1 pressing and levering the FEM tongue (%d ticks at 1 kHz, FEM every %d ticks, contact skin %.2f mm, candidate margin %.2f mm)\n\n",
               options.node_driven ? "Detection only (the FEM driven by node contacts)" : "Trajectory", options.ticks,
               options.fem_every, options.skin_m * 1e3, kCandidateMarginM * 1e3);
-  std::printf("Layout: %zu spheres (%zu grid level 0, %zu level 1, %zu hugging), ratio %.0f, levels %d, weight spread %.2f (hugging %.2f), radius rule: %s. "
+  std::printf("Layout: %zu spheres (%zu grid level 0, %zu level 1, %zu hugging; %zu with a surface anchor, anchor gap %.2f mm, surface probe: %s), ratio %.0f, levels %d, weight spread %.2f (hugging %.2f), radius rule: %s. "
               "FEM (fahr::fem, corotational, implicit Euler, Algorithm 1 projection of %s): "
               "%zu steps, %.2f ms per step. Contacts per tick at most: AIST %zu, baseline %zu; buffer overflows: %zu. "
               "Rebuilds after construction: AIST tree %llu, baseline tree %llu.\n\n",
               layout.size(), layout.count_at_level(0), layout.count_at_level(1), layout.count(haptic::SphereOrigin::kHugging),
+              layout.anchor_count(), fill.anchor_gap_m * 1e3,
+              options.surface_probe == haptic::QuerySettings::SurfaceProbe::kAnchor ? "fixed anchor" : "face point under the contact",
               fill.volume_ratio, fill.refinement_levels, fill.weight_spread, fill.hugging_weight_spread,
               options.stretch_radius ? "smallest stretch" : "volume", options.node_driven ? "every boundary node (node_contacts.h), neither detector" : "the AIST contacts", fem_steps,
               fem_ms / static_cast<double>(fem_steps), max_aist_contacts, max_base_contacts, overflows,

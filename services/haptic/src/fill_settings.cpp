@@ -34,6 +34,7 @@ void validate_fill_settings(const FillSettings& s) {
   require(std::isfinite(s.hugging_anchor_depth_factor) && s.hugging_anchor_depth_factor >= 1.0 &&
               s.hugging_anchor_depth_factor <= 8.0,
           "hugging_anchor_depth_factor", s.hugging_anchor_depth_factor, "[1, 8]");
+  require(s.anchor_gap_m >= 0.0, "anchor_gap_m", s.anchor_gap_m, ">= 0 (m) or +infinity");  // NaN fails
   require(std::isfinite(s.min_radius_fraction) && s.min_radius_fraction >= 0.0 &&
               s.min_radius_fraction <= 1.0,
           "min_radius_fraction", s.min_radius_fraction, "[0, 1]");

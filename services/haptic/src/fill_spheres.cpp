@@ -11,6 +11,7 @@
 
 #include "fahr/geometry/signed_distance_field.h"
 #include "octree_fill.h"
+#include "surface_anchor.h"
 #include "surface_hugging.h"
 #include "tet_links.h"
 
@@ -44,25 +45,13 @@ detail::SphereLink anchored_link(detail::TetLinker& linker, const detail::Candid
                                  const geometry::SurfaceMesh& boundary,
                                  const std::vector<geometry::Index>& surface_to_node,
                                  const geometry::SignedDistanceField& sdf, double depth_factor) {
-  const geometry::BvhClosestPoint hit =
-      sdf.bvh().closest_point(c.centre_m, std::numeric_limits<double>::infinity());
-  if (hit.triangle < 0) return linker.link(c.centre_m, c.radius_m, 0.0);
-  const geometry::Triangle& t = boundary.triangles()[static_cast<std::size_t>(hit.triangle)];
-  const auto& v = boundary.vertices();
-  // Barycentric coordinates of the hit in its triangle (areas of the sub-triangles).
-  const Eigen::Vector3d n = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]);
-  const double area2 = n.squaredNorm();
-  if (!(area2 > 0.0)) return linker.link(c.centre_m, c.radius_m, 0.0);
-  Eigen::Vector3d bary;
-  for (int k = 0; k < 3; ++k) {
-    bary[k] = n.dot((v[t[(k + 1) % 3]] - hit.point).cross(v[t[(k + 2) % 3]] - hit.point)) / area2;
+  SurfaceAnchor tangent;
+  if (!detail::nearest_face_point(boundary, surface_to_node, sdf, c.centre_m,
+                                  std::numeric_limits<double>::infinity(), tangent)) {
+    return linker.link(c.centre_m, c.radius_m, 0.0);
   }
-  bary = bary.cwiseMax(0.0);
-  bary /= bary.sum();
-  const Eigen::Vector3d anchor = bary[0] * v[t[0]] + bary[1] * v[t[1]] + bary[2] * v[t[2]];
-  std::array<std::uint32_t, 3> nodes{};
-  for (int k = 0; k < 3; ++k) nodes[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(surface_to_node[t[k]]);
-  return linker.link_anchored(c.centre_m, c.radius_m, anchor, nodes, bary, depth_factor);
+  const Eigen::Vector3d weights(tangent.weights[0], tangent.weights[1], tangent.weights[2]);
+  return linker.link_anchored(c.centre_m, c.radius_m, tangent.rest_point_m, tangent.nodes, weights, depth_factor);
 }
 
 }  // namespace
@@ -98,6 +87,8 @@ SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& set
   std::vector<SphereRecord> records;
   std::vector<std::uint32_t> nodes, tets;
   std::vector<double> weights;
+  std::vector<SurfaceAnchor> anchors(candidates.size());
+  std::vector<std::uint8_t> has_anchor(candidates.size(), 0);
   records.reserve(candidates.size());
   for (const auto& c : candidates) {
     const double spread =
@@ -119,10 +110,18 @@ SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& set
     nodes.insert(nodes.end(), link.nodes.begin(), link.nodes.end());
     weights.insert(weights.end(), link.weights.begin(), link.weights.end());
     tets.insert(tets.end(), link.tets.begin(), link.tets.end());
+    // The anchor of the centre as linked (the point the FEM moves).
+    const std::size_t i = records.size();
+    has_anchor[i] = detail::nearest_face_point(boundary, surface_to_node, sdf, link.centre_m,
+                                               c.radius_m + settings.anchor_gap_m, anchors[i])
+                        ? 1
+                        : 0;
     records.push_back(r);
   }
-  return SphereLayout(std::move(records), std::move(nodes), std::move(weights), std::move(tets),
-                      mesh.tets(), mesh.node_count(), settings.refinement_levels, coarse_radius);
+  SphereLayout layout(std::move(records), std::move(nodes), std::move(weights), std::move(tets), mesh.tets(),
+                      mesh.node_count(), settings.refinement_levels, coarse_radius);
+  layout.set_anchors(std::move(anchors), std::move(has_anchor));
+  return layout;
 }
 
 }  // namespace fahr::haptic

@@ -75,6 +75,36 @@ SphereLayout::SphereLayout(std::vector<SphereRecord> spheres, std::vector<std::u
   }
 }
 
+void SphereLayout::set_anchors(std::vector<SurfaceAnchor> anchors, std::vector<std::uint8_t> has_anchor) {
+  if (anchors.size() != has_anchor.size() || (!anchors.empty() && anchors.size() != spheres_.size())) {
+    throw std::invalid_argument("sphere layout: " + std::to_string(anchors.size()) + " anchors and " +
+                                std::to_string(has_anchor.size()) + " flags for " + std::to_string(spheres_.size()) +
+                                " spheres");
+  }
+  for (std::size_t i = 0; i < anchors.size(); ++i) {
+    if (has_anchor[i] == 0) continue;
+    double sum = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double w = anchors[i].weights[static_cast<std::size_t>(k)];
+      if (!(w >= 0.0) || anchors[i].nodes[static_cast<std::size_t>(k)] >= node_count_) {
+        throw std::invalid_argument("sphere layout: the anchor of sphere " + std::to_string(i) +
+                                    " has a negative or NaN weight or a node out of range");
+      }
+      sum += w;
+    }
+    if (std::abs(sum - 1.0) > kWeightSumTolerance || !anchors[i].rest_point_m.allFinite()) {
+      throw std::invalid_argument("sphere layout: the anchor of sphere " + std::to_string(i) +
+                                  " has weights not summing to 1 or a non-finite rest point");
+    }
+  }
+  anchors_ = std::move(anchors);
+  has_anchor_ = std::move(has_anchor);
+}
+
+std::size_t SphereLayout::anchor_count() const {
+  return static_cast<std::size_t>(std::count_if(has_anchor_.begin(), has_anchor_.end(), [](std::uint8_t f) { return f != 0; }));
+}
+
 std::size_t SphereLayout::count(SphereOrigin origin) const {
   return static_cast<std::size_t>(std::count_if(
       spheres_.begin(), spheres_.end(), [&](const SphereRecord& s) { return s.origin == origin; }));
@@ -92,6 +122,13 @@ std::uint64_t SphereLayout::fingerprint() const {
   hash_bytes(hash, link_nodes_.data(), link_nodes_.size() * sizeof(std::uint32_t));
   hash_bytes(hash, link_weights_.data(), link_weights_.size() * sizeof(double));
   hash_bytes(hash, linked_tets_.data(), linked_tets_.size() * sizeof(std::uint32_t));
+  for (std::size_t i = 0; i < anchors_.size(); ++i) {
+    hash_bytes(hash, &has_anchor_[i], sizeof(std::uint8_t));
+    hash_bytes(hash, anchors_[i].nodes.data(), 3 * sizeof(std::uint32_t));
+    hash_bytes(hash, anchors_[i].weights.data(), 3 * sizeof(double));
+    hash_bytes(hash, anchors_[i].rest_point_m.data(), 3 * sizeof(double));
+    for (const Eigen::Vector3d& p : anchors_[i].rest_face_m) hash_bytes(hash, p.data(), 3 * sizeof(double));
+  }
   return hash;
 }
 

@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 
+#include "fahr/geometry/closest_point.h"
+
 namespace fahr::haptic {
 namespace {
 
@@ -172,6 +174,9 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   const Eigen::Matrix3d world_rotation = body.world_from_body.linear();
   const std::uint64_t query = memory.next_query();
   const auto& slots = tree.slot_spheres();
+  const auto& slot_anchors = tree.slot_anchors();
+  const auto& slot_faces = tree.slot_faces();
+  const bool face_probe = settings.surface_probe == QuerySettings::SurfaceProbe::kFacePoint;
   const auto& order = tree.order();
   if (slots.size() != state.centres_m().size()) return stats;  // a tree of another layout
 
@@ -256,6 +261,18 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       contact.depth_m = depth;
       contact.normal_without_history = no_history;
       contact.candidate = depth <= 0.0;
+      // The surface point and its depth behind the body's tangent plane at
+      // the contact (NaN x: no anchor): no field read, and the side is the
+      // pre-penetration normal's, so a point pushed past a thin plate's
+      // mid-plane is still measured from the face it came through.
+      const Eigen::Vector3d& anchor = slot_anchors[slot];
+      if (!std::isnan(anchor.x())) {
+        const auto& face = slot_faces[slot];
+        contact.surface_point_m =
+            face_probe ? geometry::closest_point_on_triangle(contact.point_m, face[0], face[1], face[2]).point : anchor;
+        contact.surface_depth_m = (contact.point_m - contact.surface_point_m).dot(contact.normal);
+        contact.has_surface = true;
+      }
       if (!out.push(contact)) stats.overflowed = true;
       note_depth(depth);
     }

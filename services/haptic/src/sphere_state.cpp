@@ -6,11 +6,14 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
 namespace fahr::haptic {
 namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Six times the signed volume of a tet from flat positions, m^3.
 double six_volume(const geometry::Tet& t, const double* x) {
@@ -60,6 +63,9 @@ SphereState::SphereState(const SphereLayout& layout, std::span<const double> res
 SphereState::SphereState(const SphereLayout& layout)
     : centres_m_(layout.size(), Eigen::Vector3d::Zero()),
       radii_m_(layout.size(), 0.0),
+      anchors_m_(layout.size(), Eigen::Vector3d::Constant(kNaN)),
+      anchor_faces_m_(layout.size(), {Eigen::Vector3d::Constant(kNaN), Eigen::Vector3d::Constant(kNaN),
+                                      Eigen::Vector3d::Constant(kNaN)}),
       six_volume_m3_(layout.tets().size(), 0.0) {
   reset_to_rest(layout);
 }
@@ -68,6 +74,11 @@ void SphereState::reset_to_rest(const SphereLayout& layout) {
   for (std::size_t i = 0; i < layout.size(); ++i) {
     centres_m_[i] = layout.sphere(i).rest_centre_m;
     radii_m_[i] = layout.sphere(i).rest_radius_m;
+    const SurfaceAnchor* anchor = layout.anchor(i);
+    if (anchor != nullptr) {
+      anchors_m_[i] = anchor->rest_point_m;
+      anchor_faces_m_[i] = anchor->rest_face_m;
+    }
   }
   ++version_;
 }
@@ -107,6 +118,15 @@ bool SphereState::update(const SphereLayout& layout, std::span<const double> pos
       // cbrt keeps the sphere's volume proportional to its tets' volume.
       scale = ratio > kMinVolumeScale * kMinVolumeScale * kMinVolumeScale ? std::min(std::cbrt(ratio), kMaxVolumeScale)
                                                                             : kMinVolumeScale;
+    }
+    if (const SurfaceAnchor* anchor = layout.anchor(i); anchor != nullptr) {
+      Eigen::Vector3d a = Eigen::Vector3d::Zero();
+      for (std::size_t k = 0; k < 3; ++k) {
+        anchor_faces_m_[i][k] = Eigen::Vector3d(x + 3 * std::size_t{anchor->nodes[k]});
+        a += anchor->weights[k] * anchor_faces_m_[i][k];
+      }
+      if (!a.allFinite()) return false;
+      anchors_m_[i] = a;
     }
     centres_m_[i] = c;
     radii_m_[i] = s.rest_radius_m * scale;

@@ -14,6 +14,8 @@ SphereTree::SphereTree(const SphereLayout& layout) {
   nodes_.reserve(2 * layout.size() + 1);
   nodes_.emplace_back();
   slot_spheres_.assign(layout.size(), Eigen::Vector4d::Zero());
+  slot_anchors_.assign(layout.size(), Eigen::Vector3d::Zero());
+  slot_faces_.assign(layout.size(), {});
   if (n > 0) build(0, 0, n, 1, layout);
   SphereState rest(layout);
   refit(rest);
@@ -57,6 +59,8 @@ void SphereTree::build(std::int32_t node, std::int32_t begin, std::int32_t end, 
 void SphereTree::refit(const SphereState& state) {
   const auto& centres = state.centres_m();
   const auto& radii = state.radii_m();
+  const auto& anchors = state.anchors_m();
+  const auto& faces = state.anchor_faces_m();
   for (std::size_t k = nodes_.size(); k-- > 0;) {
     SphereTreeNode& node = nodes_[k];
     if (node.count > 0) {
@@ -73,6 +77,8 @@ void SphereTree::refit(const SphereState& state) {
       for (std::int32_t i = 0; i < node.count; ++i) {
         const std::uint32_t s = order_[node.first + i];
         slot_spheres_[static_cast<std::size_t>(node.first + i)] << centres[s], radii[s];
+        slot_anchors_[static_cast<std::size_t>(node.first + i)] = anchors[s];
+        slot_faces_[static_cast<std::size_t>(node.first + i)] = faces[s];
         node.reach_m = std::max(node.reach_m, (centres[s] - middle).norm() + radii[s]);
       }
     } else if (k > 0 || !order_.empty()) {

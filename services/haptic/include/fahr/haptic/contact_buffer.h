@@ -26,6 +26,27 @@ struct SphereContact {
   // was remembered: the normal is the field's, which can point the wrong way
   // through a thin plate.
   bool normal_without_history = false;
+  // The surface's own penetration (ours; set when has_surface): the sphere
+  // detects, the deformed surface measures. A sphere keeps its rest radius
+  // while the nearly incompressible tissue under a tool is squashed, so its
+  // depth_m exceeds the tissue's penetration by the amount it stands out of
+  // the deformed surface (tools/aist_bench/README.md, detection: 0.6 mm
+  // median). surface_point_m, world frame, m: a point of the deformed tissue
+  // surface on the sphere's anchor face (SurfaceAnchor; with
+  // QuerySettings::SurfaceProbe::kFacePoint, the default, the point of that
+  // face nearest point_m, i.e. the surface where the body touches; with
+  // kAnchor the fixed anchor). surface_depth_m = (point_m - surface_point_m)
+  // . normal, m: how far that surface point lies behind the body's tangent
+  // plane at point_m, > 0 penetrating, <= 0 when the surface there is clear
+  // of the body although the sphere touches. Same point, normal and side as
+  // depth_m (the pre-penetration normal), so it stays right through a thin
+  // plate; exact for a flat face, approximate where the body curves between
+  // point_m and surface_point_m (a blade's rim).
+  Eigen::Vector3d surface_point_m = Eigen::Vector3d::Zero();
+  double surface_depth_m = 0.0;
+  // False for a sphere without an anchor (FillSettings::anchor_gap_m):
+  // use depth_m.
+  bool has_surface = false;
 };
 
 class ContactBuffer {

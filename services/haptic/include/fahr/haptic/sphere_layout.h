@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -32,6 +33,21 @@ struct SphereRecord {
   SphereOrigin origin = SphereOrigin::kGrid;
 };
 
+// A sphere's point on the body's boundary (ours): the nearest boundary point
+// of its rest centre, written as barycentric weights of that boundary face's
+// three nodes, so it moves with the deformed surface. The sphere detects (its
+// union is cheap to test and to prune), the surface measures: a sphere
+// reports, beside its own depth, the penetration of its anchor
+// (SphereContact::surface_depth_m). The volume-preserving radius rule keeps
+// spheres at their rest radius while the tissue under a blade is squashed,
+// so they stand out of the deformed surface; the anchor lies on it.
+struct SurfaceAnchor {
+  std::array<std::uint32_t, 3> nodes{};  // the face's nodes
+  std::array<double, 3> weights{};       // >= 0, sum 1
+  Eigen::Vector3d rest_point_m = Eigen::Vector3d::Zero();  // = sum w_i x_i at rest, m
+  std::array<Eigen::Vector3d, 3> rest_face_m{};             // the nodes at rest, m
+};
+
 class SphereLayout {
  public:
   SphereLayout() = default;
@@ -41,6 +57,10 @@ class SphereLayout {
                std::vector<double> link_weights, std::vector<std::uint32_t> linked_tets,
                std::vector<geometry::Tet> tets, std::size_t node_count, int finest_level,
                double coarse_radius_m);
+  // Anchors: one slot per sphere; has_anchor[i] == 0 marks a sphere without
+  // one (too far from the boundary, FillSettings::anchor_gap_m). Checked as
+  // the links are; both empty: no sphere has an anchor.
+  void set_anchors(std::vector<SurfaceAnchor> anchors, std::vector<std::uint8_t> has_anchor);
 
   std::size_t size() const { return spheres_.size(); }
   const SphereRecord& sphere(std::size_t i) const { return spheres_[i]; }
@@ -55,6 +75,11 @@ class SphereLayout {
     return {linked_tets_.data() + spheres_[i].first_tet, spheres_[i].tet_count};
   }
   const std::vector<geometry::Tet>& tets() const { return tets_; }
+  // The sphere's surface anchor, or null when it has none.
+  const SurfaceAnchor* anchor(std::size_t i) const {
+    return i < has_anchor_.size() && has_anchor_[i] != 0 ? &anchors_[i] : nullptr;
+  }
+  std::size_t anchor_count() const;
   std::size_t node_count() const { return node_count_; }
   int finest_level() const { return finest_level_; }
   double coarse_radius_m() const { return coarse_radius_m_; }  // level-0 radius, m
@@ -72,6 +97,8 @@ class SphereLayout {
   std::vector<double> link_weights_;
   std::vector<std::uint32_t> linked_tets_;
   std::vector<geometry::Tet> tets_;  // the mesh's tets, for the volume of the linked ones
+  std::vector<SurfaceAnchor> anchors_;     // per sphere, or empty
+  std::vector<std::uint8_t> has_anchor_;   // per sphere, or empty
   std::size_t node_count_ = 0;
   int finest_level_ = 0;
   double coarse_radius_m_ = 0.0;

@@ -73,6 +73,15 @@ struct QuerySettings {
   // which reads the field; such a sphere may be missed when k others beat the
   // bound. Spheres not visited are not remembered outside in that query.
   std::size_t deepest_only = 0;
+  // Which point of the deformed surface measures a reported sphere
+  // (SphereContact::surface_point_m, surface_depth_m): kFacePoint: the point
+  // of its anchor's deformed face nearest the contact point (the surface
+  // where the body touches; one closest point on a triangle); kAnchor: its
+  // fixed anchor (SurfaceAnchor). On aist_bench detection the fixed anchor
+  // can lie ~1 mm from where a blade's rim cuts the face
+  // (tools/aist_bench/README.md).
+  enum class SurfaceProbe : std::uint8_t { kAnchor, kFacePoint };
+  SurfaceProbe surface_probe = SurfaceProbe::kFacePoint;
 };
 
 // Most contacts QuerySettings::deepest_only can ask for.

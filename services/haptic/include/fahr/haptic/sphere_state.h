@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -36,11 +37,21 @@ class SphereState {
   // position is not finite or the span is too short.
   bool update(const SphereLayout& layout, std::span<const double> positions_m);
 
+  // Also the deformed position of each sphere's surface anchor (sum w_i x_i
+  // over its face's nodes) and of that face's nodes, NaN for a sphere
+  // without one.
+
   // The rest state (same as update() with the rest positions).
   void reset_to_rest(const SphereLayout& layout);
 
   const std::vector<Eigen::Vector3d>& centres_m() const { return centres_m_; }
   const std::vector<double>& radii_m() const { return radii_m_; }
+  // Per sphere, m: its anchor on the deformed surface (SurfaceAnchor), or
+  // NaN (all three) for a sphere without one.
+  const std::vector<Eigen::Vector3d>& anchors_m() const { return anchors_m_; }
+  // Per sphere, m: the three deformed nodes of its anchor's face (NaN for a
+  // sphere without an anchor), for QuerySettings::SurfaceProbe::kFacePoint.
+  const std::vector<std::array<Eigen::Vector3d, 3>>& anchor_faces_m() const { return anchor_faces_m_; }
   std::uint64_t version() const { return version_; }  // bumped by every update
 
   // The radius scale of a sphere whose linked tets are inverted or flat: a
@@ -54,6 +65,8 @@ class SphereState {
  private:
   std::vector<Eigen::Vector3d> centres_m_;
   std::vector<double> radii_m_;
+  std::vector<Eigen::Vector3d> anchors_m_;
+  std::vector<std::array<Eigen::Vector3d, 3>> anchor_faces_m_;
   std::vector<double> six_volume_m3_;  // per tet, scratch of update()
   // The smallest-stretch rule: per tet the inverse rest edge matrix, and the
   // smallest singular value (scratch of update()). Empty: the volume rule.

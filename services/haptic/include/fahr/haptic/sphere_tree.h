@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -45,6 +46,12 @@ class SphereTree {
   // query reads spheres leaf by leaf, so a copy in that order is read
   // sequentially where the state's arrays (by sphere id) are read at random.
   const std::vector<Eigen::Vector4d>& slot_spheres() const { return slot_spheres_; }
+  // The last refit's surface anchor per slot (SphereState::anchors_m, NaN
+  // for none), m, in the same order: the query reads it for the spheres it
+  // reports, next to their centres.
+  const std::vector<Eigen::Vector3d>& slot_anchors() const { return slot_anchors_; }
+  // Likewise the anchor's deformed face (SphereState::anchor_faces_m).
+  const std::vector<std::array<Eigen::Vector3d, 3>>& slot_faces() const { return slot_faces_; }
   int depth() const { return depth_; }
   std::uint64_t refit_count() const { return refits_; }
   // Builds after construction. Nothing in the library rebuilds, so this stays 0.
@@ -57,6 +64,8 @@ class SphereTree {
   std::vector<SphereTreeNode> nodes_;
   std::vector<std::uint32_t> order_;
   std::vector<Eigen::Vector4d> slot_spheres_;
+  std::vector<Eigen::Vector3d> slot_anchors_;
+  std::vector<std::array<Eigen::Vector3d, 3>> slot_faces_;
   int depth_ = 0;
   std::uint64_t builds_ = 1;
   std::uint64_t refits_ = 0;
