@@ -17,11 +17,19 @@ constexpr int kMaxYieldIterations = 8;
 // a tick of a fast hand.
 constexpr double kYieldCapMarginM = 1e-3;
 // How far a held proxy may back off in one tick, m: 1 mm, a tick of a fast
-// hand. The rows' depths are those of the FEM's free motion, which lies far
-// beyond the blade once the tongue is pressed in deep (22 mm in
-// tools/overshoot_bench); a back-off bounded by them threw the blade 23 mm
-// through the tongue in one tick.
+// hand (0.4 N of coupling force at 400 N/m). The rows' depths are those of
+// the FEM's free motion, which lies far beyond the blade once the tongue is
+// pressed in deep (22 mm in tools/overshoot_bench); a back-off bounded by
+// them threw the blade 23 mm through the tongue in one tick.
 constexpr double kMaxYieldStepM = 1e-3;
+// Share of the tissue's load on rows that push against the resultant above
+// which the tool counts as gripped (tissue on more than one side): backing
+// off along the resultant then deepens a quarter or more of the load.
+constexpr double kGrippedLoadShare = 0.25;
+// A row counts as pushing against the resultant when its normal is within
+// 60 degrees of the back-off: rows beside the tool (a rounded tool sunk in
+// a block) are not a grip.
+constexpr double kBehindCosine = 0.5;
 // A tissue reaction above this multiple of the limit is not the force-aware
 // decision's rounding but a wedge (see tick()): the 5 % band.
 constexpr double kWedgeBand = 1.05;
@@ -81,17 +89,27 @@ void ContactResponse::capture_holds(const TissueCompliance& compliance) {
 // never receives more than the device can render. The reaction falls
 // monotonically as the tool backs off, so the back-off s is bracketed in
 // [0, cap] and found by regula falsi (Illinois) on the pinned solve. The cap
-// is a tick of a fast hand (kMaxYieldStepM). When even the cap leaves the
-// reaction over the limit, the tissue holds the blade from more than one side
-// (the blade sunk into a tongue that closes over it: the resultant then need
-// not point out of the tissue at all) and no back-off along it is a remedy:
-// the proxy stays, and tick() scales what the tissue receives to the limit.
+// is a tick of a fast hand (kMaxYieldStepM); a back-off that needs more
+// takes the cap and goes on next tick. A tool the tissue grips from more
+// than one side (the blade sunk into a tongue that closes over it) does not
+// back off at all: the resultant is then a small difference of large forces,
+// backing off along it deepens the rows on the other side, and the reaction
+// need not fall; the proxy stays, and tick() scales what the tissue receives
+// to the limit.
 Eigen::Vector3d ContactResponse::yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n) {
   const Eigen::Vector3d reaction = solver_.resultant(RowKind::kTissue);
   const double r0 = reaction.norm();
   if (!(r0 > limit_n)) return offset_m;
   report_.yielded = true;
   const Eigen::Vector3d out = -reaction / r0;  // the tissue pushes the tool this way
+  double load = 0.0, opposing = 0.0;
+  for (std::size_t i = 0; i < solver_.size(); ++i) {
+    if (solver_.row(i).kind != RowKind::kTissue) continue;
+    load += solver_.lambda(i);
+    // Backing off deepens this row by more than half as much: tissue behind.
+    if (solver_.row(i).normal.dot(out) > kBehindCosine) opposing += solver_.lambda(i);
+  }
+  if (opposing > kGrippedLoadShare * load) return offset_m;  // gripped: hold
   const auto excess = [&](double s) {
     solver_.solve_pinned(offset_m + s * out, settings_.pgs);
     return solver_.resultant(RowKind::kTissue).norm() - limit_n;
@@ -99,10 +117,7 @@ Eigen::Vector3d ContactResponse::yield_to_limit(const Eigen::Vector3d& offset_m,
   double lo = 0.0, f_lo = r0 - limit_n;
   double hi = kMaxYieldStepM;
   double f_hi = excess(hi);
-  if (f_hi > 0.0) {
-    excess(0.0);  // hold: leave the solver at the proxy's own pose
-    return offset_m;
-  }
+  if (f_hi > 0.0) return offset_m + hi * out;  // the most one tick allows
   int stale_side = 0;  // Illinois: halve the value kept twice in a row
   for (int iteration = 0; iteration < kMaxYieldIterations; ++iteration) {
     const double s = hi - f_hi * (hi - lo) / (f_hi - f_lo);
