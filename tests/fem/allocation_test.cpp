@@ -32,6 +32,9 @@ std::vector<Mode> modes() {
   s.refactor_period = 5;
   list.push_back({"cg lagged cholesky (period 5)", s, true});
   s.refactor_period = 0;
+  s.cg_refresh_iterations = 1;
+  list.push_back({"cg lagged cholesky (refreshed after 1 iteration)", s, true});
+  s.cg_refresh_iterations = 0;
   s.warp_lagged_factor = true;
   list.push_back({"cg lagged cholesky (rest, warped)", s, false});
   return list;
@@ -79,6 +82,42 @@ TEST(Allocation, StepAllocatesNothing) {
                   refactorisations, test::suitesparse_alloc_count());
     }
   }
+}
+
+// The compliance block keeps each sphere's solved columns while the
+// factorisation is unchanged: a changing set of spheres (as the blade
+// slides) then solves only the new ones, in chunks whose CHOLMOD buffers are
+// kept, and allocates nothing once each chunk size has been seen.
+TEST(Allocation, ComplianceOfChangingSpheresAllocatesNothing) {
+  test::hook_suitesparse_allocations();
+  const TetMesh mesh = test::bar_mesh(2);
+  BodySettings settings;
+  settings.solver.refactor_period = 0;
+  settings.solver.refactor_rotation_rad = 0.0;
+  settings.max_compliance_spheres = 16;
+  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(body, nullptr);
+  SphereLinks links;
+  const std::array<double, 4> w = {0.25, 0.25, 0.25, 0.25};
+  for (std::size_t s = 0; s < 40; ++s) ASSERT_EQ(links.add_sphere(mesh.tets[s], w, 0.001), "");
+  std::vector<float> out(9 * 16 * 16);
+  std::vector<std::uint32_t> spheres;
+  const auto window = [&](std::uint32_t first, std::uint32_t count) {
+    spheres.clear();
+    for (std::uint32_t s = first; s < first + count; ++s) spheres.push_back(s);
+    return body->compliance(spheres, links, out);
+  };
+  // Warm-up: every chunk size (8, 4, 2, 1 spheres) once.
+  ASSERT_TRUE(window(0, 15));
+  ASSERT_TRUE(window(20, 16));
+  test::reset_allocation_counts();
+  test::enable_allocation_counting(true);
+  bool ok = true;
+  for (std::uint32_t first = 1; first < 24; ++first) ok = window(first, 1 + first % 16) && ok;
+  test::enable_allocation_counting(false);
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(test::new_count(), 0u);
+  EXPECT_EQ(test::suitesparse_alloc_count(), 0u);
 }
 
 }  // namespace

@@ -101,13 +101,6 @@ struct PressedBar {
   }
 };
 
-double lowest_free_node_height(const Body& body) {
-  double lowest = std::numeric_limits<double>::infinity();
-  for (std::uint32_t n = 0; n < body.node_count(); ++n) {
-    if (!body.fixed(n)) lowest = std::min(lowest, body.position(n).y());
-  }
-  return lowest;
-}
 
 TEST(ObstacleProjection, APressedBodyNeverGoesDeeperThanTheMargin) {
   PressedBar bar;
@@ -124,7 +117,7 @@ TEST(ObstacleProjection, APressedBodyNeverGoesDeeperThanTheMargin) {
     const StepReport report = step.step(&set);
     ASSERT_FALSE(report.solve_failed) << k;
     ASSERT_TRUE(test::all_finite(*body)) << k;
-    ASSERT_GE(lowest_free_node_height(*body) + 1e-3, kMargin - kTolerance) << "step " << k;
+    ASSERT_GE(test::lowest_free_node_height(*body) + 1e-3, kMargin - kTolerance) << "step " << k;
     EXPECT_EQ(report.projection.obstacle_unresolved, 0) << k;
     if (report.projection.obstacle_deepest_m > deepest_free) {
       deepest_free = report.projection.obstacle_deepest_m;
@@ -133,7 +126,7 @@ TEST(ObstacleProjection, APressedBodyNeverGoesDeeperThanTheMargin) {
   }
   // Not vacuous: the free motion did go into the floor, and the bar lies on it.
   EXPECT_GT(deepest_free, 1e-4) << "deepest at step " << deepest_step;
-  EXPECT_LT(lowest_free_node_height(*body) + 1e-3, kMargin + 1e-4);
+  EXPECT_LT(test::lowest_free_node_height(*body) + 1e-3, kMargin + 1e-4);
 }
 
 TEST(ObstacleProjection, FixedNodesNeverMove) {
@@ -153,7 +146,7 @@ TEST(ObstacleProjection, FixedNodesNeverMove) {
       EXPECT_GT(report.projection.obstacle_nodes, 0);
     }
     for (const std::uint32_t n : bar.fixed) ASSERT_EQ(body->position(n), body->rest_position(n)) << "node " << n;
-    ASSERT_GE(lowest_free_node_height(*body) - 2e-3, kMargin - kTolerance) << "step " << k;
+    ASSERT_GE(test::lowest_free_node_height(*body) - 2e-3, kMargin - kTolerance) << "step " << k;
   }
 }
 
@@ -174,7 +167,7 @@ TEST(ObstacleProjection, TheMovesAreCarriedAsVelocity) {
   for (int k = 0; k < 600; ++k) {
     const StepReport report = step.step(nullptr);
     touching_steps += report.projection.obstacle_nodes > 0 ? 1 : 0;
-    ASSERT_GE(lowest_free_node_height(*body) + 1e-3, kMargin - kTolerance) << "step " << k;
+    ASSERT_GE(test::lowest_free_node_height(*body) + 1e-3, kMargin - kTolerance) << "step " << k;
   }
   EXPECT_GT(touching_steps, 0);  // it did reach the floor
   // At rest: the nodes no longer move from step to step. (Body velocities

@@ -2,7 +2,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "fahr/fem/body.h"
@@ -51,6 +53,15 @@ inline bool all_finite(const Body& body) {
     if (!std::isfinite(v)) return false;
   }
   return true;
+}
+
+// Height (y) of the lowest node that is not fixed, m.
+inline double lowest_free_node_height(const Body& body) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (std::uint32_t n = 0; n < body.node_count(); ++n) {
+    if (!body.fixed(n)) lowest = std::min(lowest, body.position(n).y());
+  }
+  return lowest;
 }
 
 }  // namespace fahr::fem::test

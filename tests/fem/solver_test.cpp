@@ -3,7 +3,9 @@
 // same static equilibrium.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <string>
 
 #include "scenes.h"
 
@@ -72,6 +74,81 @@ TEST(Solvers, LaggedFactorisationsReachTheSameEquilibrium) {
     cg.cg_relative_tolerance = 1e-8;
     EXPECT_LT(largest_difference(reference, run(cg, 400)), 1e-6) << "warp " << warp;
   }
+}
+
+TEST(Solvers, CgRefreshesItsFactorOnlyWhenTheSolveGetsExpensive) {
+  // The bar sags about 45 degrees: the rest factor stops being a good
+  // preconditioner. With the rotation trigger off, the iteration trigger
+  // alone refreshes it, a few times rather than every step, and the
+  // trajectory is still the exact one (CG converges on the current A).
+  const TetMesh mesh = test::bar_mesh(2);
+  SolverSettings exact;
+  const auto reference = run(exact, 100);
+  SolverSettings cg;
+  cg.kind = LinearSolver::kConjugateGradient;
+  cg.preconditioner = CgPreconditioner::kLaggedCholesky;
+  cg.refactor_period = 0;
+  cg.refactor_rotation_rad = 0.0;
+  cg.cg_relative_tolerance = 1e-10;
+  cg.cg_max_iterations = 1000;
+  const auto steps_with = [&](int refresh_iterations, int& most_iterations) {
+    BodySettings settings;
+    settings.solver = cg;
+    settings.solver.cg_refresh_iterations = refresh_iterations;
+    settings.time_step = std::chrono::duration<double>(0.01);
+    settings.sleep.enabled = false;
+    auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+    EXPECT_NE(body, nullptr);
+    most_iterations = 0;
+    for (int k = 0; k < 100; ++k) most_iterations = std::max(most_iterations, body->step().solver_iterations);
+    EXPECT_LT(largest_difference(reference, {body->positions_m().begin(), body->positions_m().end()}), 1e-8)
+        << "refresh after " << refresh_iterations;
+    return body->factorisations() - 1;  // less the set-up's
+  };
+  int never_most = 0;
+  int refreshed_most = 0;
+  EXPECT_EQ(steps_with(0, never_most), 0u);
+  const std::uint64_t refreshes = steps_with(4, refreshed_most);
+  EXPECT_GT(refreshes, 0u);
+  EXPECT_LT(refreshes, 50u);
+  EXPECT_LT(refreshed_most, never_most);
+}
+
+TEST(Solvers, SetSolverSwitchesARunningBodyAndRejectsBadSettings) {
+  const TetMesh mesh = test::bar_mesh(2);
+  BodySettings settings;
+  settings.time_step = std::chrono::duration<double>(0.01);
+  settings.sleep.enabled = false;
+  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(body, nullptr);
+  for (int k = 0; k < 20; ++k) body->step();
+  SolverSettings bad;
+  bad.cg_refresh_iterations = -1;
+  EXPECT_NE(body->set_solver(bad).find("cg_refresh_iterations"), std::string::npos);
+  bad = {};
+  bad.refactor_rotation_rad = -0.1;
+  EXPECT_NE(body->set_solver(bad).find("refactor_rotation_rad"), std::string::npos);
+  settings.solver.cg_refresh_iterations = -2;
+  EXPECT_NE(Body::create(settings, mesh.nodes_m, mesh.tets, test::fixed_x0(mesh)).error.find("cg_refresh_iterations"),
+            std::string::npos);
+  // Switched to CG on a fresh factor and back with another ordering: the
+  // trajectory stays the exact one.
+  const std::uint64_t before = body->factorisations();
+  SolverSettings cg;
+  cg.kind = LinearSolver::kConjugateGradient;
+  cg.preconditioner = CgPreconditioner::kLaggedCholesky;
+  cg.refactor_period = 0;
+  cg.cg_relative_tolerance = 1e-10;
+  cg.cg_max_iterations = 1000;
+  ASSERT_EQ(body->set_solver(cg), "");
+  EXPECT_EQ(body->factorisations(), before + 1);
+  for (int k = 0; k < 20; ++k) body->step();
+  SolverSettings amd;
+  amd.cholmod.ordering = CholmodOrdering::kAmd;
+  ASSERT_EQ(body->set_solver(amd), "");
+  for (int k = 0; k < 20; ++k) body->step();
+  const auto reference = run(SolverSettings{}, 60);
+  EXPECT_LT(largest_difference(reference, {body->positions_m().begin(), body->positions_m().end()}), 1e-8);
 }
 
 TEST(Solvers, RestFactorAloneOscillatesUnderLargeRotation) {

@@ -6,7 +6,8 @@
 // force-aware response and the penalty baseline on the same script.
 //
 //   fahr_overshoot_bench [--scene FILE] [--factor 3] [--response both|force-aware|penalty]
-//                        [--fem-anatomy on|off] [--sphere-spread service|mass|translation]
+//                        [--fem-anatomy on|off] [--fem-support RATIO] [--youngs-pa E] [--tool-stops on|off]
+//                        [--sphere-spread service|mass|translation]
 //                        [--trace FILE] [--check]
 //
 // --fem-anatomy off: the FEM leaves the anatomy to the haptic side's
@@ -178,15 +179,23 @@ ToolContacts count_contacts(const msg::ContactSet& set) {
   return c;
 }
 
-Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double factor, bool fem_anatomy,
+Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double factor, bool fem_anatomy, double support_ratio,
+           double youngs_pa, const std::string& tool_stops,
            const std::string& spread, const std::string& trace_path) {
   auto variant = std::make_shared<scene::Scene>(*scene);
   variant->contact.response = penalty ? scene::ContactResponse::kPenalty : scene::ContactResponse::kForceAware;
+  if (tool_stops != "scene") variant->contact.tool_stops_at_anatomy = tool_stops == "on";
+  if (youngs_pa > 0.0) {
+    for (auto& body : variant->bodies) {
+      if (body.deformable) body.deformable->material.youngs_modulus_pa = youngs_pa;
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
   stack_sim::StackOptions options;
   options.script = device::Script::kOvershoot;
   options.overshoot_factor = factor;
   options.fem_anatomy = fem_anatomy;
+  if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
   if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
   if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
   stack_sim::StackSim sim(variant, options);
@@ -200,7 +209,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
     std::fprintf(trace,
                  "t_s,inverted,inverted_near_anatomy,inverted_near_blade,anatomy_nodes,anatomy_depth_mm,"
                  "anatomy_unresolved,anatomy_rounds,sweeps,tool_active,tool_frozen,force_only,obstacle_contacts,"
-                 "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,inverted_free,fem_cpu_ms\n");
+                 "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,inverted_free,fem_cpu_ms,supported_nodes\n");
   }
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
@@ -273,13 +282,14 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
         // 1 mm: a tet that close to bone or blade is pressed by it.
         const Inversions inv = locate_inversions(sim, 1e-3);
         const ToolContacts tc = count_contacts(sim.contacts());
-        std::fprintf(trace, "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f\n", sim.time_s(), inv.count,
+        std::fprintf(trace, "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d\n", sim.time_s(), inv.count,
                      inv.near_anatomy, inv.near_blade, report.projection.obstacle_nodes,
                      1e3 * report.projection.obstacle_deepest_m, report.projection.obstacle_unresolved,
                      report.projection.obstacle_rounds, report.projection.sweeps, tc.active, tc.frozen, tc.force_only,
                      tc.obstacle, c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
                      1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio, inverted_free(sim),
-                     1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()));
+                     1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
+                     report.projection.obstacle_supported);
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
@@ -315,6 +325,9 @@ int main(int argc, char** argv) {
   bool check = false;
   std::string response = "both";
   std::string fem_anatomy = "on";
+  double support_ratio = -1.0;
+  double youngs_pa = 0.0;
+  std::string tool_stops = "scene";
   std::string trace_path;
   std::string spread = "service";
   app.add_option("--scene", scene_path, "scene file");
@@ -324,6 +337,14 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"both", "force-aware", "penalty"}));
   app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")
       ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--fem-support", support_ratio,
+                 "the FEM's anatomy support springs, stiffness over the node's diagonal of A; 0: off "
+                 "(default: the service's)")
+      ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--tool-stops", tool_stops, "the tool stops at the rigid anatomy (default: as the scene says)")
+      ->check(CLI::IsMember({"scene", "on", "off"}));
+  app.add_option("--youngs-pa", youngs_pa, "overrides the deformable body's Young's modulus, Pa (default: the scene's)")
+      ->check(CLI::Range(1.0, 1e9));
   app.add_option("--trace", trace_path, "per-FEM-step CSV, FILE.<response>.csv");
   app.add_option("--factor", factor, "overshoot: the hand's pull as a multiple of the device's peak force")
       ->check(CLI::Range(1.0, 10.0));
@@ -333,8 +354,8 @@ int main(int argc, char** argv) {
   try {
     const auto scene = scene::load_scene(scene_path);
     const bool anatomy = fem_anatomy == "on";
-    const Result fa = response != "penalty" ? run(scene, false, factor, anatomy, spread, trace_path) : Result{};
-    const Result pe = response != "force-aware" ? run(scene, true, factor, anatomy, spread, trace_path) : Result{};
+    const Result fa = response != "penalty" ? run(scene, false, factor, anatomy, support_ratio, youngs_pa, tool_stops, spread, trace_path) : Result{};
+    const Result pe = response != "force-aware" ? run(scene, true, factor, anatomy, support_ratio, youngs_pa, tool_stops, spread, trace_path) : Result{};
     const auto mm = [](double m) { return 1e3 * m; };
     std::printf("## Overshoot on the neonatal tongue (%.0fx the device's peak force, hold 5 s)\n\n", factor);
     std::printf("| figure | force-aware | penalty |\n|---|---:|---:|\n");

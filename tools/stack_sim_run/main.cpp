@@ -5,7 +5,7 @@
 // Equal hashes show that the in-process run is the distributed one.
 //
 //   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
-//                      [--fem-anatomy on|off] [--seconds 4]
+//                      [--fem-anatomy on|off] [--fem-support RATIO] [--seconds 4]
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -28,6 +28,11 @@ int main(int argc, char** argv) {
   app.add_option("--script", script, "the simulated hand's script")->check(CLI::IsMember({"intubation", "overshoot"}));
   std::string collision = "aist";
   std::string fem_anatomy = "on";
+  double support_ratio = -1.0;
+  app.add_option("--fem-support", support_ratio,
+                 "the FEM's anatomy support springs, stiffness over the node's diagonal of A; 0: off "
+                 "(default: the service's)")
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")
       ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--collision", collision, "the haptic service's collision method")
@@ -39,6 +44,7 @@ int main(int argc, char** argv) {
     stack_sim::StackOptions options;
     options.script = script == "overshoot" ? device::Script::kOvershoot : device::Script::kIntubation;
     options.fem_anatomy = fem_anatomy == "on";
+    if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
     options.collision =
         collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;
     stack_sim::StackSim sim(scene::load_scene(scene_path), options);

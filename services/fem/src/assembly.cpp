@@ -129,4 +129,20 @@ void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Ma
   }
 }
 
+// Within column 3 node + c the node's own three rows are contiguous (rows
+// are sorted and the node's DOFs are consecutive), so the block's column c
+// starts c entries above the diagonal.
+void SystemAssembly::add_normal_stiffness(std::uint32_t node, const Eigen::Vector3d& unit_normal, double ratio) {
+  const std::size_t first = 3 * std::size_t{node};
+  if (first + 2 >= diagonal_index_.size()) return;
+  double* values = a_.valuePtr();
+  const double mean_diagonal =
+      (values[diagonal_index_[first]] + values[diagonal_index_[first + 1]] + values[diagonal_index_[first + 2]]) / 3.0;
+  const double k = ratio * mean_diagonal;
+  for (int c = 0; c < 3; ++c) {
+    double* column = values + diagonal_index_[first + static_cast<std::size_t>(c)] - c;
+    for (int r = 0; r < 3; ++r) column[r] += k * unit_normal[r] * unit_normal[c];
+  }
+}
+
 }  // namespace fahr::fem

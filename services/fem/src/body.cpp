@@ -9,6 +9,19 @@
 
 namespace fahr::fem {
 
+namespace {
+
+std::string validate(const SolverSettings& solver) {
+  if (solver.refactor_period < 0) return "solver settings: refactor_period must be >= 0";
+  if (solver.cg_max_iterations < 0) return "solver settings: cg_max_iterations must be >= 0";
+  if (!(solver.cg_relative_tolerance >= 0.0)) return "solver settings: cg_relative_tolerance must be >= 0";
+  if (!(solver.refactor_rotation_rad >= 0.0)) return "solver settings: refactor_rotation_rad must be >= 0";
+  if (solver.cg_refresh_iterations < 0) return "solver settings: cg_refresh_iterations must be >= 0";
+  return {};
+}
+
+}  // namespace
+
 BodyOrError Body::create(const BodySettings& settings, std::span<const Eigen::Vector3d> rest_positions_m,
                          std::span<const Tet> tets, std::span<const std::uint32_t> fixed_nodes) {
   BodyOrError result;
@@ -21,9 +34,9 @@ BodyOrError Body::create(const BodySettings& settings, std::span<const Eigen::Ve
     result.error = "time_step must be finite and > 0";
     return result;
   }
-  if (settings.solver.refactor_period < 0 || settings.solver.cg_max_iterations < 0 ||
-      !(settings.solver.cg_relative_tolerance >= 0.0)) {
-    result.error = "solver settings: refactor_period and cg_max_iterations must be >= 0, tolerance >= 0";
+  const std::string solver_error = validate(settings.solver);
+  if (!solver_error.empty()) {
+    result.error = solver_error;
     return result;
   }
   if (!settings.gravity_m_per_s2.allFinite()) {
@@ -79,6 +92,7 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m, 
   for (std::size_t i = 0; i < n; ++i) {
     gravity_force_.segment<3>(3 * static_cast<Eigen::Index>(i)) = mass_kg_[i] * settings_.gravity_m_per_s2;
   }
+  supports_.assign(n, NodeSupport{});
   rotations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
   rotations_at_factor_ = rotations_;
   assembly_.build(n, rest_, fixed_dof_);
@@ -96,10 +110,43 @@ void Body::assemble_system() {
   const double alpha = settings_.material.rayleigh_mass_per_s;
   const double beta = settings_.material.rayleigh_stiffness_s;
   assembly_.assemble(rest_, rotations_, lame_, mass_per_dof_, 1.0 + h_ * alpha, h_ * beta + h_ * h_);
+  for (std::size_t i = 0; i < support_count_; ++i) {
+    assembly_.add_normal_stiffness(supports_[i].node, supports_[i].normal, support_ratio_);
+  }
+}
+
+void Body::set_supports(std::span<const NodeSupport> supports, double stiffness_ratio) {
+  support_count_ = 0;
+  support_ratio_ = stiffness_ratio > 0.0 ? stiffness_ratio : 0.0;
+  if (support_ratio_ > 0.0) {
+    for (const NodeSupport& s : supports) {
+      if (s.node >= node_count() || fixed(s.node) || !s.normal.allFinite() || support_count_ == supports_.size()) {
+        continue;
+      }
+      supports_[support_count_++] = s;
+    }
+  }
+  supports_changed_ = true;
+}
+
+std::string Body::set_solver(const SolverSettings& solver) {
+  std::string error = validate(solver);
+  if (!error.empty()) return error;
+  const bool reanalyse = solver.cholmod.factor != settings_.solver.cholmod.factor ||
+                         solver.cholmod.ordering != settings_.solver.cholmod.ordering;
+  settings_.solver = solver;
+  warp_.set_enabled(solver.warp_lagged_factor);
+  if (reanalyse && !cholmod_.analyze(assembly_.matrix(), solver.cholmod)) return "CHOLMOD symbolic analysis failed";
+  warp_.update_rotations(rest_, rotations_);
+  assemble_system();
+  if (!refactorise()) return "the system matrix is not positive definite";
+  return {};
 }
 
 bool Body::refactorise() {
   steps_since_factor_ = 0;
+  refresh_due_ = false;
+  supports_changed_ = false;
   std::copy(rotations_.begin(), rotations_.end(), rotations_at_factor_.begin());
   warp_.mark_factorised();
   return cholmod_.factorize();
@@ -139,6 +186,16 @@ int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_en
     }
   }
   return inverted;
+}
+
+// The support springs changed A as much as a rotation past the threshold
+// would: the direct solve refactorises when the rotation trigger is on (a
+// factor without them would not feel the bone at all). CG multiplies with
+// the current A, but W comes from the factor: without the springs in it W
+// was off by up to 95 % on the pressed tongue (fem_tongue_press), so a
+// lagged-factor CG refreshes too.
+bool Body::support_changed_factor_due(bool cg) const {
+  return supports_changed_ && (cg || settings_.solver.refactor_rotation_rad > 0.0);
 }
 
 bool Body::rotated_since_factor() const {
@@ -201,7 +258,9 @@ void Body::prepare_system(StepReport& report) {
   const bool cg = solver.kind == LinearSolver::kConjugateGradient;
   const bool factor_needed = !cg || solver.preconditioner == CgPreconditioner::kLaggedCholesky;
   const bool factor_due = (solver.refactor_period > 0 && steps_since_factor_ + 1 >= solver.refactor_period) ||
-                          (factor_needed && solver.refactor_period != 1 && rotated_since_factor());
+                          (factor_needed && refresh_due_) ||
+                          (factor_needed && solver.refactor_period != 1 &&
+                           (support_changed_factor_due(cg) || rotated_since_factor()));
   if (factor_needed) warp_.update_rotations(rest_, rotations_);
   // CG multiplies with the current A; the direct solve only needs A when it
   // refactorises.
@@ -227,6 +286,9 @@ void Body::solve_velocity(StepReport& report) {
                                       solver.cg_max_iterations, solver.preconditioner, &cholmod_, &warp_);
     report.solver_iterations = result.iterations;
     report.solver_relative_residual = result.relative_residual;
+    // The factor has drifted too far from A to precondition it cheaply.
+    refresh_due_ = solver.preconditioner == CgPreconditioner::kLaggedCholesky && solver.cg_refresh_iterations > 0 &&
+                   (result.iterations > solver.cg_refresh_iterations || !result.converged);
   } else {
     warp_.solve(cholmod_, rhs_.data(), v_next_.data());
   }
@@ -324,6 +386,7 @@ bool Body::reset_to_rest() {
   v_.setZero();
   clear_external_forces();
   sleep_.wake();
+  support_count_ = 0;
   std::fill(rotations_.begin(), rotations_.end(), Eigen::Matrix3d::Identity());
   warp_.update_rotations(rest_, rotations_);
   assemble_system();

@@ -5,6 +5,7 @@
 #include <cholmod.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 
 namespace fahr::fem {
@@ -13,18 +14,38 @@ struct CholmodSolver::State {
   cholmod_common common{};
   cholmod_sparse view{};  // borrows the arrays of the caller's matrix
   cholmod_factor* factor = nullptr;
-  // Reused by cholmod_solve2: X (result), Y and E (workspace). One set for
-  // single solves and one for multi-column solves, so that alternating
-  // between them does not make CHOLMOD reallocate.
+  // Reused by cholmod_solve2: X (result), Y and E (workspace). CHOLMOD
+  // reallocates them whenever the column count changes, so each count in use
+  // keeps its own set: single solves (CG, the step) and the compliance
+  // block's full and chunked solves then alternate without allocating.
   struct Buffers {
     cholmod_dense* x = nullptr;
     cholmod_dense* y = nullptr;
     cholmod_dense* e = nullptr;
+    int columns = 0;            // 0: unused
+    std::uint64_t last_use = 0; // for replacing the least recently used set
   };
-  Buffers single;
-  Buffers multi;
+  std::array<Buffers, CholmodSolver::kColumnCounts> sets{};
+  std::uint64_t uses = 0;
+  std::uint64_t factorisations = 0;
   bool numeric = false;
   std::size_t rows = 0;
+
+  // The set kept for this column count, else the least recently used one
+  // (whose buffers CHOLMOD will reallocate to the new shape).
+  Buffers& buffers_for(int columns) {
+    Buffers* chosen = &sets[0];
+    for (Buffers& b : sets) {
+      if (b.columns == columns) {
+        chosen = &b;
+        break;
+      }
+      if (b.last_use < chosen->last_use) chosen = &b;
+    }
+    chosen->columns = columns;
+    chosen->last_use = ++uses;
+    return *chosen;
+  }
 
   void release(Buffers& buffers) {
     if (buffers.x != nullptr) cholmod_free_dense(&buffers.x, &common);
@@ -34,8 +55,7 @@ struct CholmodSolver::State {
 
   ~State() {
     if (factor != nullptr) cholmod_free_factor(&factor, &common);
-    release(single);
-    release(multi);
+    for (Buffers& b : sets) release(b);
     cholmod_finish(&common);
   }
 
@@ -55,7 +75,7 @@ struct CholmodSolver::State {
   }
 
   void solve_dense(const double* b, double* out, int columns) {
-    Buffers& buffers = columns == 1 ? single : multi;
+    Buffers& buffers = buffers_for(columns);
     cholmod_dense rhs{};
     rhs.nrow = rows;
     rhs.ncol = static_cast<std::size_t>(columns);
@@ -116,10 +136,13 @@ bool CholmodSolver::factorize() {
   if (s.factor == nullptr) return false;
   const int ok = cholmod_factorize(&s.view, s.factor, &s.common);
   s.numeric = ok != 0 && s.common.status == CHOLMOD_OK;
+  if (s.numeric) ++s.factorisations;
   return s.numeric;
 }
 
 bool CholmodSolver::factorized() const { return state_->numeric; }
+
+std::uint64_t CholmodSolver::factorisations() const { return state_->factorisations; }
 
 void CholmodSolver::solve(std::span<const double> b, std::span<double> x) {
   state_->solve_dense(b.data(), x.data(), 1);

@@ -63,10 +63,15 @@ void ContactStep::set_obstacles(std::span<const ObstacleField* const> fields,
                                 const ObstacleProjectionSettings& settings) {
   obstacles_ = fields.empty() ? nullptr : std::make_unique<ObstacleProjection>(fields, body_.node_count(), settings);
   projection_settings_.project_obstacle_contacts = obstacles_ == nullptr;
+  supports_ = obstacles_ && settings.support_stiffness_ratio > 0.0
+                  ? std::make_unique<ObstacleSupport>(body_.node_count())
+                  : nullptr;
+  body_.set_supports({}, 0.0);
 }
 
 bool ContactStep::reset() {
   if (obstacles_) obstacles_->forget_clearances();
+  if (supports_ && supports_->clear()) body_.set_supports({}, 0.0);
   std::fill(carry_n_.begin(), carry_n_.end(), 0.0);
   std::fill(lambda_n_.begin(), lambda_n_.end(), 0.0);
   const auto x = body_.positions_m();
@@ -251,6 +256,10 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   update_free_centres();
   projection_ = {};
   if (obstacles_ || (contacts != nullptr && !contacts->contacts.empty())) project(contacts);
+  if (supports_ && supports_->update(*obstacles_, start_positions_, free_positions_)) {
+    body_.set_supports(supports_->supports(), obstacles_->settings().support_stiffness_ratio);
+  }
+  projection_.obstacle_supported = static_cast<int>(body_.support_count());
   report.projection = projection_;
   report.contacts_applied = contacts != nullptr;
   return report;

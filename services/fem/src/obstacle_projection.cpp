@@ -32,7 +32,8 @@ ObstacleProjection::ObstacleProjection(std::span<const ObstacleField* const> fie
       settings_(settings),
       clearance_m_(node_count * fields.size(), kUnsampled),
       sampled_at_m_(node_count, Eigen::Vector3d::Zero()),
-      moved_(node_count, 0) {
+      moved_(node_count, 0),
+      move_normal_(node_count, Eigen::Vector3d::UnitZ()) {
   settings_.max_moves_per_node = std::max(1, settings_.max_moves_per_node);
   settings_.max_rounds = std::max(1, settings_.max_rounds);
 }
@@ -123,6 +124,7 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
   bool unresolved = false;
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     if (clearance[f] >= margin) continue;
+    const Eigen::Vector3d before = x;
     ObstacleSample s = fields_[f]->sample(x);
     if (start != nullptr && s.distance_m - (x - *start).norm() < margin) {
       // The path from the step's start comes closer to this obstacle than
@@ -144,6 +146,10 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
       s = fields_[f]->sample(x);
     }
     if (!std::isfinite(s.distance_m)) return NodeOutcome::kNonFinite;
+    const double normal_length = s.normal.norm();
+    if (x != before && normal_length > kMinNormalLength && s.normal.allFinite()) {
+      move_normal_[node] = s.normal / normal_length;
+    }
     clearance[f] = s.distance_m;
     sampled_at_m_[node] = x;
     unresolved = unresolved || s.distance_m < margin - settings_.tolerance_m;

@@ -43,6 +43,7 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   digest_ = std::make_unique<haptic_service::TissueDigest>(haptic_setup_);
   tissue_ = digest_->make_snapshot();
   fem_setup_.enforce_anatomy = options.fem_anatomy;
+  if (options.fem_support_ratio) fem_setup_.anatomy_settings.support_stiffness_ratio = *options.fem_support_ratio;
   if (options.sphere_spread) fem_setup_.sphere_spread = *options.sphere_spread;
   fem_ = std::make_unique<fem_service::ServiceStep>(fem_setup_);
   contacts_.contacts().reserve(msg::MAX_CONTACTS);

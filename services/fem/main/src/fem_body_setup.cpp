@@ -45,6 +45,21 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
   // gives 116 (tools/fem_bench, `fem_bench target`); the force stays exact,
   // so the equilibrium does not change.
   s.solver.refactor_period = 0;
+  if (s.solver.kind == fem::LinearSolver::kConjugateGradient) {
+    // pcg: CG on the current A preconditioned by a lagged factorisation,
+    // refreshed when a solve needs more than 12 iterations rather than on
+    // the rotation trigger (Jacobi needs hundreds of iterations on stiff
+    // systems); W comes from the lagged factor. On the pressed neonatal
+    // tongue without the anatomy's support springs it refactorises in a
+    // third to a half of the steps (the rotation trigger: nine in ten) but
+    // the CG iterations and W's new columns eat the saving; the springs
+    // refresh it whenever the held set changes (most pressed steps), so W
+    // feels them. cholmod stays the neonatal scene's solver
+    // (services/fem/README.md, "Solver choice", fem_tongue_press).
+    s.solver.preconditioner = fem::CgPreconditioner::kLaggedCholesky;
+    s.solver.refactor_rotation_rad = 0.0;
+    s.solver.cg_refresh_iterations = 12;
+  }
   s.solver.cg_relative_tolerance = scene.solver.cg_tolerance;
   s.solver.cg_max_iterations = scene.solver.cg_max_iterations;
   s.projection.max_sweeps = scene.solver.projection_max_iterations;

@@ -30,6 +30,14 @@ class SystemAssembly {
                 const LameParameters& lame, std::span<const double> mass_per_dof_kg,
                 double mass_scale, double stiffness_scale);
 
+  // Adds k n n^T to the diagonal block of `node`, with k = ratio times the
+  // mean of the block's three diagonal entries as they are now (so the
+  // spring is that much stiffer than the node's own inertia and elasticity
+  // in the step, whatever the units and time step). unit_normal must be of
+  // length 1. Not for a fixed node (its row must stay m v = 0): the caller
+  // skips those. No allocation.
+  void add_normal_stiffness(std::uint32_t node, const Eigen::Vector3d& unit_normal, double ratio);
+
   const SparseMatrix& matrix() const { return a_; }
   // Index into matrix().valuePtr() of each DOF's diagonal entry.
   std::span<const int> diagonal_index() const { return diagonal_index_; }

@@ -29,6 +29,7 @@
 #include "fahr/fem/contact_set.h"
 #include "fahr/fem/element_rest.h"
 #include "fahr/fem/material.h"
+#include "fahr/fem/obstacle_support.h"
 #include "fahr/fem/projection.h"
 #include "fahr/fem/sleep.h"
 #include "fahr/fem/solver_settings.h"
@@ -89,6 +90,14 @@ class Body {
   static BodyOrError create(const BodySettings& settings, std::span<const Eigen::Vector3d> rest_positions_m,
                             std::span<const Tet> tets, std::span<const std::uint32_t> fixed_nodes);
 
+  // Switches the linear solve (a comparison of solvers on one running body,
+  // fem_bench's tongue_press): refactorises at the current state, analyses
+  // again if the CHOLMOD options change. Returns an error naming the bad
+  // setting (the body is then unchanged), or naming a failed analysis or
+  // factorisation (the body then has no usable factor and must not be
+  // stepped). Allocates: not for a per-step path.
+  std::string set_solver(const SolverSettings& solver);
+
   // One step. `contacts` may be null (no set this step); `links` is needed
   // when contacts are given. No allocation after the first step, apart from
   // CHOLMOD's own (malloc) workspace on refactorisation steps.
@@ -98,6 +107,14 @@ class Body {
   // m/N, from the solver's factorisation: exact when it was refactorised this
   // step (kCholmod with refactor_period 1), the lagged A otherwise.
   bool compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links, std::span<float> out);
+
+  // Nodes the static anatomy holds (obstacle_support.h): from the next step
+  // on, each gets a spring of stiffness_ratio times its diagonal of A along
+  // its normal in A (and so in W). Replaces the previous set; an empty span
+  // removes them. A changed set makes a lagged factorisation due. Fixed nodes
+  // are ignored. No allocation.
+  void set_supports(std::span<const NodeSupport> supports, double stiffness_ratio);
+  std::size_t support_count() const { return support_count_; }
 
   // External nodal force, N, held until changed; a non-zero force wakes.
   void set_external_force(std::uint32_t node, const Eigen::Vector3d& force_n);
@@ -134,6 +151,8 @@ class Body {
   const BodySettings& settings() const { return settings_; }
   const SparseMatrix& system_matrix() const { return assembly_.matrix(); }
   double factor_nonzeros() const { return cholmod_.factor_nonzeros(); }
+  // Numeric factorisations so far, set-up included.
+  std::uint64_t factorisations() const { return cholmod_.factorisations(); }
 
  private:
   Body() = default;
@@ -151,6 +170,7 @@ class Body {
   bool refactorise();
   // True if an element rotated more than the setting since the factorisation.
   bool rotated_since_factor() const;
+  bool support_changed_factor_due(bool cg) const;
   bool accept_contacts(const ContactSet* contacts, const SphereLinks* links, StepReport& report);
   double kinetic_energy() const;
 
@@ -174,7 +194,13 @@ class Body {
   CgSolver cg_;
   ComplianceBlock compliance_;
   SleepMonitor sleep_;
+  std::vector<NodeSupport> supports_;  // capacity: every node
+  std::size_t support_count_ = 0;
+  double support_ratio_ = 0.0;
+  bool supports_changed_ = false;  // since the last factorisation
   int steps_since_factor_ = 0;
+  // A CG solve took more than cg_refresh_iterations: refactorise next step.
+  bool refresh_due_ = false;
   bool external_force_set_ = false;
   std::uint64_t step_ = 0;
   std::uint64_t stale_sets_ = 0;

@@ -2,6 +2,7 @@
 // factorisation when the values change, solves into preallocated storage.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <span>
 
@@ -30,6 +31,10 @@ struct CholmodOptions {
 
 class CholmodSolver {
  public:
+  // Multi-column solves keep their buffers per column count, for this many
+  // counts (the compliance block solves a full block and fixed-size chunks).
+  static constexpr std::size_t kColumnCounts = 6;
+
   CholmodSolver();
   ~CholmodSolver();
   CholmodSolver(const CholmodSolver&) = delete;
@@ -44,12 +49,16 @@ class CholmodSolver {
   // workspace): call it outside the no-allocation path or accept that.
   bool factorize();
   bool factorized() const;
+  // Successful numeric factorisations so far: a solve of a cached right-hand
+  // side is still valid while this is unchanged (compliance.h).
+  std::uint64_t factorisations() const;
 
   // x = A^-1 b for the last factorised A; b and x have A.rows() entries and
   // may alias. No allocation after the first call (buffers are kept).
   void solve(std::span<const double> b, std::span<double> x);
   // X = A^-1 B for `columns` right-hand sides, column-major with leading
-  // dimension A.rows(). No allocation after the first call with this count.
+  // dimension A.rows(). No allocation after the first call with this count
+  // while at most kColumnCounts different counts are in use.
   void solve_columns(std::span<const double> b, std::span<double> x, int columns);
 
   // Non-zeros of the factor L, for reports.

@@ -1,6 +1,13 @@
 // Contact compliance W = h^2 J A^-1 J^T of candidate spheres (DESIGN.md,
 // "Tissue resistance at 1 kHz"): how far sphere centres move in one step per
 // newton of force on them, with the tissue's inertia, damping and stiffness.
+//
+// The solved columns A^-1 J_s^T of each sphere are kept, tagged with the
+// factorisation they came from: while the factorisation is unchanged (a
+// lagged factor, SolverSettings), a sphere that joins the block costs its
+// three columns and the others cost nothing, instead of the whole block
+// being solved again whenever the set of spheres changes (on the neonatal
+// tongue it changes in most steps while the blade slides).
 #pragma once
 
 #include <cstdint>
@@ -15,27 +22,50 @@ namespace fahr::fem {
 
 class ComplianceBlock {
  public:
-  // Sizes the right-hand sides for up to max_spheres candidates.
+  // Sizes the cache and the right-hand sides for up to max_spheres
+  // candidates. Allocates.
   void reserve(std::size_t dofs, std::size_t max_spheres);
   std::size_t capacity() const { return max_spheres_; }
 
   // Writes W, (3k x 3k) row-major float, m/N, for the k spheres listed, from
-  // `factor` (a factorisation of A = M + h D + h^2 K, kg) with one
-  // multi-right-hand-side solve (warped to the current rotations): J has three rows per sphere, holding the
-  // weights w_i on the x, y and z DOFs of its free nodes (fixed DOFs do not
-  // move). Returns false if k exceeds the capacity, `out` is too small, or
-  // the factor is missing. Block (s, t) is the motion of sphere s per unit
-  // force on sphere t. No allocation after the first call with this k.
+  // `factor` (a factorisation of A = M + h D + h^2 K, kg), solving only the
+  // spheres without columns from this factorisation (all of them when the
+  // factor is warped: its rotations change every step). J has three rows per
+  // sphere, holding the weights w_i on the x, y and z DOFs of its free nodes
+  // (fixed DOFs do not move). Returns false if k exceeds the capacity, `out`
+  // is too small, a sphere is unknown, or the factor is missing. Block (s, t) is the motion of sphere s per unit force on sphere
+  // t. No allocation (CHOLMOD's solve buffers are kept per chunk size).
   bool compute(std::span<const std::uint32_t> spheres, const SphereLinks& links,
                std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor, WarpedFactor& warp,
-               double time_step_s,
-               std::span<float> out);
+               double time_step_s, std::span<float> out);
+
+  // Spheres whose columns the last compute() solved (the others were kept).
+  std::size_t last_solved_spheres() const { return last_solved_; }
 
  private:
+  struct Slot {
+    std::uint32_t sphere = 0;
+    std::uint64_t factorisation = 0;  // CholmodSolver::factorisations() when solved
+    std::uint64_t last_use = 0;
+    bool valid = false;
+  };
+  // The slot holding this sphere's columns for the given factorisation, or
+  // a free (least recently used, not in this request) slot marked for it.
+  std::size_t slot_for(std::uint32_t sphere, std::uint64_t factorisation, bool& cached);
+  void solve_chunk(std::span<const std::size_t> slots, const SphereLinks& links,
+                   std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor, WarpedFactor& warp);
+  const double* column(std::size_t slot, std::size_t d) const { return columns_.data() + dofs_ * (3 * slot + d); }
+
   std::size_t dofs_ = 0;
   std::size_t max_spheres_ = 0;
-  std::vector<double> rhs_;
+  std::vector<Slot> slots_;
+  std::vector<double> columns_;             // 3 columns of dofs_ per slot
+  std::vector<std::size_t> request_slots_;  // slot of each requested sphere
+  std::vector<std::size_t> to_solve_;       // slots to solve this call
+  std::vector<double> rhs_;                 // one chunk of right-hand sides
   std::vector<double> solution_;
+  std::uint64_t uses_ = 0;
+  std::size_t last_solved_ = 0;
 };
 
 }  // namespace fahr::fem

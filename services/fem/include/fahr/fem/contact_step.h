@@ -16,7 +16,9 @@
 //   4. with obstacles set, the body's own non-penetration of the static
 //      anatomy on these positions (obstacle_projection.h), alternated with
 //      the ContactSet's projection so the tool cannot press a node into bone;
-//      its moves join the same carried correction.
+//      its moves join the same carried correction; the nodes it moved are
+//      held by springs along the bone's normal in the next step's A
+//      (obstacle_support.h), so the implicit solve and W feel the bone.
 // The projection is done here, not by Body::step, because step 2 needs the
 // motion before it. Staleness of a ContactSet is the caller's decision.
 // Capacities are fixed at construction: nothing allocates per step once the
@@ -33,6 +35,7 @@
 #include "fahr/fem/contact_set.h"
 #include "fahr/fem/obstacle_field.h"
 #include "fahr/fem/obstacle_projection.h"
+#include "fahr/fem/obstacle_support.h"
 #include "fahr/fem/projection.h"
 #include "fahr/fem/sphere_links.h"
 
@@ -128,6 +131,7 @@ class ContactStep {
   std::vector<Eigen::Vector3d> free_centres_;
   ProjectionSettings projection_settings_;
   std::unique_ptr<ObstacleProjection> obstacles_;
+  std::unique_ptr<ObstacleSupport> supports_;  // with obstacles_ and a ratio > 0
   ProjectionReport projection_;
 };
 

@@ -16,6 +16,9 @@
 // through (the neonatal tongue under the blade reached 7.7 mm into the jaw
 // in one 5 ms step).
 //
+// The nodes a pass moved are what obstacle_support.h holds with springs in
+// the next step's system matrix, so the implicit solve and W feel the bone.
+//
 // Fixed nodes (inverse mass 0) never move. Capacities are fixed at
 // construction; a pass allocates nothing. Each node keeps a lower bound of
 // its distance to every obstacle (the sampled distance minus how far it has
@@ -50,6 +53,12 @@ struct ObstacleProjectionSettings {
   // (ContactStep): the anatomy's pass comes last, so bone wins over a tool
   // constraint that would press a node into it.
   int max_rounds = 4;
+  // Nodes the anatomy moved are held by a spring along the bone's normal in
+  // the next steps' system matrix (obstacle_support.h), this many times
+  // stiffer than the node's own diagonal of A, >= 0; 0: no springs, the
+  // anatomy acts only through this projection. 100: pressing a supported
+  // node into the bone moves it a hundredth as far as pressing it free.
+  double support_stiffness_ratio = 100.0;
 };
 
 class ObstacleProjection {
@@ -75,6 +84,11 @@ class ObstacleProjection {
 
   // Nodes moved since begin_step().
   int nodes_moved() const { return nodes_moved_; }
+  // Whether `node` was moved since begin_step(), and the outward unit normal
+  // of the obstacle that moved it last (where it put the node).
+  bool moved(std::size_t node) const { return moved_[node] != 0; }
+  const Eigen::Vector3d& move_normal(std::size_t node) const { return move_normal_[node]; }
+  std::size_t node_count() const { return moved_.size(); }
   std::size_t field_count() const { return fields_.size(); }
   const ObstacleProjectionSettings& settings() const { return settings_; }
 
@@ -100,6 +114,7 @@ class ObstacleProjection {
   std::vector<double> clearance_m_;
   std::vector<Eigen::Vector3d> sampled_at_m_;  // per node, m
   std::vector<std::uint8_t> moved_;            // per node: moved since begin_step()
+  std::vector<Eigen::Vector3d> move_normal_;   // per node: normal of its last move
   int nodes_moved_ = 0;
 };
 

@@ -38,6 +38,14 @@ struct SolverSettings {
   // per-step change at haptic rates; looser budgets are benchmarked.
   double cg_relative_tolerance = 1e-6;
   int cg_max_iterations = 100;
+  // kConjugateGradient with kLaggedCholesky: the lagged factorisation is
+  // refreshed (in the next step) after a solve that took more than this many
+  // iterations or did not converge, >= 0; 0: only the period and the
+  // rotation trigger refresh it. The iteration count is the direct measure
+  // of how far the factor has drifted from the current A, so with the
+  // rotation trigger off (0) the factor is refreshed only when the solve
+  // actually got expensive, not whenever a sliver turned 0.1 rad.
+  int cg_refresh_iterations = 0;
 };
 
 }  // namespace fahr::fem

@@ -42,6 +42,9 @@ struct StackOptions {
   // default); false leaves that to the haptic side's obstacle contacts, as
   // before, for comparison.
   bool fem_anatomy = true;
+  // Overrides the FEM's anatomy support springs (obstacle_support.h), their
+  // stiffness over the node's diagonal of A; 0 turns them off.
+  std::optional<double> fem_support_ratio;
   // Overrides the FEM service's sphere spread (projection.h) when set.
   std::optional<fem::SphereSpread> sphere_spread;
 };

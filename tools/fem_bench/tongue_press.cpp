@@ -1,0 +1,449 @@
+// fem_tongue_press: the FEM's linear solve on the neonatal tongue while the
+// blade presses it, each candidate solver against the exact step (CHOLMOD
+// refactorised every step, W exact), in the whole loop.
+//
+// Every configuration runs its own in-process lockstep stack
+// (services/stack_sim: gateway with the scripted hand, haptic service, FEM
+// service) from the same scene, side by side, one base step each in turn,
+// so all see the same hand and the same machine load at the same moment;
+// the FEM's solver is switched after set-up (Body::set_solver). The loop is
+// closed: a solver's error changes the contacts and the force (rendered
+// force difference), and contact events are discontinuous, so closed-loop
+// differences include their consequences and grow chaotically, not just
+// one step's error. Each configuration therefore also has an open-loop
+// shadow: a FEM service of its own fed the exact run's ContactSets, step for
+// step, whose nodes and W are compared with the exact FEM's; the shadows
+// also give each configuration's cost on identical inputs.
+//
+//   fem_tongue_press [--scene FILE] [--seconds 8] [--configs shipped,pcg-it8,...]
+//                    [--support-ratio R]
+//
+// Prints, per configuration: FEM step CPU (thread CPU, the step and its
+// DeformationState) while the blade touches and over all steps, closed loop
+// and shadow; refactorisations; CG iterations; the largest node
+// displacement difference from the exact run (mm), closed loop and shadow;
+// the largest relative difference of the shadow's W from the exact W; the
+// largest and RMS difference of the force sent to the device (N); the most
+// inverted tets.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fahr/common/clock.h"
+#include "fahr/common/lockstep.h"
+#include "fahr/common/solver_threads.h"
+#include "fahr/fem_service/fem_body_setup.h"
+#include "fahr/fem_service/service_step.h"
+#include "fahr/scene/load_scene.h"
+#include "fahr/stack_sim/stack_sim.h"
+
+namespace {
+
+using fahr::fem::CgPreconditioner;
+using fahr::fem::LinearSolver;
+using fahr::fem::SolverSettings;
+
+struct Config {
+  std::string name;
+  bool keep_scene_solver = false;  // "shipped": whatever the scene maps to
+  SolverSettings solver;
+};
+
+// Names: exact, exact-amd, shipped, lagged (CHOLMOD, rotation trigger 0.1 rad),
+// pcg-rot (CG, factor refreshed on the rotation trigger), pcg-rest (CG on
+// the rest factor, never refreshed), pcg-itN (CG, refreshed when a solve
+// took more than N iterations); a CG name may end in -warp (warped factor)
+// and then -tolX (relative tolerance X instead of 1e-6), e.g.
+// pcg-it12-tol1e-4.
+bool make_cg_config(const std::string& name, SolverSettings& s);
+
+bool make_config(const std::string& name, Config& config) {
+  config.name = name;
+  SolverSettings& s = config.solver;
+  s.refactor_period = 0;
+  s.refactor_rotation_rad = 0.0;
+  if (name == "exact") {
+    s.refactor_period = 1;
+    return true;
+  }
+  if (name == "exact-amd") {
+    // The exact step with another ordering: round-off-level differences
+    // only, so its difference from "exact" is the closed loop's own
+    // sensitivity, the floor under every other configuration's.
+    s.refactor_period = 1;
+    s.cholmod.ordering = fahr::fem::CholmodOrdering::kAmd;
+    return true;
+  }
+  if (name == "shipped") {
+    config.keep_scene_solver = true;
+    return true;
+  }
+  if (name == "lagged") {
+    s.refactor_rotation_rad = 0.1;
+    return true;
+  }
+  s.kind = LinearSolver::kConjugateGradient;
+  s.preconditioner = CgPreconditioner::kLaggedCholesky;
+  s.cg_max_iterations = 200;
+  std::string base = name;
+  // "-tolX": CG relative tolerance X (default 1e-6).
+  if (const auto tol = base.find("-tol"); tol != std::string::npos) {
+    s.cg_relative_tolerance = std::atof(base.c_str() + tol + 4);
+    if (!(s.cg_relative_tolerance > 0.0 && s.cg_relative_tolerance < 1.0)) return false;
+    base = base.substr(0, tol);
+  }
+  // "-warp": the lagged factor rotated per node (warped_factor.h).
+  if (base.size() > 5 && base.substr(base.size() - 5) == "-warp") {
+    s.warp_lagged_factor = true;
+    base = base.substr(0, base.size() - 5);
+  }
+  return make_cg_config(base, s);
+}
+
+bool make_cg_config(const std::string& name, SolverSettings& s) {
+  if (name == "pcg-rot") {
+    s.refactor_rotation_rad = 0.1;
+    return true;
+  }
+  if (name == "pcg-rest") return true;
+  if (name.rfind("pcg-it", 0) == 0) {
+    s.cg_refresh_iterations = std::atoi(name.c_str() + 6);
+    return s.cg_refresh_iterations > 0;
+  }
+  return false;
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(i), v.end());
+  return v[i];
+}
+
+// A FEM service of its own, fed the exact run's ContactSets.
+struct Shadow {
+  std::unique_ptr<fahr::fem_service::FemBodySetup> setup;
+  std::unique_ptr<fahr::fem_service::ServiceStep> step;
+  std::vector<double> cpu_touching_ms;
+  std::vector<double> iterations;
+  std::uint64_t factorisations_at_start = 0;
+  double max_node_mm = 0.0;
+  double max_w_relative = 0.0;  // max |W - W_exact| / max |W_exact| over steps with the same spheres
+  int max_inverted = 0;
+  // W audit (CG only, whose A is assembled every step): W of a fresh
+  // factorisation of the shadow's own current A, same spheres, same state.
+  std::unique_ptr<fahr::fem::CholmodSolver> audit;
+  fahr::fem::ComplianceBlock audit_block;
+  fahr::fem::WarpedFactor audit_warp;
+  std::vector<std::uint8_t> fixed_dof;
+  std::vector<float> audit_w;
+  std::vector<double> audit_error;  // per audited step: max |W - W_fresh| / max |W_fresh|
+};
+
+void start_audit(Shadow& shadow) {
+  const fahr::fem::Body& body = *shadow.setup->body;
+  shadow.audit = std::make_unique<fahr::fem::CholmodSolver>();
+  shadow.audit->analyze(body.system_matrix(), body.settings().solver.cholmod);
+  shadow.audit_block.reserve(3 * body.node_count(), body.settings().max_compliance_spheres);
+  shadow.audit_warp.resize(body.node_count());
+  shadow.audit_warp.set_enabled(false);
+  shadow.fixed_dof.assign(3 * body.node_count(), 0);
+  for (std::uint32_t i = 0; i < body.node_count(); ++i) {
+    for (std::size_t d = 0; d < 3; ++d) shadow.fixed_dof[3 * i + d] = body.fixed(i) ? 1 : 0;
+  }
+}
+
+void audit_compliance(Shadow& shadow) {
+  const auto& step = shadow.step->contact_step();
+  const auto spheres = step.compliance_spheres();
+  const auto w = step.compliance();
+  if (spheres.empty() || w.size() != 9 * spheres.size() * spheres.size()) return;
+  if (!shadow.audit->factorize()) return;  // reads the body's A as assembled this step
+  shadow.audit_w.resize(w.size());
+  if (!shadow.audit_block.compute(spheres, shadow.setup->links, shadow.fixed_dof, *shadow.audit, shadow.audit_warp,
+                                  shadow.setup->body->time_step_s(), shadow.audit_w)) {
+    return;
+  }
+  double scale = 0.0;
+  double largest = 0.0;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    scale = std::max(scale, std::abs(double{shadow.audit_w[i]}));
+    largest = std::max(largest, std::abs(double{w[i]} - double{shadow.audit_w[i]}));
+  }
+  if (scale > 0.0) shadow.audit_error.push_back(largest / scale);
+}
+
+struct Run {
+  Config config;
+  std::unique_ptr<fahr::stack_sim::StackSim> sim;
+  Shadow shadow;
+  fahr::msg::ContactSet fed;  // the ContactSet its FEM steps on in this base step
+  std::uint64_t factorisations_at_start = 0;
+  std::vector<double> cpu_touching_ms, cpu_all_ms;
+  std::vector<double> iterations;
+  double max_node_mm = 0.0;
+  double max_force_n = 0.0;
+  double force_sq_sum = 0.0;
+  double peak_force_n = 0.0;
+  std::uint64_t force_samples = 0;
+  int max_inverted = 0;
+};
+
+// The ContactSet the FEM stepped on has a blade contact that pushes (not
+// only candidates, not only the anatomy's entries).
+bool blade_touches(const fahr::msg::ContactSet& set) {
+  return std::any_of(set.contacts().begin(), set.contacts().end(), [](const fahr::msg::Contact& c) {
+    return c.kind() == fahr::msg::CONTACT_FORCE_ONLY ||
+           (c.kind() == fahr::msg::CONTACT_TOOL && c.state() != fahr::msg::CONSTRAINT_CANDIDATE);
+  });
+}
+
+double force_norm(const fahr::msg::ForceCommand& c) {
+  const auto& f = c.force_n();
+  return std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z());
+}
+
+double force_difference(const fahr::msg::ForceCommand& a, const fahr::msg::ForceCommand& b) {
+  const double dx = a.force_n().x() - b.force_n().x();
+  const double dy = a.force_n().y() - b.force_n().y();
+  const double dz = a.force_n().z() - b.force_n().z();
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+double largest_node_distance_mm(const fahr::fem::Body& a, const fahr::fem::Body& b) {
+  const auto xa = a.positions_m();
+  const auto xb = b.positions_m();
+  double largest = 0.0;
+  for (std::size_t i = 0; i + 2 < xa.size(); i += 3) {
+    const double dx = xa[i] - xb[i];
+    const double dy = xa[i + 1] - xb[i + 1];
+    const double dz = xa[i + 2] - xb[i + 2];
+    largest = std::max(largest, dx * dx + dy * dy + dz * dz);
+  }
+  return 1e3 * std::sqrt(largest);
+}
+
+// Largest entry difference over the largest exact entry, when both blocks
+// are for the same spheres in the same order (else -1: not comparable).
+double w_difference(const fahr::fem::ContactStep& exact, const fahr::fem::ContactStep& other) {
+  const auto a = exact.compliance_spheres();
+  const auto b = other.compliance_spheres();
+  if (a.empty() || !std::equal(a.begin(), a.end(), b.begin(), b.end())) return -1.0;
+  const auto wa = exact.compliance();
+  const auto wb = other.compliance();
+  if (wa.size() != wb.size()) return -1.0;
+  double scale = 0.0;
+  double largest = 0.0;
+  for (std::size_t i = 0; i < wa.size(); ++i) {
+    scale = std::max(scale, std::abs(double{wa[i]}));
+    largest = std::max(largest, std::abs(double{wa[i]} - double{wb[i]}));
+  }
+  return scale > 0.0 ? largest / scale : 0.0;
+}
+
+std::string cell(double value, bool reference) {
+  if (reference) return "(reference)";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+// The pieces a step is made of, on the exact run's final A: what a
+// refactorisation, one solve (one CG iteration's preconditioner), the full
+// compliance block's solve and one product with A cost.
+void print_kernel_costs(const fahr::fem::Body& body) {
+  using fahr::common::thread_cpu_now_ns;
+  const auto& a = body.system_matrix();
+  fahr::fem::CholmodSolver factor;
+  if (!factor.analyze(a) || !factor.factorize()) return;
+  const auto n = static_cast<std::size_t>(a.rows());
+  std::vector<double> b(48 * n, 1.0);
+  std::vector<double> x(48 * n, 0.0);
+  const auto time_ms = [](int repeats, auto&& work) {
+    const std::int64_t start = thread_cpu_now_ns();
+    for (int r = 0; r < repeats; ++r) work();
+    return 1e-6 * static_cast<double>(thread_cpu_now_ns() - start) / repeats;
+  };
+  const double factorise_ms = time_ms(10, [&] { factor.factorize(); });
+  const double solve_ms = time_ms(100, [&] { factor.solve({b.data(), n}, {x.data(), n}); });
+  const double block_ms = time_ms(10, [&] { factor.solve_columns(b, x, 48); });
+  const double product_ms = time_ms(100, [&] { fahr::fem::multiply_symmetric(a, b.data(), x.data()); });
+  std::printf("\nKernels on the final A (%zu DOFs, %.0f non-zeros in L, %s): factorisation %.2f ms, one solve "
+              "%.3f ms, 48-column solve (16 spheres) %.2f ms, one product with A %.3f ms (thread CPU)\n",
+              n, factor.factor_nonzeros(), factor.supernodal() ? "supernodal" : "simplicial", factorise_ms, solve_ms,
+              block_ms, product_ms);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  fahr::common::run_solver_libraries_on_one_thread(argv);
+  using namespace fahr;
+  CLI::App app{"FEM solvers on the pressed neonatal tongue against the exact step, in the whole loop"};
+  std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
+  double seconds = 8.0;
+  std::string config_list = "shipped,lagged,pcg-it8";
+  app.add_option("--scene", scene_path, "scene file");
+  app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
+  bool no_reference = false;
+  app.add_flag("--no-reference", no_reference, "do not add the exact run: the first configuration listed is the reference (profiling one configuration)");
+  double support_ratio = -1.0;
+  app.add_option("--support-ratio", support_ratio,
+                 "the FEM's anatomy support springs over the node's diagonal of A (0: off); default: the FEM's");
+  app.add_option("--configs", config_list,
+                 "comma-separated: exact, shipped, lagged, pcg-rot, pcg-rest, pcg-itN (the exact run is always made)");
+  CLI11_PARSE(app, argc, argv);
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  try {
+    const auto scene = scene::load_scene(scene_path);
+    std::vector<Run> runs;
+    // The first configuration is the reference the others are compared with.
+    std::vector<std::string> names;
+    if (!no_reference) names.push_back("exact");
+    std::stringstream list(config_list);
+    for (std::string name; std::getline(list, name, ',');) {
+      if (!name.empty() && (name != "exact" || no_reference)) names.push_back(name);
+    }
+    for (const std::string& name : names) {
+      Run run;
+      if (!make_config(name, run.config)) {
+        std::fprintf(stderr, "fem_tongue_press: unknown configuration '%s'\n", name.c_str());
+        return 2;
+      }
+      stack_sim::StackOptions options;
+      if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
+      run.sim = std::make_unique<stack_sim::StackSim>(scene, options);
+      run.shadow.setup = std::make_unique<fem_service::FemBodySetup>(
+          fem_service::set_up_body(*scene, *run.sim->fem().setup().scene_body));
+      run.shadow.setup->anatomy_settings = run.sim->fem().setup().anatomy_settings;
+      run.shadow.step = std::make_unique<fem_service::ServiceStep>(*run.shadow.setup);
+      if (!run.config.keep_scene_solver) {
+        for (fem::Body* body : {&run.sim->body(), run.shadow.setup->body.get()}) {
+          const std::string error = body->set_solver(run.config.solver);
+          if (!error.empty()) {
+            std::fprintf(stderr, "fem_tongue_press: %s: %s\n", name.c_str(), error.c_str());
+            return 2;
+          }
+        }
+      }
+      run.factorisations_at_start = run.sim->body().factorisations();
+      run.shadow.factorisations_at_start = run.shadow.setup->body->factorisations();
+      if (run.shadow.setup->body->settings().solver.kind == LinearSolver::kConjugateGradient) start_audit(run.shadow);
+      runs.push_back(std::move(run));
+    }
+    const auto steps = static_cast<std::uint64_t>(seconds * 1000.0 + 0.5);
+    for (std::uint64_t k = 0; k < steps; ++k) {
+      const bool fem_steps = common::executes_at(k, runs.front().sim->fem_period_steps());
+      for (Run& run : runs) {
+        // What its FEM takes in this step (the read rule: the haptic
+        // output of the step before).
+        if (fem_steps) run.fed = run.sim->contacts();
+        run.sim->step();
+        const double force = force_norm(run.sim->command());
+        run.peak_force_n = std::max(run.peak_force_n, force);
+        if (!run.sim->fem_stepped()) continue;
+        const double cpu_ms = 1e-6 * static_cast<double>(run.sim->last_fem_step_cpu().count());
+        run.cpu_all_ms.push_back(cpu_ms);
+        if (blade_touches(run.fed)) run.cpu_touching_ms.push_back(cpu_ms);
+        const auto& report = run.sim->fem().last_report();
+        if (!report.asleep) run.iterations.push_back(report.solver_iterations);
+        run.max_inverted = std::max(run.max_inverted, report.inverted_elements);
+      }
+      const Run& exact = runs.front();
+      if (fem_steps) {
+        // The shadows: the exact run's ContactSet, the same step.
+        for (Run& run : runs) {
+          Shadow& shadow = run.shadow;
+          if (k > 0) shadow.step->take(exact.fed, exact.fed.header().seq());
+          const std::int64_t cpu0 = common::thread_cpu_now_ns();
+          shadow.step->step();
+          const double cpu_ms = 1e-6 * static_cast<double>(common::thread_cpu_now_ns() - cpu0);
+          if (blade_touches(exact.fed)) shadow.cpu_touching_ms.push_back(cpu_ms);
+          const auto& report = shadow.step->last_report();
+          if (shadow.audit && !report.asleep && !report.refactorised) audit_compliance(shadow);
+          if (!report.asleep) shadow.iterations.push_back(report.solver_iterations);
+          shadow.max_inverted = std::max(shadow.max_inverted, report.inverted_elements);
+          shadow.max_node_mm =
+              std::max(shadow.max_node_mm, largest_node_distance_mm(exact.sim->body(), *shadow.setup->body));
+          shadow.max_w_relative = std::max(
+              shadow.max_w_relative, w_difference(exact.sim->fem().contact_step(), shadow.step->contact_step()));
+        }
+      }
+      for (std::size_t r = 1; r < runs.size(); ++r) {
+        Run& run = runs[r];
+        const double df = force_difference(exact.sim->command(), run.sim->command());
+        run.max_force_n = std::max(run.max_force_n, df);
+        run.force_sq_sum += df * df;
+        ++run.force_samples;
+        if (run.sim->fem_stepped()) {
+          run.max_node_mm = std::max(run.max_node_mm, largest_node_distance_mm(exact.sim->body(), run.sim->body()));
+        }
+      }
+    }
+    std::printf("fem_tongue_press: %s, %.1f s simulated, %zu configurations side by side, support ratio %s; "
+                "FEM step thread CPU ms while the blade touches\n\n",
+                scene_path.c_str(), seconds, runs.size(),
+                support_ratio >= 0.0 ? std::to_string(support_ratio).c_str() : "the FEM's default");
+    std::printf("Closed loop (each configuration's own stack):\n\n");
+    std::printf("| configuration | CPU p50 / p99 / max | CPU all steps p99 | steps touching | refactorisations "
+                "| CG iterations mean / max | node diff max, mm | force diff max / RMS, N | peak force, N | most "
+                "inverted |\n");
+    std::printf("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    const auto mean_max = [](const std::vector<double>& v, double& mean, double& largest) {
+      double sum = 0.0;
+      largest = 0.0;
+      for (const double x : v) {
+        sum += x;
+        largest = std::max(largest, x);
+      }
+      mean = v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+    };
+    for (const Run& run : runs) {
+      double iteration_mean = 0.0;
+      double iteration_max = 0.0;
+      mean_max(run.iterations, iteration_mean, iteration_max);
+      const double rms =
+          run.force_samples == 0 ? 0.0 : std::sqrt(run.force_sq_sum / static_cast<double>(run.force_samples));
+      const bool reference = &run == &runs.front();
+      std::printf("| %s | %.2f / %.2f / %.2f | %.2f | %zu | %llu | %.1f / %.0f | %s | %s | %.3f | %d |\n",
+                  run.config.name.c_str(), quantile(run.cpu_touching_ms, 0.5), quantile(run.cpu_touching_ms, 0.99),
+                  quantile(run.cpu_touching_ms, 1.0), quantile(run.cpu_all_ms, 0.99), run.cpu_touching_ms.size(),
+                  static_cast<unsigned long long>(run.sim->body().factorisations() - run.factorisations_at_start),
+                  iteration_mean, iteration_max, cell(run.max_node_mm, reference).c_str(),
+                  reference ? "(reference)" : (cell(run.max_force_n, false) + " / " + cell(rms, false)).c_str(),
+                  run.peak_force_n, run.max_inverted);
+    }
+    std::printf("\nOpen loop (shadow FEMs fed the exact run's ContactSets; the exact shadow checks determinism):\n\n");
+    std::printf("| configuration | CPU p50 / p99 / max | refactorisations | CG iterations mean / max "
+                "| node diff from exact max, mm | W diff from exact run max, relative | W error vs fresh factor "
+                "p50 / p99 / max (steps) | most inverted |\n");
+    std::printf("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    for (const Run& run : runs) {
+      const Shadow& shadow = run.shadow;
+      double iteration_mean = 0.0;
+      double iteration_max = 0.0;
+      mean_max(shadow.iterations, iteration_mean, iteration_max);
+      char audit[96] = "-";
+      if (shadow.audit) {
+        std::snprintf(audit, sizeof audit, "%.3g / %.3g / %.3g (%zu)", quantile(shadow.audit_error, 0.5),
+                      quantile(shadow.audit_error, 0.99), quantile(shadow.audit_error, 1.0), shadow.audit_error.size());
+      }
+      std::printf("| %s | %.2f / %.2f / %.2f | %llu | %.1f / %.0f | %.3g | %.3g | %s | %d |\n", run.config.name.c_str(),
+                  quantile(shadow.cpu_touching_ms, 0.5), quantile(shadow.cpu_touching_ms, 0.99),
+                  quantile(shadow.cpu_touching_ms, 1.0),
+                  static_cast<unsigned long long>(shadow.setup->body->factorisations() - shadow.factorisations_at_start),
+                  iteration_mean, iteration_max, shadow.max_node_mm, shadow.max_w_relative, audit, shadow.max_inverted);
+    }
+    print_kernel_costs(runs.front().sim->body());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fem_tongue_press: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The overshoot on the neonatal tongue across the choices that decide it:
+# the tongue's Young's modulus, the FEM's anatomy support springs and whether
+# the tool stops at bone. One force-aware run per line (about 75 s each on
+# this machine), one Markdown table at the end.
+#   bash tools/overshoot_bench/sweep.sh [BUILD_DIR] [--quick]
+# --quick: only the shipped scene with and without the support springs.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build="${1:-$root/build}"
+bench="$build/tools/overshoot_bench/fahr_overshoot_bench"
+[ -x "$bench" ] || { echo "sweep.sh: no $bench (build the fahr_overshoot_bench target)" >&2; exit 2; }
+quick=false
+[ "${2:-}" = "--quick" ] && quick=true
+
+# E Pa | support ratio | tool stops (scene = the shipped scene's choice, off)
+configs=("10000 0 scene" "10000 100 scene")
+if ! $quick; then
+  configs+=("30000 0 scene" "30000 100 scene" "100000 0 scene" "100000 100 scene" "10000 100 on" "100000 100 on")
+fi
+
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+field() {  # the force-aware column of a table row
+  grep -F "| $1 |" "$2" | head -1 | awk -F'|' '{gsub(/^ +| +$/, "", $3); print $3}'
+}
+echo "| E kPa | support | tool stops | most inverted tets | reaction / limit while lost track | lost-track ticks | Green strain 1x / end | gap error mm | re-engagement step N (bound) | tongue from rest 1 s after mm | --check |"
+echo "|---:|---:|---|---:|---:|---:|---|---:|---|---:|---|"
+for config in "${configs[@]}"; do
+  read -r youngs support stops <<<"$config"
+  file="$out/$youngs-$support-$stops.txt"
+  verdict=pass
+  "$bench" --response force-aware --youngs-pa "$youngs" --fem-support "$support" --tool-stops "$stops" --check \
+    >"$file" 2>&1 || verdict=fail
+  echo "| $((youngs / 1000)) | $support | $stops | $(field "most inverted tets" "$file") |" \
+       "$(field "largest reaction / limit while lost track" "$file") | $(field "lost-track ticks" "$file") |" \
+       "$(field "max Green strain at 1x / at the end of the hold" "$file") |" \
+       "$(field "largest published-gap error mm" "$file") |" \
+       "$(field "largest force step in 50 ms of re-engagement N (bound)" "$file") |" \
+       "$(field "tongue displacement 1 s after the blade left mm" "$file") | $verdict |"
+done
