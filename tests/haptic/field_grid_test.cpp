@@ -35,11 +35,20 @@ TEST(FieldGrid, ReadsTheFieldsTrilinearValues) {
     EXPECT_NEAR(grid.distance(p), sdf.grid_distance(p), grid.storage_error_m() + 1e-12) << i;
     Eigen::Vector3d gradient;
     EXPECT_NEAR(grid.distance_gradient(p, gradient), grid.distance(p), 1e-12);
+    // read() and gradient() are the same arithmetic, bit for bit: the query
+    // mixes them with distance_gradient and promises the same contacts.
+    const FieldGrid::Read cell = grid.read(p);
+    EXPECT_EQ(cell.value, grid.distance_gradient(p, gradient)) << i;
+    EXPECT_EQ(grid.gradient(cell), gradient) << i;
+    // (distance() takes the corner differences in single precision, so it
+    // differs from these in the last bits: not compared bit for bit.)
   }
   const Eigen::Vector3d far(0.2, 0.0, 0.0);
   EXPECT_NEAR(grid.distance(far), sdf.grid_distance(far), 1e-8);
   EXPECT_TRUE(std::isnan(grid.distance(Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0, 0))));
   EXPECT_TRUE(std::isinf(FieldGrid().distance(Eigen::Vector3d::Zero())));
+  EXPECT_TRUE(std::isnan(grid.read(Eigen::Vector3d(0, std::numeric_limits<double>::quiet_NaN(), 0)).value));
+  EXPECT_TRUE(std::isinf(FieldGrid().read(Eigen::Vector3d::Zero()).value));
 }
 
 TEST(FieldGrid, GradientIsTheInterpolantsAndPointsOutward) {

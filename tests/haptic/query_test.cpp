@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fahr/geometry/signed_distance_field.h"
+#include "fahr/haptic/field_grid.h"
 #include "fahr/haptic/fill_spheres.h"
 #include "fahr/haptic/sphere_query.h"
 #include "fahr/haptic/sphere_tree.h"
@@ -126,6 +127,97 @@ TEST(Query, CandidatesAndGridNarrowPhaseOnAPlane) {
     candidates += c.candidate ? 1 : 0;
   }
   EXPECT_GT(candidates, 0u);
+}
+
+// The query skips grid reads where bounds already decide (a leaf proven
+// outside is only remembered; an outside sphere too far for a candidate gets
+// no normal): every sphere must still come out as the per-sphere rule says.
+// Grid narrow phase, fresh memory (so a centre inside has no history): a
+// sphere is reported iff r - grid(c) > -candidate margin, with that depth;
+// every centre outside within the approach margin is remembered, as is.
+TEST(Query, ShortcutsGiveThePerSphereRuleOnTheTongue) {
+  const SphereLayout& layout = test::neonatal_layout();
+  SphereState state(layout);
+  const SphereTree tree(layout);
+  // A slab pressed 3 mm into the tongue's top, tilted, so spheres lie
+  // inside, touching, within the margins and far.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = Eigen::Vector3d::Constant(-1e300);
+  for (const Eigen::Vector3d& c : state.centres_m()) {
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  geometry::SdfOptions options;
+  options.cell_size_m = 0.5e-3;
+  const geometry::SignedDistanceField slab(
+      test::box_surface({lo.x() - 0.01, -0.0012, lo.z() - 0.01}, {hi.x() + 0.01, 0.0, hi.z() + 0.01}), options);
+  const FieldGrid copy(slab);
+  RigidBody body{3, &slab, Eigen::Isometry3d::Identity(), &copy};
+  body.world_from_body =
+      Eigen::Translation3d(0.0, hi.y() - 3e-3, 0.0) * Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ());
+  QuerySettings settings;
+  settings.exact_narrow_phase = false;
+  settings.candidate_margin_m = 1e-3;
+  settings.surface_probe = QuerySettings::SurfaceProbe::kNone;
+  PrePenetrationMemory memory(layout.size());
+  ContactBuffer buffer(layout.size());
+  const QueryStats stats = query_spheres(tree, state, body, settings, memory, buffer);
+  ASSERT_FALSE(stats.overflowed);
+  EXPECT_GT(stats.spheres_remembered, 0u) << "a leaf proven outside: the shortcut ran";
+  const double error = 0.8660254037844386 * slab.cell_size_m() + copy.storage_error_m();
+  const Eigen::Isometry3d body_from_world = body.world_from_body.inverse();
+  std::vector<int> reported(layout.size(), 0);
+  for (const SphereContact& c : buffer) {
+    ASSERT_EQ(reported[c.sphere_id], 0) << "sphere " << c.sphere_id << " reported twice";
+    reported[c.sphere_id] = 1;
+    EXPECT_FALSE(c.has_surface) << "kNone gives no surface point";
+  }
+  std::size_t inside = 0, remembered = 0;
+  for (std::size_t slot = 0; slot < tree.order().size(); ++slot) {
+    const std::uint32_t id = tree.order()[slot];
+    const Eigen::Vector3d p = body_from_world * state.centres_m()[id];
+    const double r = state.radii_m()[id];
+    const double grid = copy.distance(p);
+    const bool expected = r - grid > -settings.candidate_margin_m;
+    ASSERT_EQ(reported[id] == 1, expected) << "sphere " << id << " grid " << grid << " r " << r;
+    if (expected) {
+      const auto it = std::find_if(buffer.begin(), buffer.end(), [&](const SphereContact& c) { return c.sphere_id == id; });
+      EXPECT_EQ(it->depth_m, r - grid) << "sphere " << id;
+    }
+    inside += grid <= 0.0 ? 1 : 0;
+    // Surely within the approach margin (the grid within one error of the
+    // distance) and outside: remembered by this query, as it is.
+    if (grid > 0.0 && grid + error - r - settings.candidate_margin_m <= settings.approach_margin_m) {
+      Eigen::Vector3d centre;
+      ASSERT_TRUE(memory.recall(static_cast<std::uint32_t>(slot), 1, settings.max_memory_age, centre)) << id;
+      EXPECT_EQ(centre, p) << "sphere " << id;
+      ++remembered;
+    }
+  }
+  EXPECT_GT(inside, 0u);
+  EXPECT_GT(remembered, 100u);
+}
+
+// kNone gives the same contacts as the default probe, without the surface point.
+TEST(Query, WithoutASurfaceProbeTheContactsAreTheSame) {
+  Block& b = block();
+  const auto slab = field(test::box_surface({-0.01, -0.01, -0.01}, {0.02, 0.5e-3, 0.02}));
+  RigidBody body{7, &slab, Eigen::Isometry3d::Identity()};
+  QuerySettings with, without;
+  with.candidate_margin_m = without.candidate_margin_m = 0.3e-3;
+  without.surface_probe = QuerySettings::SurfaceProbe::kNone;
+  PrePenetrationMemory m1(b.layout.size()), m2(b.layout.size());
+  ContactBuffer a(4096), c(4096);
+  query_spheres(b.tree, b.state, body, with, m1, a);
+  query_spheres(b.tree, b.state, body, without, m2, c);
+  ASSERT_EQ(a.size(), c.size());
+  ASSERT_GT(a.size(), 0u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].sphere_id, c[i].sphere_id);
+    EXPECT_EQ(a[i].depth_m, c[i].depth_m);
+    EXPECT_EQ(a[i].normal, c[i].normal);
+    EXPECT_TRUE(a[i].has_surface);
+    EXPECT_FALSE(c[i].has_surface);
+  }
 }
 
 TEST(Query, SphereContactsMatchTheAnalyticDistance) {

@@ -1,7 +1,8 @@
 // aist_bench: prints Markdown tables. Sections: coverage, trajectory, sweep
-// (default: all), detection (the trajectory with the FEM driven by node
+// (default: all), record / replay FILE (replay.cpp: the query alone on
+// recorded states, contact hashes), detection (the trajectory with the FEM driven by node
 // contacts, both detectors judged on the same states). Usage: aist_bench
-// [coverage|trajectory|detection|sweep|all] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe anchor|face] [--spread W] [--sweep-steps N]
+// [coverage|trajectory|detection|sweep|all] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe anchor|face] [--spread W] [--sweep-steps N] [--file PATH] [--evict-kb K] [--replay-only K] [--replay-passes P]
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -43,6 +44,14 @@ int main(int argc, char** argv) {
       options.stretch_radius = std::strcmp(argv[++i], "stretch") == 0;
     } else if (std::strcmp(argv[i], "--fem-every") == 0 && i + 1 < argc) {
       options.fem_every = std::max(1, std::stoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--file") == 0 && i + 1 < argc) {
+      options.file = argv[++i];
+    } else if (std::strcmp(argv[i], "--replay-passes") == 0 && i + 1 < argc) {
+      options.replay_passes = std::max(1, std::stoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--replay-only") == 0 && i + 1 < argc) {
+      options.replay_only = std::stoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--evict-kb") == 0 && i + 1 < argc) {
+      options.evict_bytes = static_cast<std::size_t>(std::stoul(argv[++i])) * 1024;
     } else if (std::strcmp(argv[i], "--sweep-steps") == 0 && i + 1 < argc) {
       options.sweep_steps = std::stoi(argv[++i]);
     } else {
@@ -58,6 +67,14 @@ int main(int argc, char** argv) {
     if (section == "coverage" || section == "all") coverage_table(*scene);
     if (section == "trajectory" || section == "all") trajectory_table(*scene, options);
     if (section == "sweep" || section == "all") sweep_table(*scene, options);
+    if (section == "record" || section == "replay") {
+      if (options.file.empty()) {
+        std::fprintf(stderr, "aist_bench: %s needs --file PATH\n", section.c_str());
+        return 2;
+      }
+      if (section == "record") record_states(*scene, options, options.file);
+      if (section == "replay") replay_states(*scene, options, options.file);
+    }
     if (section == "detection") {
       options.node_driven = true;
       trajectory_table(*scene, options);

@@ -5,6 +5,9 @@
 #include "fahr/haptic/sphere_query.h"
 #include "scene.h"
 
+#include <cstddef>
+#include <string>
+
 namespace fahr::aist_bench {
 
 struct Options {
@@ -28,6 +31,12 @@ struct Options {
   // true (--radius-rule stretch): the trajectory's SphereState uses the
   // smallest-stretch radius rule instead of the volume rule.
   bool stretch_radius = false;
+  // record / replay (replay.cpp): the recording's path, and how many bytes
+  // the replay writes between queries to evict the core's L2 (--evict-kb).
+  std::string file;
+  std::size_t evict_bytes = std::size_t{4} << 20;
+  int replay_passes = 1;  // --replay-passes P: per tick the least of P passes
+  int replay_only = -1;  // --replay-only K: replay only the K-th query variant (for perf), -1 all
 };
 
 // Candidate margin of the benchmark's queries, m: the closure's tolerance,
@@ -35,7 +44,14 @@ struct Options {
 inline constexpr double kCandidateMarginM = 0.25e-3;
 
 void coverage_table(const Scene& scene);
+// What the trajectory, record and replay fill and query with (Options').
+haptic::FillSettings trajectory_fill(const Options& options);
+haptic::QuerySettings trajectory_query(const Options& options);
 void trajectory_table(const Scene& scene, const Options& options);
 void sweep_table(const Scene& scene, const Options& options);
+// Writes the trajectory's blade poses and FEM states to options.file.
+void record_states(const Scene& scene, const Options& options, const std::string& path);
+// Times the AIST query alone on a recording (replay.cpp) and hashes its contacts.
+void replay_states(const Scene& scene, const Options& options, const std::string& path);
 
 }  // namespace fahr::aist_bench

@@ -17,6 +17,7 @@
 #include "fahr/haptic/sphere_tree.h"
 #include "fahr/haptic/triangle_baseline.h"
 #include "sections.h"
+#include "sphere_contact_set.h"
 #include "stats.h"
 
 namespace fahr::aist_bench {
@@ -89,7 +90,7 @@ void print_timing_row(const char* name, const Timings& t) {
 
 }  // namespace
 
-void trajectory_table(const Scene& scene, const Options& options) {
+haptic::FillSettings trajectory_fill(const Options& options) {
   haptic::FillSettings fill;
   fill.weight_spread = options.weight_spread;
   fill.hugging_weight_spread = std::min(fill.hugging_weight_spread, options.weight_spread);
@@ -97,6 +98,20 @@ void trajectory_table(const Scene& scene, const Options& options) {
   fill.hugging_radius_fraction = options.hugging_radius_fraction;
   fill.hugging_anchor_depth_factor = options.anchor_depth_factor;
   fill.anchor_gap_m = options.anchor_gap_m;
+  return fill;
+}
+
+haptic::QuerySettings trajectory_query(const Options& options) {
+  haptic::QuerySettings settings;
+  settings.contact_skin_m = options.skin_m;
+  settings.candidate_margin_m = kCandidateMarginM;
+  settings.approach_margin_m = options.approach_margin_m;
+  settings.surface_probe = options.surface_probe;
+  return settings;
+}
+
+void trajectory_table(const Scene& scene, const Options& options) {
+  const haptic::FillSettings fill = trajectory_fill(options);
   const haptic::SphereLayout layout = haptic::fill_spheres(scene.tongue, fill);
   const fem::SphereLinks links = to_fem_links(layout, options.skin_m);
   auto body = make_tongue_body(scene);
@@ -105,11 +120,7 @@ void trajectory_table(const Scene& scene, const Options& options) {
   haptic::SphereState state = options.stretch_radius ? haptic::SphereState(layout, rest) : haptic::SphereState(layout);
   haptic::SphereTree tree(layout);
   const haptic::FieldGrid blade_grid(scene.blade_sdf);
-  haptic::QuerySettings exact_settings;
-  exact_settings.contact_skin_m = options.skin_m;
-  exact_settings.candidate_margin_m = kCandidateMarginM;
-  exact_settings.approach_margin_m = options.approach_margin_m;
-  exact_settings.surface_probe = options.surface_probe;
+  const haptic::QuerySettings exact_settings = trajectory_query(options);
   haptic::QuerySettings grid_settings = exact_settings;
   grid_settings.exact_narrow_phase = false;
   // The first two are the AIST as the library is meant to be used (with the
@@ -161,19 +172,7 @@ void trajectory_table(const Scene& scene, const Options& options) {
       fem_ms += elapsed_us(fem_start) / 1e3;
       ++fem_steps;
     } else if (new_state) {
-      set.state_step = body->step_index();
-      set.contacts.clear();
-      for (const haptic::SphereContact& c : buffer) {
-        if (c.candidate) continue;  // near, not touching: nothing to project
-        fem::Contact contact;
-        contact.sphere_id = c.sphere_id;
-        contact.kind = fem::ContactKind::kTool;
-        contact.state = fem::ContactState::kActive;
-        contact.plane_point_m = c.point_m;
-        contact.normal = c.normal;
-        contact.penetration_m = c.depth_m;
-        set.contacts.push_back(contact);
-      }
+      fill_sphere_contacts(buffer, body->step_index(), set);
       const auto fem_start = Clock::now();
       body->step(&set, &links);
       fem_ms += elapsed_us(fem_start) / 1e3;

@@ -88,6 +88,9 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
   // It is exact on the blade's flat underside, off by a fraction of a cell
   // (0.5 mm) at its edges.
   tool_query_.exact_narrow_phase = false;
+  // The rows take the contact point, normal and depth only: no surface point
+  // (a face read and a closest point per reported sphere, ~500 a pressed tick).
+  tool_query_.surface_probe = haptic::QuerySettings::SurfaceProbe::kNone;
   for (const std::size_t a : setup.tool_obstacles) {
     const RigidField& field = *setup.anatomy[a];
     haptic::RigidBody body;

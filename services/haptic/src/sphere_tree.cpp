@@ -22,14 +22,7 @@ SphereTree::SphereTree(const SphereLayout& layout) {
   refits_ = 0;
 }
 
-void SphereTree::build(std::int32_t node, std::int32_t begin, std::int32_t end, int depth,
-                       const SphereLayout& layout) {
-  depth_ = std::max(depth_, depth);
-  if (end - begin <= kLeafSize) {
-    nodes_[node].first = begin;
-    nodes_[node].count = end - begin;
-    return;
-  }
+std::int32_t SphereTree::split(std::int32_t begin, std::int32_t end, const SphereLayout& layout) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300);
   Eigen::Vector3d hi = Eigen::Vector3d::Constant(-1e300);
   for (std::int32_t i = begin; i < end; ++i) {
@@ -47,6 +40,34 @@ void SphereTree::build(std::int32_t node, std::int32_t begin, std::int32_t end, 
                      const double cb = layout.sphere(b).rest_centre_m[axis];
                      return ca < cb || (ca == cb && a < b);
                    });
+  return mid;
+}
+
+void SphereTree::arrange_leaf(std::int32_t begin, std::int32_t end, const SphereLayout& layout,
+                              std::vector<std::uint32_t>& out) {
+  if (end - begin <= kBlockSize) {
+    out.insert(out.end(), order_.begin() + begin, order_.begin() + end);
+    return;
+  }
+  const std::int32_t mid = split(begin, end, layout);
+  arrange_leaf(mid, end, layout, out);  // the right half first, as the query's walk
+  arrange_leaf(begin, mid, layout, out);
+}
+
+void SphereTree::build(std::int32_t node, std::int32_t begin, std::int32_t end, int depth,
+                       const SphereLayout& layout) {
+  depth_ = std::max(depth_, depth);
+  if (end - begin <= kLeafSize) {
+    nodes_[node].first = begin;
+    nodes_[node].count = end - begin;
+    // The spheres in the order a tree of kBlockSize leaves walked them.
+    std::vector<std::uint32_t> arranged;
+    arranged.reserve(static_cast<std::size_t>(end - begin));
+    arrange_leaf(begin, end, layout, arranged);
+    std::copy(arranged.begin(), arranged.end(), order_.begin() + begin);
+    return;
+  }
+  const std::int32_t mid = split(begin, end, layout);
   const auto left = static_cast<std::int32_t>(nodes_.size());
   nodes_.emplace_back();
   nodes_.emplace_back();

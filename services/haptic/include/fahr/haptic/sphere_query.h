@@ -79,8 +79,10 @@ struct QuerySettings {
   // where the body touches; one closest point on a triangle); kAnchor: its
   // fixed anchor (SurfaceAnchor). On aist_bench detection the fixed anchor
   // can lie ~1 mm from where a blade's rim cuts the face
-  // (tools/aist_bench/README.md).
-  enum class SurfaceProbe : std::uint8_t { kAnchor, kFacePoint };
+  // (tools/aist_bench/README.md). kNone: no surface point (has_surface
+  // false): for callers that use depth_m only (the haptic service's rows),
+  // which then skip a face read and a closest point per reported sphere.
+  enum class SurfaceProbe : std::uint8_t { kAnchor, kFacePoint, kNone };
   SurfaceProbe surface_probe = SurfaceProbe::kFacePoint;
 };
 
@@ -89,14 +91,17 @@ inline constexpr std::size_t kMaxDeepest = 256;
 
 // Per (sphere tree, rigid body): the last centre seen outside the body, in the
 // body's frame. Capacity fixed at construction. Indexed by the sphere's slot
-// in SphereTree::order(), not its id, and a sphere's entries share one cache
-// line: the query visits spheres leaf by leaf, so memory kept by id (in
-// separate arrays) cost cache misses at random (tools/aist_bench/README.md).
-// A memory therefore belongs to one tree.
+// in SphereTree::order(), not its id: the query visits spheres leaf by leaf,
+// so memory kept by id (in separate arrays) cost cache misses at random
+// (tools/aist_bench/README.md). A memory therefore belongs to one tree. The
+// centre and its query index, which every visited sphere writes, take 32
+// bytes, two spheres a cache line (a leaf's four in two lines); the nearest
+// point, which only the exact narrow phase reads, is kept apart.
 class PrePenetrationMemory {
  public:
   PrePenetrationMemory() = default;
-  explicit PrePenetrationMemory(std::size_t sphere_count) : slots_(sphere_count) {
+  explicit PrePenetrationMemory(std::size_t sphere_count)
+      : slots_(sphere_count), nearest_(sphere_count) {
     frontier_.reserve(2 * sphere_count + 2);
   }
   void remember(std::uint32_t slot, const Eigen::Vector3d& centre_body_m, std::uint64_t query) noexcept {
@@ -116,12 +121,12 @@ class PrePenetrationMemory {
   // exact search of the next query starts from |c - q_last| and visits only
   // the triangles that can beat it.
   void remember_nearest(std::uint32_t slot, const Eigen::Vector3d& point_body_m) noexcept {
-    slots_[slot].nearest_body_m = point_body_m;
-    slots_[slot].has_nearest = 1;
+    nearest_[slot].point_body_m = point_body_m;
+    nearest_[slot].known = 1;
   }
   bool recall_nearest(std::uint32_t slot, Eigen::Vector3d& point_body_m) const noexcept {
-    if (slots_[slot].has_nearest == 0) return false;
-    point_body_m = slots_[slot].nearest_body_m;
+    if (nearest_[slot].known == 0) return false;
+    point_body_m = nearest_[slot].point_body_m;
     return true;
   }
   std::size_t size() const { return slots_.size(); }
@@ -137,20 +142,26 @@ class PrePenetrationMemory {
   std::vector<Frontier>& frontier() noexcept { return frontier_; }
 
  private:
-  struct alignas(64) Slot {
+  struct alignas(32) Slot {
     Eigen::Vector3d centre_body_m = Eigen::Vector3d::Zero();
-    Eigen::Vector3d nearest_body_m = Eigen::Vector3d::Zero();
     std::uint64_t query_index = 0;
-    std::uint8_t has_nearest = 0;
+  };
+  struct Nearest {
+    Eigen::Vector3d point_body_m = Eigen::Vector3d::Zero();
+    std::uint8_t known = 0;
   };
   std::vector<Slot> slots_;
+  std::vector<Nearest> nearest_;
   std::vector<Frontier> frontier_;
   std::uint64_t queries_ = 0;
 };
 
 struct QueryStats {
   std::uint32_t nodes_visited = 0;
-  std::uint32_t spheres_tested = 0;   // reached the leaf test
+  std::uint32_t spheres_tested = 0;   // reached the leaf test (read the grid at the centre)
+  // Remembered outside without a test: their leaf's bound proved every
+  // centre outside and no sphere of it within the candidate margin.
+  std::uint32_t spheres_remembered = 0;
   std::uint32_t exact_queries = 0;    // reached the narrow phase (exact or grid)
   std::uint32_t contacts = 0;         // found (including those a full buffer dropped)
   bool body_skipped = false;          // the root could not touch the body
