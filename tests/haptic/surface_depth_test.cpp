@@ -90,6 +90,42 @@ TEST(SurfaceAnchor, GapLimitsWhichSpheresHaveOneAndNanIsRefused) {
   EXPECT_THROW(fill_spheres(mesh, s), std::invalid_argument);
 }
 
+// The services turn anchors off (they use the sphere depth): the same
+// spheres and contacts, no surface point, nothing gathered per state.
+TEST(SurfaceAnchor, OffGivesTheSameContactsWithoutASurface) {
+  const SquashedBlock& b = squashed_block();
+  const geometry::TetMesh mesh = test::block_tet_mesh({0, 0, 0}, {kSide, kSide, kSide}, 5);
+  FillSettings s;
+  s.hugging_sample_spacing_m = 0.4e-3;
+  s.surface_anchors = false;
+  const SphereLayout bare = fill_spheres(mesh, s);
+  ASSERT_EQ(bare.size(), b.layout.size());
+  EXPECT_EQ(bare.anchor_count(), 0u);
+  const auto plate = pressing_plate(b.top_m - kPenetration);
+  RigidBody body{3, &plate, Eigen::Isometry3d::Identity()};
+  std::vector<SphereContact> found[2];
+  int k = 0;
+  for (const SphereLayout* layout : {&b.layout, &bare}) {
+    SphereState state(*layout);
+    ASSERT_TRUE(state.update(*layout, b.squashed));
+    SphereTree tree(*layout);
+    tree.refit(state);
+    PrePenetrationMemory memory(layout->size());
+    ContactBuffer buffer(4096);
+    query_spheres(tree, state, body, QuerySettings{}, memory, buffer);
+    for (const SphereContact& c : buffer) found[k].push_back(c);
+    ++k;
+  }
+  ASSERT_EQ(found[0].size(), found[1].size());
+  ASSERT_GT(found[0].size(), 10u);
+  for (std::size_t i = 0; i < found[0].size(); ++i) {
+    EXPECT_EQ(found[0][i].sphere_id, found[1][i].sphere_id);
+    EXPECT_EQ(found[0][i].depth_m, found[1][i].depth_m);
+    EXPECT_TRUE(found[0][i].has_surface);
+    EXPECT_FALSE(found[1][i].has_surface);
+  }
+}
+
 TEST(SurfaceDepth, IsTheFlattenedSurfacesTruePenetrationWhereTheSphereDepthIsNot) {
   const SquashedBlock& b = squashed_block();
   SphereState state(b.layout);  // the volume rule: radii stay at rest under a volume-keeping squash

@@ -112,8 +112,9 @@ SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& set
     tets.insert(tets.end(), link.tets.begin(), link.tets.end());
     // The anchor of the centre as linked (the point the FEM moves).
     const std::size_t i = records.size();
-    has_anchor[i] = detail::nearest_face_point(boundary, surface_to_node, sdf, link.centre_m,
-                                               c.radius_m + settings.anchor_gap_m, anchors[i])
+    has_anchor[i] = settings.surface_anchors &&
+                            detail::nearest_face_point(boundary, surface_to_node, sdf, link.centre_m,
+                                                       c.radius_m + settings.anchor_gap_m, anchors[i])
                         ? 1
                         : 0;
     records.push_back(r);

@@ -2,6 +2,7 @@
 #include "fahr/haptic/sphere_tree.h"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 
 namespace fahr::haptic {
@@ -14,7 +15,10 @@ SphereTree::SphereTree(const SphereLayout& layout) {
   nodes_.reserve(2 * layout.size() + 1);
   nodes_.emplace_back();
   slot_spheres_.assign(layout.size(), Eigen::Vector4d::Zero());
-  slot_anchors_.assign(layout.size(), Eigen::Vector3d::Zero());
+  // Without anchors the slot copies stay as set here (never read: every
+  // contact then reports has_surface false) and the refit skips them.
+  anchored_ = layout.anchor_count() > 0;
+  slot_anchors_.assign(layout.size(), Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   slot_faces_.assign(layout.size(), {});
   if (n > 0) build(0, 0, n, 1, layout);
   SphereState rest(layout);
@@ -98,8 +102,10 @@ void SphereTree::refit(const SphereState& state) {
       for (std::int32_t i = 0; i < node.count; ++i) {
         const std::uint32_t s = order_[node.first + i];
         slot_spheres_[static_cast<std::size_t>(node.first + i)] << centres[s], radii[s];
-        slot_anchors_[static_cast<std::size_t>(node.first + i)] = anchors[s];
-        slot_faces_[static_cast<std::size_t>(node.first + i)] = faces[s];
+        if (anchored_) {
+          slot_anchors_[static_cast<std::size_t>(node.first + i)] = anchors[s];
+          slot_faces_[static_cast<std::size_t>(node.first + i)] = faces[s];
+        }
         node.reach_m = std::max(node.reach_m, (centres[s] - middle).norm() + radii[s]);
       }
     } else if (k > 0 || !order_.empty()) {

@@ -22,6 +22,10 @@ haptic::FillSettings fill_settings_for(const scene::Body& body) {
   f.refinement_levels = a.refinement_levels;
   f.surface_hugging = a.surface_spheres;
   f.max_spheres = static_cast<std::size_t>(a.sphere_budget);
+  // The services' rows use the sphere's own depth (the FEM projects whole
+  // spheres), so the surface anchors would only cost the digest a gather
+  // per FEM state.
+  f.surface_anchors = false;
   return f;
 }
 

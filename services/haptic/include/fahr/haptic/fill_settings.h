@@ -48,6 +48,12 @@ struct FillSettings {
   // sphere gave a lower depth error than 0.5 mm (the coverage target)
   // or 2 mm (tools/aist_bench/README.md).
   double anchor_gap_m = std::numeric_limits<double>::infinity();
+  // false: no sphere gets an anchor, whatever anchor_gap_m says. For a
+  // caller that never asks for the surface point (QuerySettings::
+  // SurfaceProbe::kNone, the haptic service): anchors would only cost a
+  // gather of each anchor face per state in SphereState::update and
+  // SphereTree::refit. Sphere ids do not depend on it.
+  bool surface_anchors = true;
   // A finest-level sphere clipped to the surface is kept only if its radius
   // is at least this fraction of the level radius, in [0, 1]: smaller ones add
   // nodes to link but hardly any covered volume.

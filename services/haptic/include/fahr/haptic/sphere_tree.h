@@ -79,6 +79,7 @@ class SphereTree {
   std::vector<SphereTreeNode> nodes_;
   std::vector<std::uint32_t> order_;
   std::vector<Eigen::Vector4d> slot_spheres_;
+  bool anchored_ = false;  // the layout has surface anchors to copy
   std::vector<Eigen::Vector3d> slot_anchors_;
   std::vector<std::array<Eigen::Vector3d, 3>> slot_faces_;
   int depth_ = 0;
