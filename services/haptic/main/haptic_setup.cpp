@@ -51,7 +51,7 @@ std::unique_ptr<TriangleCollisionSetup> triangle_setup(const HapticSetup& setup)
   return t;
 }
 
-HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision) {
+HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fem_keeps_anatomy) {
   const scene::ServicePlan plan = scene::derive_plan(scene);
   if (!plan.tool_body) throw std::runtime_error("scene '" + scene.name + "' has no tool: nothing for the haptic service");
   if (plan.fem_bodies.size() != 1) {
@@ -85,6 +85,7 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision) {
   };
   for (const auto& pair : plan.pairs) {
     if (pair.kind == scene::PairKind::kHard && pair.first == plan.fem_bodies.front()) {
+      if (fem_keeps_anatomy) continue;
       setup.tissue_obstacles.push_back(anatomy_index(pair.second));
     } else if (pair.kind == scene::PairKind::kTool && pair.reason == scene::PairReason::kToolObstacle &&
                scene.contact.tool_stops_at_anatomy) {

@@ -70,6 +70,12 @@ struct HapticSetup {
 };
 
 // Throws std::runtime_error naming the body and what is wrong.
-HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision = CollisionMethod::kAist);
+// fem_keeps_anatomy: the FEM keeps the tongue out of the anatomy itself
+// (fem/obstacle_projection.h; the FEM service always does), so the tongue
+// is not tested against the anatomy here and the ContactSet carries no
+// obstacle entries, which that FEM ignores. false: the haptic side finds
+// them, for a FEM without its own anatomy (stack_sim's --fem-anatomy off).
+HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision = CollisionMethod::kAist,
+                   bool fem_keeps_anatomy = true);
 
 }  // namespace fahr::haptic_service

@@ -24,7 +24,7 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
     : scene_(std::move(scene)),
       base_period_ns_(scene_->run.base_period.count()),
       fem_period_(static_cast<std::uint64_t>(scene_->rates.fem_period() / scene_->run.base_period)),
-      haptic_setup_(haptic_service::set_up(*scene_, options.collision)),
+      haptic_setup_(haptic_service::set_up(*scene_, options.collision, options.fem_anatomy)),
       fem_setup_(fem_service::set_up_body(*scene_, deformable_body(*scene_))) {
   if (scene_->rates.haptic_period() != scene_->run.base_period) {
     throw std::runtime_error("stack_sim: the haptic rate must be the base rate of scene '" + scene_->name + "'");
