@@ -84,11 +84,12 @@ TEST(ForceAware, DisabledNeverFreezes) {
 
 // A blade sunk into tissue that closes over it: one row below the tool and
 // one above, both deep in the FEM's free motion (which lies far beyond the
-// blade once the tongue is pressed in: tools/overshoot_bench saw 22 mm). The
+// blade once the tongue is pressed in). The
 // resultant is the small difference of two large forces, and backing off
 // along it makes one row deeper: no back-off within the rows' depth brings it
-// under the limit. A held proxy must not be thrown there in one tick (it was:
-// 23 mm through the tongue).
+// under the limit. A held proxy must not be thrown there in one tick (with
+// the bracket "deepest row + 1 mm" it was: 23 mm here, and through the
+// tongue in tools/overshoot_bench).
 TEST(ForceAware, ATickNeverThrowsAHeldToolFartherThanAFastHandMoves) {
   const double radius = 1e-3, compliance = 1e-3;  // m, m/N: a 1 kN/m tissue spring
   ContactRow below, above;

@@ -102,6 +102,20 @@ struct PressedBar {
 };
 
 
+// The pressed bar stepped with a floor 1 mm below it as its anatomy.
+struct BarOverFloor {
+  PressedBar bar;
+  std::unique_ptr<Body> body;
+  Floor floor{-1e-3};
+  std::unique_ptr<ContactStep> step;
+  explicit BarOverFloor(const BodySettings& settings) : body(test::make_body(settings, bar.mesh, bar.fixed)) {
+    if (!body) return;
+    step = std::make_unique<ContactStep>(*body, bar.links);
+    const ObstacleField* fields[] = {&floor};
+    step->set_obstacles(fields);
+  }
+};
+
 TEST(ObstacleProjection, APressedBodyNeverGoesDeeperThanTheMargin) {
   PressedBar bar;
   auto body = test::make_body(tongue_like(), bar.mesh, bar.fixed);
@@ -154,15 +168,12 @@ TEST(ObstacleProjection, TheMovesAreCarriedAsVelocity) {
   // Gravity alone bends the soft bar onto a floor 1 mm below it; with the
   // correction carried into the next step the bar settles on the floor
   // instead of being pushed out and falling back every step.
-  PressedBar bar;
   BodySettings settings = tongue_like();
   settings.gravity_m_per_s2 = Eigen::Vector3d(0, -9.81, 0);
-  auto body = test::make_body(settings, bar.mesh, bar.fixed);
-  ASSERT_TRUE(body);
-  const Floor floor(-1e-3);
-  const ObstacleField* fields[] = {&floor};
-  ContactStep step(*body, bar.links);
-  step.set_obstacles(fields);
+  BarOverFloor run(settings);
+  ASSERT_TRUE(run.body);
+  auto& body = run.body;
+  ContactStep& step = *run.step;
   int touching_steps = 0;
   for (int k = 0; k < 600; ++k) {
     const StepReport report = step.step(nullptr);
@@ -255,16 +266,14 @@ TEST(ObstacleProjection, FarNodesAreNotSampledEveryStep) {
 
 TEST(ObstacleProjection, StepAllocatesNothingOnceWarmed) {
   test::hook_suitesparse_allocations();
-  PressedBar bar;
   BodySettings settings = tongue_like();
   settings.solver.refactor_period = 0;
   settings.solver.refactor_rotation_rad = 0.0;  // no refactorisation: CHOLMOD mallocs there
-  auto body = test::make_body(settings, bar.mesh, bar.fixed);
-  ASSERT_TRUE(body);
-  const Floor floor(-1e-3);
-  const ObstacleField* fields[] = {&floor};
-  ContactStep step(*body, bar.links);
-  step.set_obstacles(fields);
+  BarOverFloor run(settings);
+  ASSERT_TRUE(run.body);
+  const PressedBar& bar = run.bar;
+  auto& body = run.body;
+  ContactStep& step = *run.step;
   ContactSet set = bar.press(*body, 0.015, 1.0);
   for (int k = 0; k < 5; ++k) {
     set.state_step = body->step_index();

@@ -19,8 +19,9 @@ constexpr double kYieldCapMarginM = 1e-3;
 // How far a held proxy may back off in one tick, m: 1 mm, a tick of a fast
 // hand (0.4 N of coupling force at 400 N/m). The rows' depths are those of
 // the FEM's free motion, which lies far beyond the blade once the tongue is
-// pressed in deep (22 mm in tools/overshoot_bench); a back-off bounded by
-// them threw the blade 23 mm through the tongue in one tick.
+// pressed in deep; a back-off bounded by them threw the blade through the
+// tongue in one tick (the overshoot bench; reproduced by
+// ForceAware.ATickNeverThrowsAHeldToolFartherThanAFastHandMoves: 23 mm).
 constexpr double kMaxYieldStepM = 1e-3;
 // Share of the tissue's load on rows that push against the resultant above
 // which the tool counts as gripped (tissue on more than one side): backing
