@@ -83,6 +83,9 @@ TEST(SceneErrors, OutOfRangeValuesStateTheValidRange) {
                    "range; valid: (-1, 0.5)"});
   expect_contains(error_of(with_material("      poisson_ratio: -1\n")),
                   {"bodies[0].material.poisson_ratio: value -1 is out of range"});
+  expect_contains(error_of(with_material("      yeoh_c20_over_c10: -0.47\n")),
+                  {"test.yaml:9:26: bodies[0].material.yeoh_c20_over_c10: value -0.47 is out of "
+                   "range; valid: [0, 100]"});
   expect_contains(error_of(std::string(kMinimalScene) + "rates:\n  fem_hz: 0\n"),
                   {"test.yaml:23:11: rates.fem_hz: value 0 is out of range; valid: (0, 10000]"});
   expect_contains(error_of(std::string(kMinimalScene) + "rates:\n  haptic_hz: -1000\n"),

@@ -7,6 +7,7 @@
 //
 //   fahr_overshoot_bench [--scene FILE] [--factor 3] [--response both|force-aware|penalty]
 //                        [--fem-anatomy on|off] [--fem-support RATIO] [--youngs-pa E] [--tool-stops on|off]
+//                        [--stiffening C20/C10]
 //                        [--sphere-spread service|mass|translation]
 //                        [--trace FILE] [--check]
 //
@@ -14,6 +15,8 @@
 // obstacle contacts (as before the FEM kept its own nodes out of bone).
 // --sphere-spread: how the FEM shares a tool contact's correction among the
 // sphere's nodes (services/fem projection.h), instead of the service's choice.
+// --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
+// (services/fem compression_stiffening.h; 0: off), instead of the scene's.
 // --trace: one CSV line per FEM step of each run (FILE with the response's
 // name appended): inversions and where they are, the anatomy projection,
 // the tool's contacts.
@@ -28,10 +31,13 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "fahr/common/solver_threads.h"
 #include "fahr/geometry/tet_quality.h"
@@ -73,7 +79,62 @@ struct Result {
   double fem_base_step_mean_ms = 0.0, fem_base_step_max_ms = 0.0;
   // Thread-CPU time of the FEM service's step alone, ms.
   double fem_cpu_median_ms = 0.0, fem_cpu_p99_ms = 0.0, fem_cpu_max_ms = 0.0;
+  // Per tet: inverted after some FEM step of the run; inverted at its end.
+  std::vector<std::uint8_t> ever_inverted, inverted_at_end;
+  // Per rest radius ratio class (kRadiusRatioEdges): the mesh's tets and
+  // those of them ever inverted and inverted at the end.
+  std::vector<std::size_t> class_tets, class_inverted, class_inverted_at_end;
 };
+
+// Rest radius ratio classes (3 inradius / circumradius; a regular tet has 1,
+// a sliver near 0): are the tets that invert the mesh's poor ones?
+constexpr double kRadiusRatioEdges[] = {0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0};
+constexpr std::size_t kRadiusRatioClasses = std::size(kRadiusRatioEdges) - 1;
+
+std::size_t radius_ratio_class(double ratio) {
+  std::size_t c = 0;
+  while (c + 1 < kRadiusRatioClasses && ratio >= kRadiusRatioEdges[c + 1]) ++c;
+  return c;
+}
+
+// Marks the tets inverted in the body's current state.
+void mark_inverted(const fem::Body& body, const geometry::TetMesh& mesh, std::vector<std::uint8_t>& marks) {
+  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+    const auto& tet = mesh.tets()[e];
+    Eigen::Matrix3d ds;
+    const Eigen::Vector3d x0 = body.position(tet[0]);
+    for (int c = 0; c < 3; ++c) ds.col(c) = body.position(tet[static_cast<std::size_t>(c) + 1]) - x0;
+    if ((ds * mesh.rest_data()[e].dm_inverse).determinant() <= 0.0) marks[e] = 1;
+  }
+}
+
+// The mesh's tets by rest radius ratio class, and those ever inverted.
+void count_by_radius_ratio(const geometry::TetMesh& mesh, Result& r) {
+  r.class_tets.assign(kRadiusRatioClasses, 0);
+  r.class_inverted.assign(kRadiusRatioClasses, 0);
+  r.class_inverted_at_end.assign(kRadiusRatioClasses, 0);
+  const auto& rest = mesh.rest_positions();
+  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+    const auto& t = mesh.tets()[e];
+    const std::size_t c = radius_ratio_class(geometry::tet_shape(rest[t[0]], rest[t[1]], rest[t[2]], rest[t[3]]).radius_ratio);
+    ++r.class_tets[c];
+    if (r.ever_inverted[e] != 0) ++r.class_inverted[c];
+    if (r.inverted_at_end[e] != 0) ++r.class_inverted_at_end[c];
+  }
+}
+
+void print_radius_ratio_table(const Result& r) {
+  const std::vector<std::size_t>& tets = r.class_tets;
+  const std::vector<std::size_t>& inverted = r.class_inverted;
+  std::printf("\n| rest radius ratio | tets | inverted after some FEM step (force-aware) | share of the class |"
+              " inverted at the end of the run |\n|---|---:|---:|---:|---:|\n");
+  for (std::size_t c = 0; c < kRadiusRatioClasses; ++c) {
+    std::printf("| [%.2f, %.2f%s | %zu | %zu | %.1f %% | %zu |\n", kRadiusRatioEdges[c], kRadiusRatioEdges[c + 1],
+                c + 1 == kRadiusRatioClasses ? "]" : ")", tets[c], inverted[c],
+                tets[c] > 0 ? 100.0 * static_cast<double>(inverted[c]) / static_cast<double>(tets[c]) : 0.0,
+                r.class_inverted_at_end[c]);
+  }
+}
 
 // Largest principal Green strain over the tets, |E| = |(F^T F - I) / 2|.
 double max_green_strain(const fem::Body& body, const geometry::TetMesh& mesh) {
@@ -180,14 +241,19 @@ ToolContacts count_contacts(const msg::ContactSet& set) {
 }
 
 Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double factor, bool fem_anatomy, double support_ratio,
-           double youngs_pa, const std::string& tool_stops,
-           const std::string& spread, const std::string& trace_path) {
+           double youngs_pa, double stiffening, const std::string& tool_stops,
+           const std::string& spread, const std::string& trace_path, const std::string& tick_trace_path) {
   auto variant = std::make_shared<scene::Scene>(*scene);
   variant->contact.response = penalty ? scene::ContactResponse::kPenalty : scene::ContactResponse::kForceAware;
   if (tool_stops != "scene") variant->contact.tool_stops_at_anatomy = tool_stops == "on";
   if (youngs_pa > 0.0) {
     for (auto& body : variant->bodies) {
       if (body.deformable) body.deformable->material.youngs_modulus_pa = youngs_pa;
+    }
+  }
+  if (stiffening >= 0.0) {
+    for (auto& body : variant->bodies) {
+      if (body.deformable) body.deformable->material.yeoh_c20_over_c10 = stiffening;
     }
   }
   const auto start = std::chrono::steady_clock::now();
@@ -201,6 +267,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
   stack_sim::StackSim sim(variant, options);
   Result r;
   r.name = penalty ? "penalty" : "force-aware";
+  r.ever_inverted.assign(sim.tongue_mesh().tet_count(), 0);
   std::FILE* trace = nullptr;
   if (!trace_path.empty()) {
     const std::string path = trace_path + "." + r.name + ".csv";
@@ -210,6 +277,16 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
                  "t_s,inverted,inverted_near_anatomy,inverted_near_blade,anatomy_nodes,anatomy_depth_mm,"
                  "anatomy_unresolved,anatomy_rounds,sweeps,tool_active,tool_frozen,force_only,obstacle_contacts,"
                  "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,inverted_free,fem_cpu_ms,supported_nodes\n");
+  }
+  std::FILE* tick_trace = nullptr;
+  if (!tick_trace_path.empty()) {
+    const std::string path = tick_trace_path + "." + r.name + ".csv";
+    tick_trace = std::fopen(path.c_str(), "w");
+    if (tick_trace == nullptr) throw std::runtime_error("cannot write " + path);
+    std::fprintf(tick_trace,
+                 "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,proxy_z,gap_mm,"
+                 "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,obstacle_reaction_n,rows,"
+                 "pgs_converged\n");
   }
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
@@ -239,6 +316,17 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
     r.finite = r.finite && force.allFinite() && gap.allFinite();
     const double commanded = penalty ? force.norm() : k_c * gap.norm();
     r.max_commanded_n = std::max(r.max_commanded_n, commanded);
+    if (tick_trace != nullptr) {
+      const Eigen::Vector3d proxy = vec(c.world_from_proxy().position_m());
+      const contact::TickReport& report = sim.haptic().response().report();
+      std::fprintf(tick_trace, "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,%d,%d,%d,%.4f,%d,%d\n",
+                   sim.time_s(), c.lost_track() ? 1 : 0, force.norm(), force.x(), force.y(), force.z(),
+                   c.tissue_reaction_n(), 1e3 * hand.x(), 1e3 * hand.y(), 1e3 * hand.z(), 1e3 * proxy.x(),
+                   1e3 * proxy.y(), 1e3 * proxy.z(), 1e3 * gap.norm(), limit, static_cast<int>(report.state),
+                   report.catch_up_limited ? 1 : 0, report.yielded ? 1 : 0, report.implausible_step ? 1 : 0,
+                   report.tissue_force_clamped ? 1 : 0, report.obstacle_reaction_n, static_cast<int>(report.load.rows),
+                   report.pgs.converged ? 1 : 0);
+    }
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
     for (const auto& contact : sim.contacts().contacts()) {
       if (contact.kind() != msg::CONTACT_OBSTACLE) r.max_penetration_m = std::max(r.max_penetration_m, contact.penetration_m());
@@ -276,6 +364,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
     if (sim.fem_stepped()) {
       const fem::StepReport& report = sim.fem().last_report();
       r.max_inverted = std::max(r.max_inverted, report.inverted_elements);
+      mark_inverted(sim.body(), sim.tongue_mesh(), r.ever_inverted);
       r.max_elastic_j = std::max(r.max_elastic_j, sim.body().energy().elastic_j);
       r.max_anatomy_depth_m = std::max(r.max_anatomy_depth_m, report.projection.obstacle_deepest_m);
       if (trace != nullptr) {
@@ -312,6 +401,10 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, double facto
   r.fem_cpu_p99_ms = ms(sim.fem_step_cpu().percentile(0.99));
   r.fem_cpu_max_ms = ms(sim.fem_step_cpu().max());
   if (trace != nullptr) std::fclose(trace);
+  if (tick_trace != nullptr) std::fclose(tick_trace);
+  r.inverted_at_end.assign(sim.tongue_mesh().tet_count(), 0);
+  mark_inverted(sim.body(), sim.tongue_mesh(), r.inverted_at_end);
+  count_by_radius_ratio(sim.tongue_mesh(), r);
   return r;
 }
 
@@ -327,8 +420,10 @@ int main(int argc, char** argv) {
   std::string fem_anatomy = "on";
   double support_ratio = -1.0;
   double youngs_pa = 0.0;
+  double stiffening = -1.0;
   std::string tool_stops = "scene";
   std::string trace_path;
+  std::string tick_trace_path;
   std::string spread = "service";
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--sphere-spread", spread, "how the FEM spreads a sphere's correction (default: the service's)")
@@ -345,7 +440,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"scene", "on", "off"}));
   app.add_option("--youngs-pa", youngs_pa, "overrides the deformable body's Young's modulus, Pa (default: the scene's)")
       ->check(CLI::Range(1.0, 1e9));
+  app.add_option("--stiffening", stiffening,
+                 "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
+      ->check(CLI::Range(0.0, 100.0));
   app.add_option("--trace", trace_path, "per-FEM-step CSV, FILE.<response>.csv");
+  app.add_option("--tick-trace", tick_trace_path, "per-tick CSV (force, hand, proxy, gap), FILE.<response>.csv");
   app.add_option("--factor", factor, "overshoot: the hand's pull as a multiple of the device's peak force")
       ->check(CLI::Range(1.0, 10.0));
   app.add_flag("--check", check, "exit 1 unless the force-aware run meets the targets");
@@ -354,8 +453,8 @@ int main(int argc, char** argv) {
   try {
     const auto scene = scene::load_scene(scene_path);
     const bool anatomy = fem_anatomy == "on";
-    const Result fa = response != "penalty" ? run(scene, false, factor, anatomy, support_ratio, youngs_pa, tool_stops, spread, trace_path) : Result{};
-    const Result pe = response != "force-aware" ? run(scene, true, factor, anatomy, support_ratio, youngs_pa, tool_stops, spread, trace_path) : Result{};
+    const Result fa = response != "penalty" ? run(scene, false, factor, anatomy, support_ratio, youngs_pa, stiffening, tool_stops, spread, trace_path, tick_trace_path) : Result{};
+    const Result pe = response != "force-aware" ? run(scene, true, factor, anatomy, support_ratio, youngs_pa, stiffening, tool_stops, spread, trace_path, tick_trace_path) : Result{};
     const auto mm = [](double m) { return 1e3 * m; };
     std::printf("## Overshoot on the neonatal tongue (%.0fx the device's peak force, hold 5 s)\n\n", factor);
     std::printf("| figure | force-aware | penalty |\n|---|---:|---:|\n");
@@ -383,6 +482,14 @@ int main(int argc, char** argv) {
     std::printf("| FEM step CPU ms median / p99 / max (period %.1f) | %.2f / %.2f / %.2f | %.2f / %.2f / %.2f |\n",
                 1e3 / scene->rates.fem_hz, fa.fem_cpu_median_ms, fa.fem_cpu_p99_ms, fa.fem_cpu_max_ms,
                 pe.fem_cpu_median_ms, pe.fem_cpu_p99_ms, pe.fem_cpu_max_ms);
+    for (const auto& body : scene->bodies) {
+      if (!body.deformable) continue;
+      const auto& m = body.deformable->material;
+      std::printf("\ntongue material: E %.0f Pa, Yeoh C20/C10 %.2f (compression stiffening%s)\n",
+                  youngs_pa > 0.0 ? youngs_pa : m.youngs_modulus_pa, stiffening >= 0.0 ? stiffening : m.yeoh_c20_over_c10,
+                  (stiffening >= 0.0 ? stiffening : m.yeoh_c20_over_c10) > 0.0 ? "" : " off");
+      if (response != "penalty") print_radius_ratio_table(fa);
+    }
     if (!check) return 0;
     if (response == "penalty") throw std::runtime_error("--check needs the force-aware run");
     int failures = 0;

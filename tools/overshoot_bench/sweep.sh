@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # The overshoot on the neonatal tongue across the choices that decide it:
-# the tongue's Young's modulus, the FEM's anatomy support springs and whether
-# the tool stops at bone. One force-aware run per line (about 75 s each on
+# the tongue's Young's modulus, the FEM's anatomy support springs, whether
+# the tool stops at bone and the tongue's compression stiffening (Yeoh
+# C20/C10; 0: off, 0.47: the tongue's fit, services/fem material.cpp). One force-aware run per line (about 75 s each on
 # this machine), one Markdown table at the end.
 #   bash tools/overshoot_bench/sweep.sh [BUILD_DIR] [--quick]
-# --quick: only the shipped scene with and without the support springs.
+# --quick: only the shipped modulus, with and without the support springs,
+# each with and without stiffening.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 build="${1:-$root/build}"
@@ -13,10 +15,11 @@ bench="$build/tools/overshoot_bench/fahr_overshoot_bench"
 quick=false
 [ "${2:-}" = "--quick" ] && quick=true
 
-# E Pa | support ratio | tool stops (scene = the shipped scene's choice, off)
-configs=("10000 0 scene" "10000 100 scene")
+# E Pa | support ratio | tool stops (scene = the shipped scene's choice, off) | stiffening C20/C10
+configs=("10000 0 scene 0" "10000 100 scene 0" "10000 0 scene 0.47" "10000 100 scene 0.47")
 if ! $quick; then
-  configs+=("30000 0 scene" "30000 100 scene" "100000 0 scene" "100000 100 scene" "10000 100 on" "100000 100 on")
+  configs+=("30000 0 scene 0" "30000 100 scene 0" "100000 0 scene 0" "100000 100 scene 0" "10000 100 on 0"
+            "100000 100 on 0" "100000 100 scene 0.47" "10000 100 on 0.47")
 fi
 
 out=$(mktemp -d)
@@ -24,15 +27,16 @@ trap 'rm -rf "$out"' EXIT
 field() {  # the force-aware column of a table row
   grep -F "| $1 |" "$2" | head -1 | awk -F'|' '{gsub(/^ +| +$/, "", $3); print $3}'
 }
-echo "| E kPa | support | tool stops | most inverted tets | reaction / limit while lost track | lost-track ticks | Green strain 1x / end | gap error mm | re-engagement step N (bound) | tongue from rest 1 s after mm | --check |"
-echo "|---:|---:|---|---:|---:|---:|---|---:|---|---:|---|"
+echo "| E kPa | support | tool stops | stiffening | most inverted tets | reaction / limit while lost track | lost-track ticks | Green strain 1x / end | gap error mm | re-engagement step N (bound) | tongue from rest 1 s after mm | --check |"
+echo "|---:|---:|---|---:|---:|---:|---:|---|---:|---|---:|---|"
 for config in "${configs[@]}"; do
-  read -r youngs support stops <<<"$config"
-  file="$out/$youngs-$support-$stops.txt"
+  read -r youngs support stops stiffening <<<"$config"
+  file="$out/$youngs-$support-$stops-$stiffening.txt"
   verdict=pass
-  "$bench" --response force-aware --youngs-pa "$youngs" --fem-support "$support" --tool-stops "$stops" --check \
+  "$bench" --response force-aware --youngs-pa "$youngs" --fem-support "$support" --tool-stops "$stops" \
+    --stiffening "$stiffening" --check \
     >"$file" 2>&1 || verdict=fail
-  echo "| $((youngs / 1000)) | $support | $stops | $(field "most inverted tets" "$file") |" \
+  echo "| $((youngs / 1000)) | $support | $stops | $stiffening | $(field "most inverted tets" "$file") |" \
        "$(field "largest reaction / limit while lost track" "$file") | $(field "lost-track ticks" "$file") |" \
        "$(field "max Green strain at 1x / at the end of the hold" "$file") |" \
        "$(field "largest published-gap error mm" "$file") |" \

@@ -5,12 +5,16 @@
 // Equal hashes show that the in-process run is the distributed one.
 //
 //   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
-//                      [--fem-anatomy on|off] [--fem-support RATIO] [--seconds 4]
+//                      [--fem-anatomy on|off] [--fem-support RATIO] [--stiffening C20/C10] [--seconds 4]
+//
+// --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
+// (services/fem compression_stiffening.h; 0: off), instead of the scene's.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "fahr/common/solver_threads.h"
@@ -37,6 +41,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--collision", collision, "the haptic service's collision method")
       ->check(CLI::IsMember({"aist", "triangle"}));
+  double stiffening = -1.0;
+  app.add_option("--stiffening", stiffening,
+                 "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
+      ->check(CLI::Range(0.0, 100.0));
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -47,7 +55,11 @@ int main(int argc, char** argv) {
     if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
     options.collision =
         collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;
-    stack_sim::StackSim sim(scene::load_scene(scene_path), options);
+    auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));
+    for (auto& body : scene->bodies) {
+      if (body.deformable && stiffening >= 0.0) body.deformable->material.yeoh_c20_over_c10 = stiffening;
+    }
+    stack_sim::StackSim sim(scene, options);
     const auto steps = static_cast<std::uint64_t>(seconds * 1000.0 + 0.5);
     const auto start = std::chrono::steady_clock::now();
     double peak_force = 0.0;

@@ -88,7 +88,7 @@ void SystemAssembly::build(std::size_t node_count, const ElementRest& rest,
 
 void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Matrix3d> rotations,
                               const LameParameters& lame, std::span<const double> mass_per_dof_kg,
-                              double mass_scale, double stiffness_scale) {
+                              double mass_scale, double stiffness_scale, std::span<const double> element_scales) {
   double* values = a_.valuePtr();
   std::memset(values, 0, sizeof(double) * static_cast<std::size_t>(a_.nonZeros()));
   for (std::size_t e = 0; e < rest.size(); ++e) {
@@ -96,7 +96,8 @@ void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Ma
     // V (lambda r_a r_b^T + mu r_b r_a^T + mu (g_a . g_b) I).
     const Eigen::Matrix<double, 3, 4>& g = rest.gradients[e];
     const Eigen::Matrix<double, 3, 4> r = rotations[e] * g;
-    const double scale = stiffness_scale * rest.volume_m3[e];
+    double scale = stiffness_scale * rest.volume_m3[e];
+    if (!element_scales.empty()) scale *= element_scales[e];
     const double lambda = scale * lame.lambda_pa;
     const double mu = scale * lame.mu_pa;
     const std::uint32_t* starts = &block_column_start_[48 * e];

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fahr/fem/compression_stiffening.h"
 #include "fahr/fem/corotation.h"
 #include "fahr/fem/lumped_mass.h"
 
@@ -17,6 +18,9 @@ std::string validate(const SolverSettings& solver) {
   if (!(solver.cg_relative_tolerance >= 0.0)) return "solver settings: cg_relative_tolerance must be >= 0";
   if (!(solver.refactor_rotation_rad >= 0.0)) return "solver settings: refactor_rotation_rad must be >= 0";
   if (solver.cg_refresh_iterations < 0) return "solver settings: cg_refresh_iterations must be >= 0";
+  if (!(solver.refactor_stiffening_change >= 0.0)) {
+    return "solver settings: refactor_stiffening_change must be >= 0";
+  }
   return {};
 }
 
@@ -95,6 +99,11 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m, 
   supports_.assign(n, NodeSupport{});
   rotations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
   rotations_at_factor_ = rotations_;
+  stiffening_ = settings_.material.yeoh_c20_over_c10 > 0.0;
+  if (stiffening_) {
+    stiffening_scales_.assign(rest_.size(), 1.0);
+    stiffening_scales_at_factor_ = stiffening_scales_;
+  }
   assembly_.build(n, rest_, fixed_dof_);
   cg_.resize(3 * n);
   compliance_.reserve(3 * n, settings_.max_compliance_spheres);
@@ -109,7 +118,8 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m, 
 void Body::assemble_system() {
   const double alpha = settings_.material.rayleigh_mass_per_s;
   const double beta = settings_.material.rayleigh_stiffness_s;
-  assembly_.assemble(rest_, rotations_, lame_, mass_per_dof_, 1.0 + h_ * alpha, h_ * beta + h_ * h_);
+  assembly_.assemble(rest_, rotations_, lame_, mass_per_dof_, 1.0 + h_ * alpha, h_ * beta + h_ * h_,
+                     stiffening_scales_);
   for (std::size_t i = 0; i < support_count_; ++i) {
     assembly_.add_normal_stiffness(supports_[i].node, supports_[i].normal, support_ratio_);
   }
@@ -148,6 +158,7 @@ bool Body::refactorise() {
   refresh_due_ = false;
   supports_changed_ = false;
   std::copy(rotations_.begin(), rotations_.end(), rotations_at_factor_.begin());
+  std::copy(stiffening_scales_.begin(), stiffening_scales_.end(), stiffening_scales_at_factor_.begin());
   warp_.mark_factorised();
   return cholmod_.factorize();
 }
@@ -168,14 +179,21 @@ int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_en
     inverted += corotation.inverted ? 1 : 0;
     const Eigen::Matrix3d& r = corotation.rotation;
     rotations_[e] = r;
+    // The stiffened element acts as s times as much of the linear material
+    // (compression_stiffening.h); s = 1 exactly without stiffening.
+    double scale = 1.0;
+    if (stiffening_) {
+      scale = stiffening_scale(deformation, settings_.material.yeoh_c20_over_c10);
+      stiffening_scales_[e] = scale;
+    }
     // Small strain in the rotated frame, linear stress, rotated back:
-    // f = -R K0 (R^T x - X) written per element as -V P Dm^-T.
+    // f = -s R K0 (R^T x - X) written per element as -s V P Dm^-T.
     const Eigen::Matrix3d unrotated = r.transpose() * deformation;
     const Eigen::Matrix3d strain = 0.5 * (unrotated + unrotated.transpose()) - Eigen::Matrix3d::Identity();
     const double trace = strain.trace();
     Eigen::Matrix3d stress = 2.0 * lame_.mu_pa * strain;
     stress.diagonal().array() += lame_.lambda_pa * trace;
-    const double volume = rest_.volume_m3[e];
+    const double volume = scale * rest_.volume_m3[e];
     const Eigen::Matrix3d h = -volume * (r * stress) * rest_.dm_inv[e].transpose();
     Eigen::Map<Eigen::Vector3d>(f + 3 * std::size_t{tet[0]}) -= h.col(0) + h.col(1) + h.col(2);
     for (Eigen::Index a = 0; a < 3; ++a) {
@@ -206,6 +224,16 @@ bool Body::rotated_since_factor() const {
   const double min_trace = 1.0 + 2.0 * std::cos(threshold);
   for (std::size_t e = 0; e < rotations_.size(); ++e) {
     if (rotations_[e].cwiseProduct(rotations_at_factor_[e]).sum() < min_trace) return true;
+  }
+  return false;
+}
+
+bool Body::stiffened_since_factor() const {
+  const double change = settings_.solver.refactor_stiffening_change;
+  if (!stiffening_ || !(change > 0.0)) return false;
+  for (std::size_t e = 0; e < stiffening_scales_.size(); ++e) {
+    const double then = stiffening_scales_at_factor_[e];
+    if (std::abs(stiffening_scales_[e] - then) > change * then) return true;
   }
   return false;
 }
@@ -260,7 +288,7 @@ void Body::prepare_system(StepReport& report) {
   const bool factor_due = (solver.refactor_period > 0 && steps_since_factor_ + 1 >= solver.refactor_period) ||
                           (factor_needed && refresh_due_) ||
                           (factor_needed && solver.refactor_period != 1 &&
-                           (support_changed_factor_due(cg) || rotated_since_factor()));
+                           (support_changed_factor_due(cg) || rotated_since_factor() || stiffened_since_factor()));
   if (factor_needed) warp_.update_rotations(rest_, rotations_);
   // CG multiplies with the current A; the direct solve only needs A when it
   // refactorises.
@@ -388,6 +416,7 @@ bool Body::reset_to_rest() {
   sleep_.wake();
   support_count_ = 0;
   std::fill(rotations_.begin(), rotations_.end(), Eigen::Matrix3d::Identity());
+  std::fill(stiffening_scales_.begin(), stiffening_scales_.end(), 1.0);
   warp_.update_rotations(rest_, rotations_);
   assemble_system();
   return refactorise();

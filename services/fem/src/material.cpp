@@ -16,6 +16,21 @@ namespace fahr::fem {
 // tetrahedra lock volumetrically as nu approaches 0.5; 0.45 is the usual
 // compromise in surgical simulation and matches the project's solver notes.
 // Density: skeletal muscle is about 1040-1060 kg/m^3; 1040 is used.
+// Compression stiffening: Gerard, Ohayon, Luboz, Perrier and Payan indented
+// fresh cadaver tongue and fitted a Yeoh solid, W = C10 (I1 - 3) +
+// C20 (I1 - 3)^2 ("Non-linear elastic properties of the lingual and facial
+// tissues assessed by indentation technique. Application to the
+// biomechanics of speech production", Med Eng Phys 27(10):884-892, 2005),
+// quoted as C10 = 192 Pa, C20 = 90 Pa. Tongue models built on it keep its
+// shape and scale it to living tissue: Buchaillard, Perrier and Payan
+// (J Acoust Soc Am 126(4):2033-2051, 2009) use C10 = 1037 Pa, C20 = 486 Pa,
+// as does ArtiSynth's tongue (artisynth_models: MooneyRivlinMaterial(1037,
+// 0, 0, 486, 0, 10370), "[Buchaillard 2009]"); another ArtiSynth model uses
+// 2500 Pa and 1175 Pa after Nazari et al. (Motor Control). C20/C10 is the
+// same in all three: 0.469, 0.469, 0.470. Only the ratio is used here, so
+// the small-strain modulus stays E: kTongueYeohC20OverC10 = 0.47. The 1037
+// / 486 and 2500 / 1175 pairs were read in ArtiSynth's public source; the
+// 2005 paper's own table was not at hand (192 / 90 is as quoted).
 // Damping: alpha and beta are numerical choices (a lowest tongue mode near
 // 5 Hz gets a few percent of critical damping from alpha; beta damps the
 // high-frequency element modes), not measurements.
@@ -52,6 +67,9 @@ const char* validate(const Material& material) {
   }
   if (!(material.rayleigh_mass_per_s >= 0.0) || !(material.rayleigh_stiffness_s >= 0.0)) {
     return "material Rayleigh coefficients must be >= 0";
+  }
+  if (!(material.yeoh_c20_over_c10 >= 0.0 && material.yeoh_c20_over_c10 <= kMaxYeohC20OverC10)) {
+    return "material.yeoh_c20_over_c10 must be in [0, 100]";
   }
   return "";
 }

@@ -85,7 +85,7 @@ Material parse_material(const MapReader& body_map) {
   Material m;
   const MapReader map(body_map.log(), body_map.value("material"), body_map.child_path("material"),
                       {"youngs_modulus_pa", "poisson_ratio", "density_kg_per_m3",
-                       "rayleigh_mass_per_s", "rayleigh_stiffness_s"});
+                       "rayleigh_mass_per_s", "rayleigh_stiffness_s", "yeoh_c20_over_c10"});
   map.read("youngs_modulus_pa", open_closed(0.0, 1.0e12), m.youngs_modulus_pa);
   // nu = 0.5 is incompressible (the stiffness matrix is singular), nu = -1
   // has no shear stiffness: both ends excluded.
@@ -93,6 +93,8 @@ Material parse_material(const MapReader& body_map) {
   map.read("density_kg_per_m3", open_closed(0.0, 1.0e5), m.density_kg_per_m3);
   map.read("rayleigh_mass_per_s", closed(0.0, 1.0e4), m.rayleigh_mass_per_s);
   map.read("rayleigh_stiffness_s", closed(0.0, 10.0), m.rayleigh_stiffness_s);
+  // The FEM's own bound (services/fem material.h, kMaxYeohC20OverC10).
+  map.read("yeoh_c20_over_c10", closed(0.0, 100.0), m.yeoh_c20_over_c10);
   return m;
 }
 

@@ -8,7 +8,9 @@
 //   =>  A v' = M v + h f,   A = (1 + h alpha) M + (h beta + h^2) K
 //   x' = x + h v'
 // which is one Newton step of backward Euler with f linearised about x
-// (Baraff and Witkin 1998; Mueller and Gross 2004 for the corotation). The
+// (Baraff and Witkin 1998; Mueller and Gross 2004 for the corotation). With
+// compression stiffening each element's K0 is scaled by its s_e of the start
+// of the step, in f and in A alike (compression_stiffening.h). The
 // right-hand side needs no K, so a lagged A only changes the dynamics, never
 // the static equilibrium. Fixed DOFs are decoupled rows with v' = 0.
 #pragma once
@@ -70,7 +72,10 @@ struct StepReport {
 
 struct Energy {
   double kinetic_j = 0.0;
-  double elastic_j = 0.0;            // corotational strain energy, J
+  // Corotational strain energy, J; with compression stiffening each
+  // element's s_e times its linear energy (the scaled force derives from no
+  // energy, so this is the secant estimate).
+  double elastic_j = 0.0;
   double gravity_potential_j = 0.0;  // -m g . x summed, J (relative to origin)
   double total_j() const { return kinetic_j + elastic_j + gravity_potential_j; }
 };
@@ -170,6 +175,8 @@ class Body {
   bool refactorise();
   // True if an element rotated more than the setting since the factorisation.
   bool rotated_since_factor() const;
+  // True if an element's stiffening scale changed by more than the setting.
+  bool stiffened_since_factor() const;
   bool support_changed_factor_due(bool cg) const;
   bool accept_contacts(const ContactSet* contacts, const SphereLinks* links, StepReport& report);
   double kinetic_energy() const;
@@ -187,6 +194,12 @@ class Body {
   Eigen::VectorXd rest_x_, x_, v_, x_start_, force_, external_force_, gravity_force_, rhs_, v_next_;
   std::vector<Eigen::Matrix3d> rotations_;
   std::vector<Eigen::Matrix3d> rotations_at_factor_;
+  // Compression stiffening (compression_stiffening.h), per element: the
+  // scale at the start of the step and at the last factorisation. Empty
+  // when the material has none.
+  bool stiffening_ = false;
+  std::vector<double> stiffening_scales_;
+  std::vector<double> stiffening_scales_at_factor_;
 
   SystemAssembly assembly_;
   CholmodSolver cholmod_;

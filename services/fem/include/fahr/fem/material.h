@@ -11,10 +11,24 @@ struct Material {
   double density_kg_per_m3 = 1040.0;   // rho, kg/m^3, > 0
   double rayleigh_mass_per_s = 1.0;    // alpha, 1/s, >= 0
   double rayleigh_stiffness_s = 0.01;  // beta, s, >= 0
+  // Compression stiffening (compression_stiffening.h): the Yeoh ratio
+  // C20/C10, dimensionless, [0, kMaxYeohC20OverC10]; 0: off, the linear
+  // corotational material exactly as without it. The tongue's is
+  // kTongueYeohC20OverC10.
+  double yeoh_c20_over_c10 = 0.0;
 };
+
+// Gerard et al.'s Yeoh fit of human tongue tissue, C20/C10 = 0.47 (see
+// material.cpp for the source and the figures).
+inline constexpr double kTongueYeohC20OverC10 = 0.47;
+// Beyond this the stiffening is no longer a tissue's: at C20/C10 = 100 an
+// incompressible 10 % shortening (I1bar - 3 = 0.032) already multiplies the
+// stress by 7.4.
+inline constexpr double kMaxYeohC20OverC10 = 100.0;
 
 // Defaults for neonatal tongue tissue. No neonatal measurement is known to
 // us; the stiffness is the adult in-vivo value, see material.cpp for sources.
+// Compression stiffening stays off here (the scene file turns it on).
 Material neonatal_tongue();
 
 struct LameParameters {

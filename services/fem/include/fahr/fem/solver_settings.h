@@ -28,6 +28,14 @@ struct SolverSettings {
   // damped (a never-refreshed factor oscillates at 45 degrees), while a
   // body deforming gently refactorises rarely.
   double refactor_rotation_rad = 0.1;
+  // Also refactorise when some element's compression-stiffening scale
+  // (compression_stiffening.h) has changed by more than this fraction of
+  // itself since the last factorisation (0 disables; only a material with
+  // stiffening has scales that change). Its block of A is off by that
+  // fraction, as a turn of 0.1 rad puts it off by about 10 %: 0.1 matches
+  // the rotation trigger. Applies where the rotation trigger does (a factor
+  // in use and refactor_period != 1).
+  double refactor_stiffening_change = 0.1;
   // Rotate a reused factorisation per node into the current frame (see
   // warped_factor.h). Off only to measure what it buys.
   bool warp_lagged_factor = false;

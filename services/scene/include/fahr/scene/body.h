@@ -29,13 +29,16 @@ std::string_view to_string(LengthUnit unit);
 // Metres per file unit: the scale a mesh loader multiplies coordinates by.
 double metres_per_unit(LengthUnit unit);
 
-// Linear elastic, isotropic material in SI units.
+// Linear elastic, isotropic material in SI units, optionally stiffening
+// under large compression.
 struct Material {
   double youngs_modulus_pa = kDefaultYoungsModulusPa;        // Pa, (0, 1e12]
   double poisson_ratio = kDefaultPoissonRatio;               // (-1, 0.5)
   double density_kg_per_m3 = kDefaultDensityKgPerM3;         // kg/m^3, (0, 1e5]
   double rayleigh_mass_per_s = kDefaultRayleighMassPerS;     // 1/s, [0, 1e4]
   double rayleigh_stiffness_s = kDefaultRayleighStiffnessS;  // s, [0, 10]
+  // Yeoh C20/C10, dimensionless, [0, 100]; 0: no compression stiffening.
+  double yeoh_c20_over_c10 = kDefaultYeohC20OverC10;
 };
 
 // Nodes held at their rest position: the union of an index file and a box.

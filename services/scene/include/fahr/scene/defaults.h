@@ -24,6 +24,10 @@ inline constexpr double kDefaultDensityKgPerM3 = 1040.0;
 // lowest modes lie; alpha is small so slow, rigid-like motion is not braked.
 inline constexpr double kDefaultRayleighMassPerS = 0.1;
 inline constexpr double kDefaultRayleighStiffnessS = 0.01;
+// Compression stiffening, the Yeoh ratio C20/C10 (services/fem
+// compression_stiffening.h): 0 is the linear corotational material. Off by
+// default so a scene without the key behaves as before the key existed.
+inline constexpr double kDefaultYeohC20OverC10 = 0.0;
 
 // --- AIST (adaptive inner sphere tree) of a deformable body. ----------------
 // The paper finds about 10x the mean tet volume per coarse sphere best.
