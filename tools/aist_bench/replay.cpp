@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "fahr/haptic/deepest_contacts.h"
 #include "fahr/haptic/field_grid.h"
 #include "fahr/haptic/fill_spheres.h"
 #include "fahr/haptic/sphere_query.h"
@@ -103,17 +104,35 @@ struct ContactHash {
   }
 };
 
+// Rows the haptic tick keeps of a query's contacts (its tissue_row_budget:
+// msg::MAX_COMPLIANCE_SPHERES, the response's row count).
+constexpr std::size_t kServiceRows = 64;
+
 struct ReplayVariant {
   const char* name;
   haptic::QuerySettings settings;
+  // > 0: the timed work is the haptic tick's, the query and then the `keep`
+  // deepest selected (and completed, defer_outside_contacts); row_hash hashes them.
+  std::size_t keep;
   haptic::PrePenetrationMemory memory;
   haptic::ContactBuffer buffer;
+  std::vector<std::uint32_t> rows;
   std::vector<double> first_us, warm_us;
   ContactHash hash;      // every contact in buffer order
   ContactHash set_hash;  // per query the sum of each contact's hash: the same contacts in any order
+  ContactHash row_hash;  // the kept rows, in row order
   double tested_sum = 0.0, contacts_sum = 0.0, nodes_sum = 0.0;
   std::uint32_t tested_max = 0, contacts_max = 0;
 };
+
+// The haptic tick's row selection (services/haptic/main/haptic_loop.cpp)
+// for a variant that keeps rows; returns how many.
+std::size_t select_rows(const haptic::SphereTree& tree, const haptic::RigidBody& blade, ReplayVariant& v) {
+  if (v.keep == 0) return 0;
+  const std::size_t kept = haptic::select_deepest(v.buffer, v.keep, v.rows);
+  haptic::complete_deferred(tree, blade, v.settings, v.buffer, v.rows.data(), kept);
+  return kept;
+}
 
 }  // namespace
 
@@ -184,18 +203,24 @@ void replay_states(const Scene& scene, const Options& options, const std::string
   service_plain.surface_probe = haptic::QuerySettings::SurfaceProbe::kNone;
   haptic::QuerySettings service_deepest = service;
   service_deepest.deepest_only = 64;
+  haptic::QuerySettings service_deferred = service_plain;
+  service_deferred.defer_outside_contacts = true;
   std::deque<ReplayVariant> variants;
   int added = 0;
-  auto add = [&](const char* name, const haptic::QuerySettings& s) {
+  auto add = [&](const char* name, const haptic::QuerySettings& s, std::size_t keep) {
     const int index = added++;
     if (options.replay_only >= 0 && index != options.replay_only) return;
-    variants.push_back({name, s, haptic::PrePenetrationMemory(layout.size()), haptic::ContactBuffer(4096), {}, {}, {}, {}});
+    variants.push_back({name, s, keep, haptic::PrePenetrationMemory(layout.size()), haptic::ContactBuffer(4096),
+                        std::vector<std::uint32_t>(4096), {}, {}, {}, {}, {}});
   };
-  add("grid narrow phase (trajectory's settings)", bench_grid);
-  add("exact narrow phase (trajectory's settings)", bench);
-  add("grid, 1 mm candidates (the service's settings)", service);
-  add("grid, 1 mm candidates, deepest_only 64", service_deepest);
-  add("grid, 1 mm candidates, no surface probe", service_plain);
+  add("grid narrow phase (trajectory's settings)", bench_grid, 0);
+  add("exact narrow phase (trajectory's settings)", bench, 0);
+  add("grid, 1 mm candidates (the service's settings)", service, 0);
+  add("grid, 1 mm candidates, deepest_only 64", service_deepest, 0);
+  add("grid, 1 mm candidates, no surface probe", service_plain, 0);
+  add("the same, then the 64 deepest kept (the service's tick before)", service_plain, kServiceRows);
+  add("the same, outside contacts deferred, the 64 deepest completed (the service's tick now)", service_deferred,
+      kServiceRows);
   if (variants.empty()) throw std::runtime_error("replay: --replay-only names no variant");
   // Evicting the core's L2 (2 MB here) between queries stands for the rest
   // of a haptic tick (and other processes) running in between.
@@ -231,6 +256,7 @@ void replay_states(const Scene& scene, const Options& options, const std::string
         v.buffer.clear();
         const double start = thread_cpu_us();
         const haptic::QueryStats stats = haptic::query_spheres(tree, state, blade, v.settings, v.memory, v.buffer);
+        const std::size_t kept = select_rows(tree, blade, v);
         v.first_us[tick] = std::min(v.first_us[tick], thread_cpu_us() - start);
         if (pass == 0) {
           std::uint64_t sum = 0;
@@ -241,6 +267,7 @@ void replay_states(const Scene& scene, const Options& options, const std::string
             sum += one.value;
           }
           v.set_hash.bytes(&sum, sizeof(sum));
+          for (std::size_t r = 0; r < kept; ++r) v.row_hash.add(v.buffer[v.rows[r]]);
           v.tested_sum += stats.spheres_tested;
           v.nodes_sum += stats.nodes_visited;
           v.contacts_sum += stats.contacts;
@@ -250,6 +277,7 @@ void replay_states(const Scene& scene, const Options& options, const std::string
         v.buffer.clear();
         const double warm_start = thread_cpu_us();
         haptic::query_spheres(tree, state, blade, v.settings, v.memory, v.buffer);
+        select_rows(tree, blade, v);
         v.warm_us[tick] = std::min(v.warm_us[tick], thread_cpu_us() - warm_start);
       }
     }
@@ -258,15 +286,17 @@ void replay_states(const Scene& scene, const Options& options, const std::string
   std::printf("\n## Replay of %s: %zu ticks, %zu FEM states, %zu spheres, %zu kB written before each first run (evicts L2), per tick the least of %d passes (checksum %llu)\n\n",
               path.c_str(), rec.poses.size(), rec.states.size(), layout.size(), options.evict_bytes / 1024, options.replay_passes,
               static_cast<unsigned long long>(sink % 10));
-  std::printf("| query | first run thread CPU: median / p99 / p99.9 / max (us) | warm rerun: median / p99 / p99.9 / max (us) | nodes visited (mean) | spheres tested: mean / max | contacts: mean / max | contact hash: in order / as sets |\n");
-  std::printf("| --- | --- | --- | --- | --- | --- | --- |\n");
+  std::printf("| query | first run thread CPU: median / p99 / p99.9 / max (us) | warm rerun: median / p99 / p99.9 / max (us) | nodes visited (mean) | spheres tested: mean / max | contacts: mean / max | contact hash: in order / as sets | row hash |\n");
+  std::printf("| --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const auto& v : variants) {
-    std::printf("| %s | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f | %.0f | %.0f / %u | %.0f / %u | %016llx / %016llx |\n", v.name,
+    char rows[32] = "";
+    if (v.keep > 0) std::snprintf(rows, sizeof(rows), "%016llx", static_cast<unsigned long long>(v.row_hash.value));
+    std::printf("| %s | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f | %.0f | %.0f / %u | %.0f / %u | %016llx / %016llx | %s |\n", v.name,
                 percentile(v.first_us, 50), percentile(v.first_us, 99), percentile(v.first_us, 99.9),
                 percentile(v.first_us, 100), percentile(v.warm_us, 50), percentile(v.warm_us, 99),
                 percentile(v.warm_us, 99.9), percentile(v.warm_us, 100), v.nodes_sum / n, v.tested_sum / n,
                 v.tested_max, v.contacts_sum / n, v.contacts_max, static_cast<unsigned long long>(v.hash.value),
-                static_cast<unsigned long long>(v.set_hash.value));
+                static_cast<unsigned long long>(v.set_hash.value), rows);
   }
   std::printf("\nupdate+refit thread CPU: median %.1f us, p99.9 %.1f us.\n", percentile(refit_us, 50),
               percentile(refit_us, 99.9));

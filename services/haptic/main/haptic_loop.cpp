@@ -91,6 +91,9 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
   // The rows take the contact point, normal and depth only: no surface point
   // (a face read and a closest point per reported sphere, ~500 a pressed tick).
   tool_query_.surface_probe = haptic::QuerySettings::SurfaceProbe::kNone;
+  // Of ~540 contacts a pressed tick ~64 become rows: the others' normals
+  // (a gradient, a square root, two transforms each) are not worked out.
+  tool_query_.defer_outside_contacts = true;
   for (const std::size_t a : setup.tool_obstacles) {
     const RigidField& field = *setup.anatomy[a];
     haptic::RigidBody body;
@@ -118,11 +121,11 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
 }
 
 void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
-  const std::size_t n = tool_contacts_.size();
-  std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
-  const std::size_t keep = std::min(n, tissue_row_budget_);
-  // More than W can cover: keep the deepest (touching before candidates).
-  relaxed_add<std::uint64_t>(metrics_.rows_dropped, keep_deepest(order_, n, keep, tool_contacts_));
+  // More than W can cover: keep the deepest (touching before candidates),
+  // and only those get their point and normal (defer_outside_contacts).
+  const std::size_t keep = haptic::select_deepest(tool_contacts_, tissue_row_budget_, order_);
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, tool_contacts_.size() - keep);
+  haptic::complete_deferred(tissue.tree, tool_body_, tool_query_, tool_contacts_, order_.data(), keep);
   // (The penalty baseline's forces are part of the FEM's step, so it reads
   // the published centres.)
   const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;

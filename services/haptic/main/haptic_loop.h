@@ -17,6 +17,7 @@
 #include "fahr/contact/contact_response.h"
 #include "fahr/contact/penalty_response.h"
 #include "fahr/haptic/contact_buffer.h"
+#include "fahr/haptic/deepest_contacts.h"
 #include "fahr/haptic/rigid_body.h"
 #include "fahr/haptic/sphere_query.h"
 #include "fahr/haptic/surface_samples.h"

@@ -126,6 +126,35 @@ geometry::SdfSample sample(const Grid& field, const Eigen::Vector3d& p, double g
   return bounded_exact(sdf, p, grid, bound);
 }
 
+// The contact of a sphere whose centre is outside (s.distance_m > 0): it is
+// its own pre-penetration centre. complete_deferred() calls it too, so a
+// deferred contact gets the same numbers.
+void outside_contact(const Eigen::Vector3d& centre_body, double radius, const geometry::SdfSample& s,
+                     Eigen::Vector3d& q, Eigen::Vector3d& n, double& depth) noexcept {
+  q = s.closest_point_m;
+  const Eigen::Vector3d d = centre_body - q;
+  const double len = d.norm();
+  n = len > kMinNormalLength ? Eigen::Vector3d(d / len) : s.normal;
+  depth = radius - s.distance_m;
+}
+
+// The surface point of a reported sphere and its depth behind the body's
+// tangent plane at the contact (NaN x: no anchor): no field read, and the
+// side is the pre-penetration normal's, so a point pushed past a thin
+// plate's mid-plane is still measured from the face it came through.
+void probe_surface(const SphereTree& tree, std::uint32_t slot, QuerySettings::SurfaceProbe probe,
+                   SphereContact& contact) noexcept {
+  if (probe == QuerySettings::SurfaceProbe::kNone) return;
+  const Eigen::Vector3d& anchor = tree.slot_anchors()[slot];
+  if (std::isnan(anchor.x())) return;
+  const auto& face = tree.slot_faces()[slot];
+  contact.surface_point_m = probe == QuerySettings::SurfaceProbe::kFacePoint
+                                ? geometry::closest_point_on_triangle(contact.point_m, face[0], face[1], face[2]).point
+                                : anchor;
+  contact.surface_depth_m = (contact.point_m - contact.surface_point_m).dot(contact.normal);
+  contact.has_surface = true;
+}
+
 // The contact of one sphere whose exact sample at its centre is `s`.
 bool narrow_phase(const Grid& field, const Eigen::Vector3d* hint, double margin,
                   const Eigen::Vector3d& centre_body,
@@ -134,12 +163,7 @@ bool narrow_phase(const Grid& field, const Eigen::Vector3d* hint, double margin,
                   Eigen::Vector3d& q, Eigen::Vector3d& n, double& depth, bool& no_history) noexcept {
   no_history = false;
   if (s.distance_m > 0.0) {
-    // The centre is outside: it is its own pre-penetration centre.
-    q = s.closest_point_m;
-    const Eigen::Vector3d d = centre_body - q;
-    const double len = d.norm();
-    n = len > kMinNormalLength ? Eigen::Vector3d(d / len) : s.normal;
-    depth = radius - s.distance_m;
+    outside_contact(centre_body, radius, s, q, n, depth);
     return depth > -margin;
   }
   Eigen::Vector3d before;
@@ -184,12 +208,21 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   const Eigen::Matrix3d world_rotation = body.world_from_body.linear();
   const std::uint64_t query = memory.next_query();
   const auto& slots = tree.slot_spheres();
-  const auto& slot_anchors = tree.slot_anchors();
-  const auto& slot_faces = tree.slot_faces();
-  const bool face_probe = settings.surface_probe == QuerySettings::SurfaceProbe::kFacePoint;
-  const bool probe = settings.surface_probe != QuerySettings::SurfaceProbe::kNone;
   const auto& order = tree.order();
+  // With a FieldGrid and the grid narrow phase one read gives the value
+  // and, only for the spheres that reach the narrow phase, the gradient.
+  const bool one_read = copy != nullptr && !settings.exact_narrow_phase;
+  const bool defer = one_read && settings.defer_outside_contacts;
   if (slots.size() != state.centres_m().size()) return stats;  // a tree of another layout
+
+  // The grid's interpolant is L-Lipschitz, L = sqrt(3) (1 + 2 e / h) + 1:
+  // each axis's slope is a blend of edge differences of exact distances,
+  // each within a cell plus twice the storage error e; beyond the grid the
+  // clamp adds slope 1. The sphere floors below
+  // (PrePenetrationMemory::remember) use it.
+  const double storage_error = copy != nullptr ? copy->storage_error_m() : 0.0;
+  const double lipschitz = std::sqrt(3.0) * (1.0 + 2.0 * storage_error / sdf.cell_size_m()) + 1.0;
+  const double lipschitz_squared = lipschitz * lipschitz;
 
   // Lower bound of the grid value at any point of a node's spheres (grown by
   // the skin and the candidate margin), m. On the grid: the grid at the box's
@@ -205,14 +238,17 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   const Eigen::Vector3d inset = Eigen::Vector3d::Constant(sdf.band_m() + 2.0 * sdf.cell_size_m());
   const Eigen::Vector3d surface_low = grid_low + inset;
   const Eigen::Vector3d surface_high = grid_high - inset;
-  auto node_bound = [&](const SphereTreeNode& node) noexcept {
-    const Eigen::Vector3d middle = frame.to_body(0.5 * (node.box_min_m + node.box_max_m));
+  auto node_middle = [&](const SphereTreeNode& node) noexcept {
+    return frame.to_body(0.5 * (node.box_min_m + node.box_max_m));
+  };
+  auto bound_at = [&](const SphereTreeNode& node, const Eigen::Vector3d& middle) noexcept {
     const double reach = node.reach_m + settings.contact_skin_m + settings.candidate_margin_m;
     const bool on_grid = (middle.array() >= grid_low.array()).all() && (middle.array() <= grid_high.array()).all();
     if (on_grid) return field.distance(middle) - 2.0 * grid_error - reach;
     const double to_surface_box = (middle - middle.cwiseMax(surface_low).cwiseMin(surface_high)).norm();
     return to_surface_box - grid_error - reach;  // a NaN pose gives NaN: the caller prunes it
   };
+  auto node_bound = [&](const SphereTreeNode& node) noexcept { return bound_at(node, node_middle(node)); };
   // The deepest k contacts found so far, as a min-heap of depths (deepest_only).
   const std::size_t keep = std::min(settings.deepest_only, kMaxDeepest);
   std::array<double, kMaxDeepest> kept_depths;
@@ -239,38 +275,72 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     const auto count = static_cast<std::size_t>(std::min<std::int32_t>(node.count, SphereTree::kLeafSize));
     for (std::size_t k = 0; k < count; ++k) {
       leaf_body[k] = frame.to_body(slots[static_cast<std::size_t>(node.first) + k].head<3>());
-      if (copy != nullptr) copy->prefetch(leaf_body[k]);
     }
     return count;
+  };
+  // The grid read at a sphere decides first whether grid - error > r +
+  // candidate margin (then it is only remembered). Its memory's floor of the
+  // grid at the centre it last remembered decides that without the read
+  // when floor - L |p - centre| is still beyond it. No square root unless
+  // the read is skipped: the new floor needs it.
+  std::array<double, SphereTree::kLeafSize> leaf_floor;  // new floor of a sphere whose read is skipped, else NaN
+  auto bound_leaf = [&](const SphereTreeNode& node, std::size_t count) noexcept {
+    for (std::size_t k = 0; k < count; ++k) {
+      const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
+      const double r = slots[slot][3] + settings.contact_skin_m;
+      const double spare = memory.grid_floor_m(slot) - grid_error - r - settings.candidate_margin_m;
+      const double moved_squared = (leaf_body[k] - memory.last_centre_body_m(slot)).squaredNorm();
+      if (spare > 0.0 && spare * spare > lipschitz_squared * moved_squared) {
+        leaf_floor[k] = memory.grid_floor_m(slot) - lipschitz * std::sqrt(moved_squared);
+      } else {
+        leaf_floor[k] = std::numeric_limits<double>::quiet_NaN();
+        if (copy != nullptr) copy->prefetch(leaf_body[k]);
+      }
+    }
   };
   // A leaf whose bound proves every centre outside, with its margin to
   // spare: each sphere would pass the leaf test's first check (grid - error
   // > r + candidate margin) and only be remembered, so it is remembered
-  // without its grid read. The same memory and contacts as testing it.
-  auto remember_leaf = [&](const SphereTreeNode& node) noexcept {
+  // without its grid read (and its cells are not prefetched: lines nobody
+  // reads only evict others). The same memory and contacts as testing it.
+  // The floor it leaves: the grid at a sphere is at least the bound + r +
+  // candidate margin (|c - middle| + r <= reach, the bound's derivation).
+  auto remember_leaf = [&](const SphereTreeNode& node, double bound) noexcept {
     const std::size_t count = load_leaf(node);
     for (std::size_t k = 0; k < count; ++k) {
-      memory.remember(static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k), leaf_body[k], query);
+      const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
+      const double r = slots[slot][3] + settings.contact_skin_m;
+      memory.remember(slot, leaf_body[k], query, bound + r + settings.candidate_margin_m);
     }
     stats.spheres_remembered += static_cast<std::uint32_t>(count);
   };
   auto test_leaf = [&](const SphereTreeNode& node) noexcept {
+    // The floors are read before any grid cell can be asked for: their lines
+    // are asked for at once, so a cold leaf waits on memory once, not once
+    // per line. (The stack walk asked for them already, when the leaf
+    // passed its bound; asking before the bound was read was slower: most
+    // leaves whose bound is read are pruned.)
+    memory.prefetch_leaf(static_cast<std::uint32_t>(node.first), static_cast<std::uint32_t>(node.count));
     const std::size_t count = load_leaf(node);
+    bound_leaf(node, count);
     for (std::size_t k = 0; k < count; ++k) {
       const std::uint32_t sphere = order[static_cast<std::size_t>(node.first) + k];
       // The memory is kept by slot (leaf order): read in sequence, not at random.
       const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
       const Eigen::Vector3d& p = leaf_body[k];
       const double r = slots[slot][3] + settings.contact_skin_m;
+      if (!std::isnan(leaf_floor[k])) {
+        // The read would find grid - error > r + margin: remembered, as then.
+        memory.remember(slot, p, query, leaf_floor[k]);
+        ++stats.spheres_bounded;
+        continue;
+      }
       ++stats.spheres_tested;
-      // With a FieldGrid and the grid narrow phase one read gives the value
-      // and, only for the spheres that reach the narrow phase, the gradient.
-      const bool one_read = copy != nullptr && !settings.exact_narrow_phase;
       FieldGrid::Read cell;
       if (one_read) cell = copy->read(p);
       const double grid = one_read ? cell.value : field.distance(p);
       if (grid - grid_error > r + settings.candidate_margin_m) {
-        if (grid - grid_error > 0.0) memory.remember(slot, p, query);
+        if (grid - grid_error > 0.0) memory.remember(slot, p, query, grid);
         continue;
       }
       // The grid narrow phase's distance is this read: with the centre
@@ -278,17 +348,34 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       // narrow phase would only remember the centre and report nothing. Its
       // normal (a square root and three divisions) is not worked out for that.
       if (!settings.exact_narrow_phase && grid > 0.0 && !(r - grid > -settings.candidate_margin_m)) {
-        memory.remember(slot, p, query);
+        memory.remember(slot, p, query, grid);
         continue;
       }
       ++stats.exact_queries;
+      if (defer && grid > 0.0) {
+        // Outside and within the candidate margin (the test above): the
+        // narrow phase's depth is r - grid; the rest waits for
+        // complete_deferred(), which only the kept contacts reach.
+        memory.remember(slot, p, query, grid);
+        ++stats.contacts;
+        SphereContact contact;
+        contact.sphere_id = sphere;
+        contact.body_id = body.id;
+        contact.depth_m = r - grid;
+        contact.candidate = contact.depth_m <= 0.0;
+        contact.deferred = true;
+        contact.slot = slot;
+        if (!out.push(contact)) stats.overflowed = true;
+        note_depth(contact.depth_m);
+        continue;
+      }
       Eigen::Vector3d last_nearest;
       // Only the exact search uses the hint: the grid narrow phase does not read it.
       const Eigen::Vector3d* hint =
           settings.exact_narrow_phase && memory.recall_nearest(slot, last_nearest) ? &last_nearest : nullptr;
       const geometry::SdfSample s =
           one_read ? from_gradient(p, grid, copy->gradient(cell)) : sample(field, p, grid, settings, hint);
-      if (s.distance_m > 0.0) memory.remember(slot, p, query);
+      if (s.distance_m > 0.0) memory.remember(slot, p, query, grid);
       if (s.exact) memory.remember_nearest(slot, s.closest_point_m);
       Eigen::Vector3d q, n;
       double depth = 0.0;
@@ -306,47 +393,72 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       contact.depth_m = depth;
       contact.normal_without_history = no_history;
       contact.candidate = depth <= 0.0;
-      // The surface point and its depth behind the body's tangent plane at
-      // the contact (NaN x: no anchor): no field read, and the side is the
-      // pre-penetration normal's, so a point pushed past a thin plate's
-      // mid-plane is still measured from the face it came through.
-      const Eigen::Vector3d& anchor = slot_anchors[slot];
-      if (probe && !std::isnan(anchor.x())) {
-        const auto& face = slot_faces[slot];
-        contact.surface_point_m =
-            face_probe ? geometry::closest_point_on_triangle(contact.point_m, face[0], face[1], face[2]).point : anchor;
-        contact.surface_depth_m = (contact.point_m - contact.surface_point_m).dot(contact.normal);
-        contact.has_surface = true;
-      }
+      contact.slot = slot;
+      probe_surface(tree, slot, settings.surface_probe, contact);
       if (!out.push(contact)) stats.overflowed = true;
       note_depth(depth);
     }
   };
 
   if (keep == 0) {
-    std::array<std::int32_t, SphereTree::kMaxDepth + 1> stack{};
+    // A node's bound is worked out when its parent passes, both children's
+    // at once: their grid cells are asked for together, and a child that
+    // passes has its own children's boxes (or, a leaf, its spheres and
+    // memory) asked for when it is pushed, long before it is popped. On a
+    // cold cache the walk otherwise waits on a box, then on its grid cell,
+    // node after node. The nodes that pass are popped in the same order
+    // (right child first) as when each bound was read at its pop.
+    struct Pending {
+      std::int32_t node;
+      double bound_m;
+    };
+    std::array<Pending, SphereTree::kMaxDepth + 1> stack{};
     int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const SphereTreeNode& node = nodes[stack[--top]];
-      ++stats.nodes_visited;
-      const double bound = node_bound(node);
-      if (!(bound <= settings.approach_margin_m)) {  // NaN-safe: a NaN pose touches nothing
-        if (&node == &nodes[0]) stats.body_skipped = true;
-        continue;
-      }
+    auto passes = [&](double bound) noexcept { return bound <= settings.approach_margin_m; };  // NaN: pruned
+    auto push = [&](std::int32_t index, double bound) noexcept {
+      const SphereTreeNode& node = nodes[static_cast<std::size_t>(index)];
       if (node.count == 0) {
-        // Both children share two lines; the right one is read next.
+        // Both children share two lines.
         __builtin_prefetch(&nodes[static_cast<std::size_t>(node.first)]);
         __builtin_prefetch(&nodes[static_cast<std::size_t>(node.first) + 1]);
-        stack[top++] = node.first;
-        stack[top++] = node.first + 1;
+      } else {
+        const auto first = static_cast<std::size_t>(node.first);
+        const std::size_t end = std::min(slots.size(), first + static_cast<std::size_t>(node.count));
+        for (std::size_t slot = first; slot < end; slot += 2) __builtin_prefetch(&slots[slot]);
+        memory.prefetch_leaf(static_cast<std::uint32_t>(node.first), static_cast<std::uint32_t>(node.count));
+      }
+      stack[top++] = {index, bound};
+    };
+    ++stats.nodes_visited;
+    const double root_bound = node_bound(nodes[0]);
+    if (!passes(root_bound)) {
+      stats.body_skipped = true;
+      return stats;
+    }
+    push(0, root_bound);
+    while (top > 0) {
+      const Pending next = stack[--top];
+      const SphereTreeNode& node = nodes[static_cast<std::size_t>(next.node)];
+      if (node.count == 0) {
+        const SphereTreeNode& left = nodes[static_cast<std::size_t>(node.first)];
+        const SphereTreeNode& right = nodes[static_cast<std::size_t>(node.first) + 1];
+        const Eigen::Vector3d left_middle = node_middle(left);
+        const Eigen::Vector3d right_middle = node_middle(right);
+        if (copy != nullptr) {
+          copy->prefetch(left_middle);
+          copy->prefetch(right_middle);
+        }
+        const double left_bound = bound_at(left, left_middle);
+        const double right_bound = bound_at(right, right_middle);
+        stats.nodes_visited += 2;
+        if (passes(left_bound)) push(node.first, left_bound);
+        if (passes(right_bound)) push(node.first + 1, right_bound);
         continue;
       }
       // bound - error > 0: every centre is outside by more than its radius,
       // the skin and the candidate margin plus the sphere test's own error.
-      if (bound - grid_error > kDecisionSlackM) {
-        remember_leaf(node);
+      if (next.bound_m - grid_error > kDecisionSlackM) {
+        remember_leaf(node, next.bound_m);
       } else {
         test_leaf(node);
       }
@@ -395,6 +507,32 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     test_leaf(node);
   }
   return stats;
+}
+
+void complete_deferred(const SphereTree& tree, const RigidBody& body, const QuerySettings& settings,
+                       ContactBuffer& contacts, const std::uint32_t* indices, std::size_t count) noexcept {
+  if (body.grid == nullptr || body.grid->empty()) return;  // the query defers nothing without one
+  const FieldGrid& copy = *body.grid;
+  // The query's own frame and reads, step for step: the same numbers.
+  const Eigen::Isometry3d body_from_world = body.world_from_body.inverse();
+  const Frame frame{body_from_world.linear(), body_from_world.translation()};
+  const Eigen::Matrix3d world_rotation = body.world_from_body.linear();
+  const auto& slots = tree.slot_spheres();
+  for (std::size_t i = 0; i < count; ++i) {
+    SphereContact& contact = contacts[indices[i]];
+    if (!contact.deferred || contact.slot >= slots.size()) continue;
+    const Eigen::Vector4d& sphere = slots[contact.slot];
+    const Eigen::Vector3d p = frame.to_body(sphere.head<3>());
+    const FieldGrid::Read cell = copy.read(p);
+    const geometry::SdfSample s = from_gradient(p, cell.value, copy.gradient(cell));
+    Eigen::Vector3d q, n;
+    double depth = 0.0;
+    outside_contact(p, sphere[3] + settings.contact_skin_m, s, q, n, depth);
+    contact.point_m = body.world_from_body * q;
+    contact.normal = world_rotation * n;
+    contact.deferred = false;
+    probe_surface(tree, contact.slot, settings.surface_probe, contact);
+  }
 }
 
 }  // namespace fahr::haptic

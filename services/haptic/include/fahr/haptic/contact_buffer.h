@@ -47,6 +47,12 @@ struct SphereContact {
   // False for a sphere without an anchor (FillSettings::anchor_gap_m):
   // use depth_m.
   bool has_surface = false;
+  // True: only sphere_id, body_id, slot, depth_m and candidate are set yet
+  // (QuerySettings::defer_outside_contacts); complete_deferred() works out the
+  // rest for the contacts the caller keeps.
+  bool deferred = false;
+  // The sphere's slot in SphereTree::order() (where the query read it).
+  std::uint32_t slot = 0;
 };
 
 class ContactBuffer {
@@ -70,6 +76,8 @@ class ContactBuffer {
   std::size_t capacity() const { return contacts_.size(); }
   bool overflowed() const { return overflowed_; }
   const SphereContact& operator[](std::size_t i) const { return contacts_[i]; }
+  // complete_deferred() fills in the contacts a caller keeps.
+  SphereContact& operator[](std::size_t i) { return contacts_[i]; }
   const SphereContact* begin() const { return contacts_.data(); }
   const SphereContact* end() const { return contacts_.data() + size_; }
 

@@ -17,7 +17,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "fahr/haptic/contact_buffer.h"
@@ -84,6 +86,16 @@ struct QuerySettings {
   // which then skip a face read and a closest point per reported sphere.
   enum class SurfaceProbe : std::uint8_t { kAnchor, kFacePoint, kNone };
   SurfaceProbe surface_probe = SurfaceProbe::kFacePoint;
+  // Grid narrow phase with a FieldGrid only (else ignored): a contact whose
+  // centre is outside the body is reported with its depth (r - grid, the
+  // value the leaf test read) and flagged SphereContact::deferred; its
+  // point, normal and surface point are worked out by complete_deferred()
+  // for the contacts the caller keeps, the same numbers bit for bit. The
+  // haptic tick keeps the 64 deepest of ~540 (a pressed blade with 1 mm
+  // candidates), so most contacts need no gradient, normal or transform.
+  // Contacts whose centre is inside are always complete: their depth comes
+  // from the pre-penetration centre's own grid read.
+  bool defer_outside_contacts = false;
 };
 
 // Most contacts QuerySettings::deepest_only can ask for.
@@ -94,9 +106,9 @@ inline constexpr std::size_t kMaxDeepest = 256;
 // in SphereTree::order(), not its id: the query visits spheres leaf by leaf,
 // so memory kept by id (in separate arrays) cost cache misses at random
 // (tools/aist_bench/README.md). A memory therefore belongs to one tree. The
-// centre and its query index, which every visited sphere writes, take 32
-// bytes, two spheres a cache line (a leaf's four in two lines); the nearest
-// point, which only the exact narrow phase reads, is kept apart.
+// centre, its query index and a floor of the grid there, which every
+// visited sphere writes, take 32 bytes, two spheres a cache line; the
+// nearest point, which only the exact narrow phase reads, is kept apart.
 class PrePenetrationMemory {
  public:
   PrePenetrationMemory() = default;
@@ -104,17 +116,44 @@ class PrePenetrationMemory {
       : slots_(sphere_count), nearest_(sphere_count) {
     frontier_.reserve(2 * sphere_count + 2);
   }
-  void remember(std::uint32_t slot, const Eigen::Vector3d& centre_body_m, std::uint64_t query) noexcept {
+  // grid_floor_m: a lower bound of the grid's value at the centre (the value
+  // read there, or what a bound proved without the read), m. The next query
+  // reads no grid for a sphere whose floor, less the grid's Lipschitz bound
+  // times how far the sphere has moved in the body frame since, still puts
+  // it beyond its margins (the body moves ~0.1 mm a tick, the spheres only
+  // when a FEM state arrives). Stored in single precision, rounded down.
+  void remember(std::uint32_t slot, const Eigen::Vector3d& centre_body_m, std::uint64_t query,
+                double grid_floor_m) noexcept {
     slots_[slot].centre_body_m = centre_body_m;
-    slots_[slot].query_index = query;
+    slots_[slot].query_index = static_cast<std::uint32_t>(query);
+    // Floors above kFloorCapM say no more than the cap (a floor may be
+    // lower than the truth), and below it a float's rounding is under
+    // kFloorRoundingM, taken off first so the stored floor never exceeds it.
+    slots_[slot].grid_floor_m = static_cast<float>(std::min(grid_floor_m, kFloorCapM) - kFloorRoundingM);
   }
   // True and the centre when remembered within max_age queries of `query`.
+  // The index is kept modulo 2^32 (next_query() skips 0): at 1 kHz a
+  // memory older than 49 days could pass for a recent one.
   bool recall(std::uint32_t slot, std::uint64_t query, std::uint64_t max_age,
               Eigen::Vector3d& centre_body_m) const noexcept {
-    const std::uint64_t when = slots_[slot].query_index;
-    if (when == 0 || query - when > max_age) return false;
+    const std::uint32_t when = slots_[slot].query_index;
+    if (when == 0 || static_cast<std::uint32_t>(static_cast<std::uint32_t>(query) - when) > max_age) return false;
     centre_body_m = slots_[slot].centre_body_m;
     return true;
+  }
+  // The centre last remembered (any age; zero if never) and the floor of the
+  // grid there (-inf if never), m.
+  const Eigen::Vector3d& last_centre_body_m(std::uint32_t slot) const noexcept { return slots_[slot].centre_body_m; }
+  double grid_floor_m(std::uint32_t slot) const noexcept { return slots_[slot].grid_floor_m; }
+  // Drops every floor (the next query reads every sphere it tests): for a
+  // body whose grid changed, and for tests that compare with and without.
+  void forget_grid_floors() noexcept {
+    for (Slot& s : slots_) s.grid_floor_m = -std::numeric_limits<float>::infinity();
+  }
+  // Asks the cache for the lines of `count` slots from `first` (no value changes).
+  void prefetch_leaf(std::uint32_t first, std::uint32_t count) const noexcept {
+    const std::size_t end = std::min<std::size_t>(slots_.size(), std::size_t{first} + count);
+    for (std::size_t slot = first; slot < end; slot += 2) __builtin_prefetch(&slots_[slot]);
   }
   // The last nearest surface point found for a slot's sphere, body frame. Any point
   // of the rigid surface bounds the distance from above, however old, so the
@@ -130,7 +169,11 @@ class PrePenetrationMemory {
     return true;
   }
   std::size_t size() const { return slots_.size(); }
-  std::uint64_t next_query() noexcept { return ++queries_; }  // 1-based, 0 = never
+  // 1-based; an index whose low 32 bits are 0 (never, in a slot) is skipped.
+  std::uint64_t next_query() noexcept {
+    if (static_cast<std::uint32_t>(++queries_) == 0) ++queries_;
+    return queries_;
+  }
 
   // Workspace of the deepest-first walk: subtrees to visit, keyed by their
   // distance bound. Sized at construction for any tree over these spheres
@@ -142,9 +185,13 @@ class PrePenetrationMemory {
   std::vector<Frontier>& frontier() noexcept { return frontier_; }
 
  private:
+  static constexpr double kFloorCapM = 1.0;
+  // > the rounding of a float below kFloorCapM (2^-24 m).
+  static constexpr double kFloorRoundingM = 1e-7;
   struct alignas(32) Slot {
     Eigen::Vector3d centre_body_m = Eigen::Vector3d::Zero();
-    std::uint64_t query_index = 0;
+    std::uint32_t query_index = 0;  // low 32 bits, 0 never
+    float grid_floor_m = -std::numeric_limits<float>::infinity();
   };
   struct Nearest {
     Eigen::Vector3d point_body_m = Eigen::Vector3d::Zero();
@@ -162,6 +209,10 @@ struct QueryStats {
   // Remembered outside without a test: their leaf's bound proved every
   // centre outside and no sphere of it within the candidate margin.
   std::uint32_t spheres_remembered = 0;
+  // Remembered outside without a grid read: the floor their memory kept,
+  // less how far they moved since, proved them beyond the candidate margin
+  // (PrePenetrationMemory::remember). Not counted in spheres_tested.
+  std::uint32_t spheres_bounded = 0;
   std::uint32_t exact_queries = 0;    // reached the narrow phase (exact or grid)
   std::uint32_t contacts = 0;         // found (including those a full buffer dropped)
   bool body_skipped = false;          // the root could not touch the body
@@ -174,5 +225,13 @@ struct QueryStats {
 QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const RigidBody& body,
                          const QuerySettings& settings, PrePenetrationMemory& memory,
                          ContactBuffer& out) noexcept;
+
+// Completes the deferred contacts among contacts[indices[i]], i < count
+// (QuerySettings::defer_outside_contacts; complete ones are left alone):
+// point, normal and, with a surface probe, the surface point, as the query
+// would have given them. `tree`, `body` and `settings` must be the query's,
+// the tree not refitted since. Allocation-free.
+void complete_deferred(const SphereTree& tree, const RigidBody& body, const QuerySettings& settings,
+                       ContactBuffer& contacts, const std::uint32_t* indices, std::size_t count) noexcept;
 
 }  // namespace fahr::haptic
