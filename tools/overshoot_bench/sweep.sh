@@ -39,7 +39,7 @@ for config in "${configs[@]}"; do
   echo "| $((youngs / 1000)) | $support | $stops | $stiffening | $(field "most inverted tets" "$file") |" \
        "$(field "largest reaction / limit while lost track" "$file") | $(field "lost-track ticks" "$file") |" \
        "$(field "max Green strain at 1x / at the end of the hold" "$file") |" \
-       "$(field "largest published-gap error mm" "$file") |" \
+       "$(field "largest published-gap error mm (lost-track ticks at the peak limit)" "$file") |" \
        "$(field "largest force step in 50 ms of re-engagement N (bound)" "$file") |" \
        "$(field "tongue displacement 1 s after the blade left mm" "$file") | $verdict |"
 done

@@ -167,6 +167,7 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     }
     if (!release) {
       solver_.solve_pinned(zero, settings_.pgs);
+      if (!settings_.force_aware.hold_within_limit) return zero;
       const Eigen::Vector3d back = yield_to_limit(zero, limit);
       if (back != zero) capture_holds(input.compliance);
       return back;
@@ -323,7 +324,8 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   // its yield tolerance and the one-tick lag), and the constraints stay.
   const double solved_reaction = solver_.resultant(RowKind::kTissue).norm();
   tissue_force_scale_ = 1.0;
-  if (settings_.mode != ResponseMode::kNaive && solved_reaction > kWedgeBand * device.renderable_force_n) {
+  if (settings_.mode != ResponseMode::kNaive && settings_.force_aware.hold_within_limit &&
+      solved_reaction > kWedgeBand * device.renderable_force_n) {
     tissue_force_scale_ = device.renderable_force_n / solved_reaction;
     report_.tissue_force_clamped = true;
   }

@@ -26,6 +26,11 @@ struct ForceAwareSettings {
   // motion causes: 0.05 m/s x 400 N/m x 1 ms = 0.02 N per tick, 20 N/s,
   // below the ~ 50 N/s at which a force step is felt as a click.
   double catch_up_speed_mps = 0.05;
+  // false: a diagnostic, not a response: a held proxy never backs off and
+  // the tissue gets whatever the pinned solve asks, unclamped, so a bench
+  // can see whether the frozen hold is steady by itself (with a rigid tool
+  // held still the tissue's reaction should settle, not grow).
+  bool hold_within_limit = true;
 };
 
 // Tissue reaction past the limit: freeze.
