@@ -252,6 +252,7 @@ struct RunChoices {
   std::string tool_stops = "scene";
   std::string spread = "service";
   std::string held_proxy = "limit";
+  bool fem_tool_obstacle = false;
   std::string trace_path;
   std::string tick_trace_path;
 };
@@ -284,6 +285,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   options.fem_anatomy = choices.fem_anatomy;
   if (choices.support_ratio >= 0.0) options.fem_support_ratio = choices.support_ratio;
   options.hold_within_limit = choices.held_proxy == "limit";
+  options.fem_tool_obstacle = choices.fem_tool_obstacle;
   if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
   if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
   stack_sim::StackSim sim(variant, options);
@@ -477,6 +479,9 @@ int main(int argc, char** argv) {
                  "while the device has lost track: limit (the response: back off to keep the tissue within the "
                  "limit) or fixed (a diagnostic: never back off, tissue forces unclamped)")
       ->check(CLI::IsMember({"limit", "fixed"}));
+  app.add_flag("--fem-tool-obstacle", choices.fem_tool_obstacle,
+               "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose, not only the "
+               "ContactSet's spheres (services/fem contact_step.h set_tool_obstacle)");
   app.add_flag("--check", check, "exit 1 unless the force-aware run meets the targets");
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);

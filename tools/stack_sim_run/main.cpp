@@ -45,6 +45,9 @@ int main(int argc, char** argv) {
   app.add_option("--stiffening", stiffening,
                  "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
       ->check(CLI::Range(0.0, 100.0));
+  bool fem_tool_obstacle = false;
+  app.add_flag("--fem-tool-obstacle", fem_tool_obstacle,
+               "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose");
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -53,6 +56,7 @@ int main(int argc, char** argv) {
     options.script = script == "overshoot" ? device::Script::kOvershoot : device::Script::kIntubation;
     options.fem_anatomy = fem_anatomy == "on";
     if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
+    options.fem_tool_obstacle = fem_tool_obstacle;
     options.collision =
         collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;
     auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));

@@ -69,6 +69,22 @@ void ContactStep::set_obstacles(std::span<const ObstacleField* const> fields,
   body_.set_supports({}, 0.0);
 }
 
+void ContactStep::set_tool_obstacle(const ObstacleField* field) {
+  tool_field_ = field;
+  if (field == nullptr) {
+    tool_pass_.reset();
+    return;
+  }
+  // No margin: the spheres' projection already clears r from the tool; the
+  // nodes need only be out of it.
+  ObstacleProjectionSettings settings;
+  settings.margin_m = 0.0;
+  settings.support_stiffness_ratio = 0.0;
+  tool_pass_ = std::make_unique<ObstacleProjection>(std::span<const ObstacleField* const>(&tool_field_, 1),
+                                                    body_.node_count(), settings);
+  tool_start_.assign(3 * body_.node_count(), 0.0);
+}
+
 bool ContactStep::reset() {
   if (obstacles_) obstacles_->forget_clearances();
   if (supports_ && supports_->clear()) body_.set_supports({}, 0.0);
@@ -199,8 +215,9 @@ void ContactStep::update_free_centres() {
 }
 
 // Gauss-Seidel between the tool and the bone: the ContactSet's projection,
-// then the anatomy's pass; again while the anatomy's moves broke a tool
-// constraint, up to the round limit. The anatomy always has the last word.
+// the tool obstacle's pass (if set), then the anatomy's pass; again while
+// the anatomy's moves broke a tool constraint, up to the round limit. The
+// anatomy always has the last word.
 void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
   const auto inverse_mass = body_.inverse_mass_per_kg();
   const bool tool = contacts != nullptr && !contacts->contacts.empty();
@@ -208,6 +225,18 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
   ProjectionReport anatomy;
   int sweeps = 0;
   if (obstacles_) obstacles_->begin_step();
+  int tool_nodes = 0;
+  if (tool_pass_) {
+    // The tool moved since the last step: no clearance from then holds, and
+    // each node's path is taken relative to the tool.
+    tool_pass_->begin_step();
+    tool_pass_->forget_clearances();
+    for (std::size_t n = 0; n < body_.node_count(); ++n) {
+      const Eigen::Vector3d start(start_positions_[3 * n], start_positions_[3 * n + 1], start_positions_[3 * n + 2]);
+      const Eigen::Vector3d carried = tool_motion_ * start;
+      for (std::size_t d = 0; d < 3; ++d) tool_start_[3 * n + d] = carried[static_cast<Eigen::Index>(d)];
+    }
+  }
   for (int round = 0; round < rounds; ++round) {
     if (tool) {
       projection_ = project_contacts(*contacts, links_, inverse_mass, projection_settings_, projected_);
@@ -215,11 +244,17 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
       // The anatomy's last pass moved nothing the tool constraints needed.
       if (round > 0 && projection_.sweeps <= 1 && projection_.converged) break;
     }
+    if (tool_pass_) {
+      ProjectionReport tool_report;
+      tool_pass_->project(projected_, inverse_mass, tool_report, tool_start_);
+      tool_nodes += tool_report.obstacle_nodes;
+    }
     if (!obstacles_) break;
     ++anatomy.obstacle_rounds;
     if (obstacles_->project(projected_, inverse_mass, anatomy, start_positions_) == 0 || !tool) break;
   }
   projection_.sweeps = sweeps;
+  projection_.tool_nodes = tool_nodes;
   projection_.obstacle_rounds = anatomy.obstacle_rounds;
   projection_.obstacle_nodes = anatomy.obstacle_nodes;
   projection_.obstacle_unresolved = anatomy.obstacle_unresolved;
@@ -255,7 +290,7 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   update_compliance(report.refactorised);
   update_free_centres();
   projection_ = {};
-  if (obstacles_ || (contacts != nullptr && !contacts->contacts.empty())) project(contacts);
+  if (obstacles_ || tool_pass_ || (contacts != nullptr && !contacts->contacts.empty())) project(contacts);
   if (supports_ && supports_->update(*obstacles_, start_positions_, free_positions_)) {
     body_.set_supports(supports_->supports(), obstacles_->settings().support_stiffness_ratio);
   }

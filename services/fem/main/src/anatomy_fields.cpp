@@ -18,6 +18,11 @@ AnatomyField::AnatomyField(std::unique_ptr<runtime::RigidField> field)
       world_from_body_rotation_(field_->world_from_body().linear()),
       far_error_m_(kCellDiagonal * field_->sdf->cell_size_m()) {}
 
+void AnatomyField::set_world_from_body(const Eigen::Isometry3d& world_from_body) {
+  body_from_world_ = world_from_body.inverse();
+  world_from_body_rotation_ = world_from_body.linear();
+}
+
 fem::ObstacleSample AnatomyField::sample(const Eigen::Vector3d& p_m) const noexcept {
   fem::ObstacleSample out;
   if (!p_m.allFinite()) {

@@ -54,6 +54,7 @@ struct ProjectionReport {
   int obstacle_non_finite = 0;     // nodes with a non-finite position or sample, left alone
   double obstacle_deepest_m = 0.0; // deepest node inside an obstacle before its move, m (>= 0)
   int obstacle_supported = 0;      // nodes held by a support spring from the next step on (obstacle_support.h)
+  int tool_nodes = 0;              // node moves out of the tool obstacle (ContactStep::set_tool_obstacle)
 };
 
 // Whether the contact is projected, and how. Obstacles are always hard: a

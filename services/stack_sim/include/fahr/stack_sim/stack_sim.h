@@ -22,6 +22,7 @@
 #include "fahr/device/servo_core.h"
 #include "fahr/device/simulated_backend.h"
 #include "fahr/device/trajectory.h"
+#include "fahr/fem_service/anatomy_fields.h"
 #include "fahr/fem_service/fem_body_setup.h"
 #include "fahr/fem_service/service_step.h"
 #include "fahr/scene/scene.h"
@@ -51,6 +52,10 @@ struct StackOptions {
   // proxy held while the device has lost track never backs off and the
   // tissue gets the pinned solve's forces unclamped.
   bool hold_within_limit = true;
+  // Experimental: the FEM keeps the whole tongue out of the tool at the
+  // proxy's pose (fem_service::ServiceStep::set_tool_obstacle), not only the
+  // ContactSet's spheres. In process only: the DDS services lack the pose.
+  bool fem_tool_obstacle = false;
 };
 
 class StackSim {
@@ -109,6 +114,10 @@ class StackSim {
   std::unique_ptr<device::ServoCore> gateway_;
 
   haptic_service::HapticSetup haptic_setup_;
+  // The tool's field for the FEM, moved to the proxy each FEM step (null
+  // unless StackOptions::fem_tool_obstacle).
+  std::unique_ptr<fem_service::AnatomyField> tool_obstacle_;
+  Eigen::Isometry3d world_from_tool_at_last_step_ = Eigen::Isometry3d::Identity();
   std::unique_ptr<haptic_service::HapticLoop> haptic_;
   std::unique_ptr<haptic_service::TissueDigest> digest_;
   haptic_service::TissueSnapshot tissue_;

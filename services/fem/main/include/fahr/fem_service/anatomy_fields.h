@@ -1,7 +1,8 @@
 // The scene's rigid anatomy as the FEM body sees it: each obstacle the body
 // is held out of (the scene plan's hard pairs) as a fem::ObstacleField over
 // the same signed distance field the haptic service builds (services/runtime),
-// so the FEM keeps its own nodes out of bone in every step.
+// so the FEM keeps its own nodes out of bone in every step. The same adapter,
+// moved each step, gives the tool as an obstacle (ContactStep::set_tool_obstacle).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -24,6 +25,9 @@ class AnatomyField final : public fem::ObstacleField {
   fem::ObstacleSample sample(const Eigen::Vector3d& p_m) const noexcept override;
 
   const runtime::RigidField& field() const { return *field_; }
+  // Moves the body (the tool, which follows the haptic side's proxy; the
+  // anatomy never moves). Not thread-safe against sample().
+  void set_world_from_body(const Eigen::Isometry3d& world_from_body);
 
  private:
   std::unique_ptr<runtime::RigidField> field_;

@@ -38,6 +38,13 @@ class ServiceStep {
   const msg::DeformationState& state() const { return state_; }
   const fem::StepReport& last_report() const { return last_report_; }
   const fem::ContactStep& contact_step() const { return contact_step_; }
+  // Experimental, in-process only (stack_sim): the tool as an obstacle the
+  // whole body is kept out of (fem::ContactStep::set_tool_obstacle); the
+  // caller moves `field` to the proxy before each step. Over DDS the FEM
+  // service does not know the tool's pose yet (the ContactSet would have to
+  // carry it). Allocates: call at set-up.
+  void set_tool_obstacle(const fem::ObstacleField* field) { contact_step_.set_tool_obstacle(field); }
+  void set_tool_motion(const Eigen::Isometry3d& new_from_old) { contact_step_.set_tool_motion(new_from_old); }
   const FemBodySetup& setup() const { return setup_; }
   std::uint64_t stale_sets() const { return stale_sets_; }
   std::uint64_t inverted_max() const { return inverted_max_; }
