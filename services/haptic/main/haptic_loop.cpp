@@ -295,6 +295,10 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
     contacts.tool_frozen(response_.tool_frozen());
     fill_contacts(response_.contacts(), tool_body_.id, tissue.tissue_obstacle_body_ids(), contacts);
   }
+  // Where the FEM finds the tool: the proxy after this tick (the penalty
+  // baseline's tool is the device).
+  put(setup_.penalty ? device.position_m : response_.proxy().position_m, contacts.world_from_tool().position_m());
+  put(device.orientation, contacts.world_from_tool().orientation());
   contacts.header().sim_step(pose.servo_tick());
   contacts.header().sim_time_ns(pose.header().sim_time_ns());
   ++tick_;

@@ -46,13 +46,8 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   fem_setup_.enforce_anatomy = options.fem_anatomy;
   if (options.fem_support_ratio) fem_setup_.anatomy_settings.support_stiffness_ratio = *options.fem_support_ratio;
   if (options.sphere_spread) fem_setup_.sphere_spread = *options.sphere_spread;
+  if (options.fem_tool_obstacle) fem_setup_.tool = fem_service::load_tool_field(*scene_);
   fem_ = std::make_unique<fem_service::ServiceStep>(fem_setup_);
-  if (options.fem_tool_obstacle) {
-    tool_obstacle_ = std::make_unique<fem_service::AnatomyField>(
-        runtime::load_rigid_field(*haptic_setup_.tool->scene_body));
-    fem_->set_tool_obstacle(tool_obstacle_.get());
-    world_from_tool_at_last_step_ = tool_obstacle_->field().world_from_body();
-  }
   contacts_.contacts().reserve(msg::MAX_CONTACTS);
   next_contacts_.contacts().reserve(msg::MAX_CONTACTS);
   contacts_.body_id(haptic_setup_.deformable->id);
@@ -97,17 +92,6 @@ void StackSim::step() {
   fem_stepped_ = common::executes_at(k, fem_period_);
   if (fem_stepped_) {
     if (k > 0) fem_->take(contacts_, contacts_.header().seq());
-    if (tool_obstacle_ && k > 0) {
-      // Where the haptic tick of those contacts left the tool.
-      const msg::Pose& proxy = command_.world_from_proxy();
-      const Eigen::Quaterniond orientation(proxy.orientation().w(), proxy.orientation().x(),
-                                           proxy.orientation().y(), proxy.orientation().z());
-      const Eigen::Isometry3d world_from_tool =
-          Eigen::Translation3d(proxy.position_m().x(), proxy.position_m().y(), proxy.position_m().z()) * orientation;
-      tool_obstacle_->set_world_from_body(world_from_tool);
-      fem_->set_tool_motion(world_from_tool * world_from_tool_at_last_step_.inverse());
-      world_from_tool_at_last_step_ = world_from_tool;
-    }
     const std::int64_t cpu0 = common::thread_cpu_now_ns();
     fem_->step();
     last_fem_step_cpu_ = std::chrono::nanoseconds(common::thread_cpu_now_ns() - cpu0);

@@ -36,6 +36,12 @@ fem::ObstacleSample AnatomyField::sample(const Eigen::Vector3d& p_m) const noexc
   return out;
 }
 
+std::unique_ptr<AnatomyField> load_tool_field(const scene::Scene& scene) {
+  const auto tool = scene.tool_index();
+  if (!tool) return nullptr;
+  return std::make_unique<AnatomyField>(runtime::load_rigid_field(scene.bodies[*tool]));
+}
+
 std::vector<std::unique_ptr<AnatomyField>> load_anatomy_fields(const scene::Scene& scene,
                                                                const scene::Body& deformable) {
   const auto index = static_cast<std::size_t>(&deformable - scene.bodies.data());

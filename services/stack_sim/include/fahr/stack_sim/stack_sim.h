@@ -53,8 +53,8 @@ struct StackOptions {
   // tissue gets the pinned solve's forces unclamped.
   bool hold_within_limit = true;
   // Experimental: the FEM keeps the whole tongue out of the tool at the
-  // proxy's pose (fem_service::ServiceStep::set_tool_obstacle), not only the
-  // ContactSet's spheres. In process only: the DDS services lack the pose.
+  // ContactSet's tool pose (FemBodySetup::tool), not only the set's spheres;
+  // the FEM service's --tool-obstacle.
   bool fem_tool_obstacle = false;
 };
 
@@ -114,10 +114,6 @@ class StackSim {
   std::unique_ptr<device::ServoCore> gateway_;
 
   haptic_service::HapticSetup haptic_setup_;
-  // The tool's field for the FEM, moved to the proxy each FEM step (null
-  // unless StackOptions::fem_tool_obstacle).
-  std::unique_ptr<fem_service::AnatomyField> tool_obstacle_;
-  Eigen::Isometry3d world_from_tool_at_last_step_ = Eigen::Isometry3d::Identity();
   std::unique_ptr<haptic_service::HapticLoop> haptic_;
   std::unique_ptr<haptic_service::TissueDigest> digest_;
   haptic_service::TissueSnapshot tissue_;

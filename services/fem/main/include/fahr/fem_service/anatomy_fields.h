@@ -36,6 +36,10 @@ class AnatomyField final : public fem::ObstacleField {
   double far_error_m_;  // the grid's error beyond the exact band, m
 };
 
+// The scene's tool as an obstacle field at its scene pose; null when the
+// scene has no tool. Throws std::runtime_error if its field cannot be built.
+std::unique_ptr<AnatomyField> load_tool_field(const scene::Scene& scene);
+
 // Throws std::runtime_error naming the body whose field cannot be built.
 std::vector<std::unique_ptr<AnatomyField>> load_anatomy_fields(const scene::Scene& scene,
                                                                const scene::Body& deformable);

@@ -34,6 +34,11 @@ struct FemBodySetup {
   bool enforce_anatomy = true;
   // How a tool contact's correction moves the sphere's nodes (projection.h).
   fem::SphereSpread sphere_spread = fem::SphereSpread::kMassWeighted;
+  // Experimental (null: off): the tool's field, which the step moves to the
+  // ContactSet's tool pose and keeps the whole body out of
+  // (fem::ContactStep::set_tool_obstacle). Set before the ServiceStep is
+  // made (load_tool_field).
+  std::unique_ptr<AnatomyField> tool;
 };
 
 // Throws std::runtime_error naming the body and what is wrong.

@@ -38,13 +38,7 @@ class ServiceStep {
   const msg::DeformationState& state() const { return state_; }
   const fem::StepReport& last_report() const { return last_report_; }
   const fem::ContactStep& contact_step() const { return contact_step_; }
-  // Experimental, in-process only (stack_sim): the tool as an obstacle the
-  // whole body is kept out of (fem::ContactStep::set_tool_obstacle); the
-  // caller moves `field` to the proxy before each step. Over DDS the FEM
-  // service does not know the tool's pose yet (the ContactSet would have to
-  // carry it). Allocates: call at set-up.
-  void set_tool_obstacle(const fem::ObstacleField* field) { contact_step_.set_tool_obstacle(field); }
-  void set_tool_motion(const Eigen::Isometry3d& new_from_old) { contact_step_.set_tool_motion(new_from_old); }
+
   const FemBodySetup& setup() const { return setup_; }
   std::uint64_t stale_sets() const { return stale_sets_; }
   std::uint64_t inverted_max() const { return inverted_max_; }
@@ -61,6 +55,11 @@ class ServiceStep {
   fem::ContactStep contact_step_;
   fem::ContactSet contacts_;
   bool have_contacts_ = false;
+  // The newest ContactSet's tool pose (setup.tool): where the step puts the
+  // tool obstacle, and where it was at the last step.
+  bool have_tool_pose_ = false;
+  Eigen::Isometry3d world_from_tool_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d world_from_tool_at_last_step_ = Eigen::Isometry3d::Identity();
   std::uint64_t applied_contact_seq_ = 0;
   msg::DeformationState state_;
   fem::StepReport last_report_;
