@@ -253,6 +253,7 @@ struct RunChoices {
   std::string spread = "service";
   std::string held_proxy = "limit";
   bool fem_tool_obstacle = false;
+  std::string row_compliance = "deepest";
   std::string trace_path;
   std::string tick_trace_path;
 };
@@ -286,6 +287,8 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   if (choices.support_ratio >= 0.0) options.fem_support_ratio = choices.support_ratio;
   options.hold_within_limit = choices.held_proxy == "limit";
   options.fem_tool_obstacle = choices.fem_tool_obstacle;
+  options.row_compliance =
+      choices.row_compliance == "keep" ? haptic_service::RowCompliance::kKeep : haptic_service::RowCompliance::kDeepest;
   if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
   if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
   stack_sim::StackSim sim(variant, options);
@@ -310,7 +313,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     std::fprintf(tick_trace,
                  "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,proxy_z,gap_mm,"
                  "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,obstacle_reaction_n,rows,"
-                 "pgs_converged,contacts_found,fem_step,pgs_sweeps\n");
+                 "pgs_converged,contacts_found,fem_step,pgs_sweeps,missing_compliance\n");
   }
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
@@ -343,14 +346,15 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = vec(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
-      std::fprintf(tick_trace, "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,%d,%d,%d,%.4f,%d,%d,%u,%llu,%d\n",
+      std::fprintf(tick_trace, "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d\n",
                    sim.time_s(), c.lost_track() ? 1 : 0, force.norm(), force.x(), force.y(), force.z(),
                    c.tissue_reaction_n(), 1e3 * hand.x(), 1e3 * hand.y(), 1e3 * hand.z(), 1e3 * proxy.x(),
                    1e3 * proxy.y(), 1e3 * proxy.z(), 1e3 * gap.norm(), limit, static_cast<int>(report.state),
                    report.catch_up_limited ? 1 : 0, report.yielded ? 1 : 0, report.implausible_step ? 1 : 0,
                    report.tissue_force_clamped ? 1 : 0, report.obstacle_reaction_n, static_cast<int>(report.load.rows),
                    report.pgs.converged ? 1 : 0, sim.haptic().last_phases().tissue_query.contacts,
-                   static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps);
+                   static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps,
+                   report.load.missing_compliance);
     }
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
     for (const auto& contact : sim.contacts().contacts()) {
@@ -482,6 +486,10 @@ int main(int argc, char** argv) {
   app.add_flag("--fem-tool-obstacle", choices.fem_tool_obstacle,
                "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose, not only the "
                "ContactSet's spheres (services/fem contact_step.h set_tool_obstacle)");
+  app.add_option("--row-compliance", choices.row_compliance,
+                 "experimental: which rows get W when the blade touches more spheres than the FEM sends W for: "
+                 "deepest (as shipped) or keep (services/haptic/main haptic_setup.h RowCompliance)")
+      ->check(CLI::IsMember({"deepest", "keep"}));
   app.add_flag("--check", check, "exit 1 unless the force-aware run meets the targets");
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);

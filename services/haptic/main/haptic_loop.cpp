@@ -120,10 +120,27 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   return d;
 }
 
+// RowCompliance::kKeep (haptic_setup.h): the spheres with W first, then by depth.
+std::size_t HapticLoop::select_compliance_first(const TissueSnapshot& tissue) {
+  const std::size_t n = std::min(tool_contacts_.size(), order_.size());
+  std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
+  if (n <= tissue_row_budget_) return n;
+  const auto has_block = [&](std::uint32_t i) { return tissue.compliance_index[tool_contacts_[i].sphere_id] >= 0; };
+  std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
+                    order_.begin() + static_cast<std::ptrdiff_t>(n), [&](std::uint32_t a, std::uint32_t b) {
+                      const bool wa = has_block(a), wb = has_block(b);
+                      if (wa != wb) return wa;
+                      return tool_contacts_[a].depth_m > tool_contacts_[b].depth_m;
+                    });
+  return tissue_row_budget_;
+}
+
 void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
   // More than W can cover: keep the deepest (touching before candidates),
   // and only those get their point and normal (defer_outside_contacts).
-  const std::size_t keep = haptic::select_deepest(tool_contacts_, tissue_row_budget_, order_);
+  const std::size_t keep = setup_.row_compliance != RowCompliance::kDeepest
+                                ? select_compliance_first(tissue)
+                                : haptic::select_deepest(tool_contacts_, tissue_row_budget_, order_);
   relaxed_add<std::uint64_t>(metrics_.rows_dropped, tool_contacts_.size() - keep);
   haptic::complete_deferred(tissue.tree, tool_body_, tool_query_, tool_contacts_, order_.data(), keep);
   // (The penalty baseline's forces are part of the FEM's step, so it reads

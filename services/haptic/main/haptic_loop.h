@@ -81,6 +81,7 @@ class HapticLoop {
  private:
   contact::DeviceSample device_sample(const msg::DevicePose& pose);
   void collect_tissue_rows(const TissueSnapshot& tissue);
+  std::size_t select_compliance_first(const TissueSnapshot& tissue);
   void collect_triangle_rows(const TissueSnapshot& tissue);
   void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
   const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device, const TissueSnapshot& tissue);

@@ -43,6 +43,15 @@ struct TriangleCollisionSetup {
   std::vector<std::uint32_t> vertex_sphere;      // sphere id of each boundary vertex
 };
 
+// A pressed blade touches ~600 spheres; the solve takes 64 rows and the
+// neonatal scene's FEM sends W (and free centres) for 16 of them. kDeepest:
+// the 64 deepest rows; the others are on the response's fallback compliance
+// and their projected centres, and most rows change each FEM state (after
+// its projection the W spheres are the shallowest). kKeep: the spheres the
+// newest state has W for come first, then the deepest of the rest, so the
+// FEM computes W for the same spheres again.
+enum class RowCompliance { kDeepest, kKeep };
+
 struct HapticSetup {
   const scene::Scene* scene = nullptr;
   const scene::Body* deformable = nullptr;
@@ -67,6 +76,9 @@ struct HapticSetup {
   contact::PenaltySettings penalty_settings;
   CollisionMethod collision = CollisionMethod::kAist;
   std::unique_ptr<TriangleCollisionSetup> triangles;  // set for kTriangle only
+  // Experimental: how rows get W when the tool touches more spheres than
+  // the FEM sends W for (see RowCompliance).
+  RowCompliance row_compliance = RowCompliance::kDeepest;
 };
 
 // Throws std::runtime_error naming the body and what is wrong.
