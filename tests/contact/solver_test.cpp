@@ -87,6 +87,55 @@ TEST(ContactSolver, OneRowBalancesTheCouplingAgainstTheTissue) {
   EXPECT_NEAR(stiffness(0, 0), 0.0, 1e-9);
 }
 
+TEST(TissueCompliance, AlongNormalsReadsAsTheBlocksForTheFemsNormalAndItsOpposite) {
+  // A random symmetric 3x3-block W of 3 spheres; the same W along the FEM's
+  // normals m_t (one column a sphere) gives n_s . W_st n_t exactly for
+  // n_t = +-m_t, and a turned n_t only its part along m_t.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::size_t k = 3;
+  Eigen::MatrixXd b(3 * k, 3 * k);
+  for (Eigen::Index i = 0; i < b.size(); ++i) b.data()[i] = u(rng);
+  const Eigen::MatrixXd w = 1e-3 * b * b.transpose();
+  const std::vector<std::uint32_t> ids = {4, 9, 2};
+  std::vector<float> blocks(9 * k * k), along(3 * k * k), normals(3 * k);
+  std::vector<Eigen::Vector3d> m(k);
+  for (std::size_t t = 0; t < k; ++t) {
+    m[t] = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+    for (std::size_t d = 0; d < 3; ++d) normals[3 * t + d] = static_cast<float>(m[t][static_cast<Eigen::Index>(d)]);
+  }
+  for (std::size_t r = 0; r < 3 * k; ++r) {
+    for (std::size_t c = 0; c < 3 * k; ++c) {
+      blocks[r * 3 * k + c] = static_cast<float>(w(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)));
+    }
+    for (std::size_t t = 0; t < k; ++t) {
+      // Through the float normals, as the FEM's columns are.
+      const Eigen::Vector3d mt(normals[3 * t], normals[3 * t + 1], normals[3 * t + 2]);
+      const Eigen::RowVector3d row = w.block<1, 3>(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(3 * t));
+      along[r * k + t] = static_cast<float>(row.dot(mt.transpose()));
+    }
+  }
+  const TissueCompliance full{1, ids, blocks, {}};
+  const TissueCompliance by_normals{1, ids, along, normals};
+  ASSERT_TRUE(full.valid());
+  ASSERT_TRUE(by_normals.valid());
+  EXPECT_TRUE(by_normals.along_normals());
+  const TissueCompliance short_normals{1, ids, along, {normals.data(), 3 * k - 1}};
+  EXPECT_FALSE(short_normals.valid());
+  for (std::size_t s = 0; s < k; ++s) {
+    for (std::size_t t = 0; t < k; ++t) {
+      const Eigen::Vector3d mt(normals[3 * t], normals[3 * t + 1], normals[3 * t + 2]);
+      for (const double sign : {1.0, -1.0}) {
+        const Eigen::Vector3d n = sign * mt;
+        EXPECT_NEAR(by_normals.normal_compliance(s, m[s], t, n), full.normal_compliance(s, m[s], t, n), 1e-9);
+        EXPECT_LT((by_normals.column(s, t, n) - full.column(s, t, n)).norm(), 1e-9);
+      }
+      const Eigen::Vector3d turned = (mt + 0.05 * mt.unitOrthogonal()).normalized();
+      EXPECT_LT((by_normals.column(s, t, turned) - turned.dot(mt) * full.column(s, t, mt)).norm(), 1e-9);
+    }
+  }
+}
+
 TEST(ContactSolver, LocalStiffnessIsSymmetricAndBoundedByTheCoupling) {
   test::SyntheticPatch patch = test::make_patch(12, 0.002, 0.002, 0.0005);
   // Tilt the normals so the active set spans several directions.

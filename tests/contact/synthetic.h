@@ -14,7 +14,7 @@ struct SyntheticPatch {
   std::vector<std::uint32_t> ids;
   std::vector<float> w;
   std::vector<ContactRow> rows;
-  TissueCompliance compliance() const { return TissueCompliance{7, ids, w}; }
+  TissueCompliance compliance() const { return TissueCompliance{7, ids, w, {}}; }
 };
 
 // n spheres at x = i mm, y = 0, pressed from above by a tool whose face is at

@@ -55,6 +55,43 @@ TEST(Compliance, MatchesTheResponseOfOneStep) {
   }
 }
 
+TEST(Compliance, AlongNormalsIsTheBlocksTimesTheNormals) {
+  // One column a sphere, W_st n_t, is the 3x3 blocks applied to n_t; the
+  // 3x3 blocks' kept columns are not disturbed by it.
+  const TetMesh mesh = test::bar_mesh(2);
+  BodySettings settings;
+  settings.gravity_m_per_s2.setZero();
+  settings.time_step = std::chrono::milliseconds(10);
+  const SphereLinks links = tip_spheres(mesh, 3);
+  const std::vector<std::uint32_t> spheres = {2, 0, 1};
+  const std::vector<Eigen::Vector3d> normals = {Eigen::Vector3d(0.0, 0.6, 0.8), Eigen::Vector3d(-1.0, 0.0, 0.0),
+                                                Eigen::Vector3d(0.0, 0.0, 1.0)};
+  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(body, nullptr);
+  std::vector<float> blocks(81), along(27), again(81);
+  ASSERT_TRUE(body->compliance(spheres, links, blocks));
+  ASSERT_TRUE(body->compliance_along(spheres, normals, links, along));
+  ASSERT_TRUE(body->compliance(spheres, links, again));
+  EXPECT_EQ(blocks, again);
+  double largest = 0.0;
+  for (const float v : along) largest = std::max(largest, double{std::abs(v)});
+  ASSERT_GT(largest, 0.0);
+  for (std::size_t s = 0; s < 3; ++s) {
+    for (std::size_t t = 0; t < 3; ++t) {
+      for (std::size_t d = 0; d < 3; ++d) {
+        double expected = 0.0;
+        for (std::size_t e = 0; e < 3; ++e) {
+          expected += double{blocks[(3 * s + d) * 9 + 3 * t + e]} * normals[t][static_cast<Eigen::Index>(e)];
+        }
+        EXPECT_NEAR(along[(3 * s + d) * 3 + t], expected, 1e-6 * largest) << s << " " << t << " " << d;
+      }
+    }
+  }
+  std::vector<float> short_out(26);
+  EXPECT_FALSE(body->compliance_along(spheres, normals, links, short_out));
+  EXPECT_FALSE(body->compliance_along(spheres, {normals.data(), 2}, links, along));
+}
+
 TEST(Compliance, KeptColumnsGiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
   // A body that solved other spheres before (some of them kept) writes the
   // same block as a body solving these spheres for the first time; after a

@@ -71,6 +71,50 @@ TEST(ContactStep, FreeCentresAreTheMotionWithoutTheContactForces) {
   EXPECT_LT(with.free_positions_m()[3 * bar.top[0] + 1], free->position(bar.top[0]).y() - 1e-7);
 }
 
+TEST(ContactStep, AlongNormalsGivesTheSameFreeCentresAndTheBlocksAlongTheSetsNormals) {
+  // W along the set's normals (one column a sphere) carries the same
+  // free-motion centres as the 3x3 blocks, and its columns are the blocks
+  // times those normals; a turned normal is solved again, not reused.
+  Bar bar;
+  auto blocks_body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  auto along_body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  ASSERT_TRUE(blocks_body && along_body);
+  ContactStep blocks(*blocks_body, bar.links);
+  ContactStepSettings along_settings;
+  along_settings.compliance_along_normals = true;
+  ContactStep along(*along_body, bar.links, along_settings);
+  ContactSet set = press(bar, *blocks_body, 0.01);
+  set.contacts[1].normal = Eigen::Vector3d(0.0, -0.6, 0.8);
+  blocks.step(&set);
+  along.step(&set);
+  const std::size_t k = bar.top.size();
+  ASSERT_EQ(along.compliance_spheres().size(), k);
+  ASSERT_EQ(along.compliance().size(), 3 * k * k);
+  ASSERT_EQ(along.compliance_normals().size(), k);
+  EXPECT_TRUE(blocks.compliance_normals().empty());
+  for (std::size_t s = 0; s < k; ++s) {
+    EXPECT_LT((along.free_centres()[s] - blocks.free_centres()[s]).norm(), 1e-12) << "sphere " << s;
+    for (std::size_t t = 0; t < k; ++t) {
+      const Eigen::Vector3d n = set.contacts[t].normal;
+      EXPECT_EQ(along.compliance_normals()[t], n);
+      for (std::size_t d = 0; d < 3; ++d) {
+        double expected = 0.0;
+        for (std::size_t e = 0; e < 3; ++e) {
+          expected += double{blocks.compliance()[(3 * s + d) * 3 * k + 3 * t + e]} * n[static_cast<Eigen::Index>(e)];
+        }
+        EXPECT_NEAR(along.compliance()[(3 * s + d) * k + t], expected, 1e-6 * std::abs(blocks.compliance()[0]));
+      }
+    }
+  }
+  // The pushed sphere's free centre differs from where it went: not vacuous.
+  EXPECT_GT((along.free_centres()[0] - bar.links.centre(0, along_body->positions_m().data())).norm(), 1e-7);
+  along.step(&set);
+  EXPECT_EQ(along.compliance_reuses(), 1u);
+  set.contacts[2].normal = Eigen::Vector3d(1.0, 0.0, 0.0);
+  along.step(&set);
+  EXPECT_EQ(along.compliance_solves(), 2u);
+}
+
 TEST(ContactStep, ReusesComplianceOnlyWhileSpheresAndFactorAreUnchanged) {
   Bar bar;
   auto body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));

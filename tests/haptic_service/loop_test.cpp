@@ -194,14 +194,20 @@ TEST(TissueDigest, RefusesStatesThatDoNotFit) {
   EXPECT_FALSE(digest.digest(state, snapshot));
 }
 
-TEST(TissueDigest, IndexesTheComplianceSpheres) {
-  const HapticSetup& setup = neonatal_scene().setup;
-  TissueDigest digest(setup);
-  TissueSnapshot snapshot = digest.make_snapshot();
+// A DeformationState with the body at rest and no compliance yet.
+msg::DeformationState rest_state(const HapticSetup& setup) {
   msg::DeformationState state;
   for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
     for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
   }
+  return state;
+}
+
+TEST(TissueDigest, IndexesTheComplianceSpheres) {
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest(setup);
+  TissueSnapshot snapshot = digest.make_snapshot();
+  msg::DeformationState state = rest_state(setup);
   state.compliance_sphere_ids({5, 9});
   state.compliance_mpn().assign(36, 1e-3f);
   state.compliance_free_centres_m().assign(6, 0.01f);
@@ -222,6 +228,36 @@ TEST(TissueDigest, IndexesTheComplianceSpheres) {
   state.compliance_sphere_ids({static_cast<std::uint32_t>(setup.layout.size())});
   ASSERT_TRUE(digest.digest(state, snapshot));
   EXPECT_EQ(snapshot.compliance_count, 0u);
+}
+
+TEST(TissueDigest, TakesWAlongTheFemsNormals) {
+  // (3k x k) columns with k normals: the view reads them as W along the
+  // normals; without enough normals, or with a block of the 3x3 size but
+  // normals present, W is refused (rows then use the fallback).
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest(setup);
+  TissueSnapshot snapshot = digest.make_snapshot();
+  msg::DeformationState state = rest_state(setup);
+  state.compliance_sphere_ids({5, 9});
+  state.compliance_mpn().assign(12, 0.0f);
+  state.compliance_mpn()[(3 * 1 + 1) * 2 + 0] = 2e-3f;  // sphere 9 moves +y per newton on sphere 5 along its normal
+  state.compliance_normals({0.0f, 1.0f, 0.0f, 1.0f, 0.0f, 0.0f});
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  ASSERT_EQ(snapshot.compliance_count, 2u);
+  const contact::TissueCompliance w = snapshot.compliance();
+  ASSERT_TRUE(w.valid());
+  ASSERT_TRUE(w.along_normals());
+  EXPECT_NEAR(w.normal_compliance(1, Eigen::Vector3d::UnitY(), 0, Eigen::Vector3d::UnitY()), 2e-3, 1e-9);
+  EXPECT_NEAR(w.normal_compliance(1, Eigen::Vector3d::UnitY(), 0, -Eigen::Vector3d::UnitY()), -2e-3, 1e-9);
+  state.compliance_normals().pop_back();
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  EXPECT_EQ(snapshot.compliance_count, 0u);
+  // Back to 3x3 blocks: no normals, nine entries a sphere pair.
+  state.compliance_normals().clear();
+  state.compliance_mpn().assign(36, 1e-3f);
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  EXPECT_EQ(snapshot.compliance_count, 2u);
+  EXPECT_FALSE(snapshot.compliance().along_normals());
 }
 
 }  // namespace

@@ -104,6 +104,8 @@ TEST(SceneErrors, UnknownEnumerationValuesListTheValidOnes) {
   expect_contains(error_of(replaced("backend: simulated", "backend: phantom")),
                   {"device.backend: 'phantom' is not one of: simulated, replay, remote, "
                    "openhaptics"});
+  expect_contains(error_of(std::string(kMinimalScene) + "solver:\n  compliance_columns: rows\n"),
+                  {"solver.compliance_columns: 'rows' is not one of: blocks, normals"});
 }
 
 TEST(SceneErrors, TwoTools) {

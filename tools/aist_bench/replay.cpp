@@ -121,8 +121,8 @@ struct ReplayVariant {
   ContactHash hash;      // every contact in buffer order
   ContactHash set_hash;  // per query the sum of each contact's hash: the same contacts in any order
   ContactHash row_hash;  // the kept rows, in row order
-  double tested_sum = 0.0, contacts_sum = 0.0, nodes_sum = 0.0;
-  std::uint32_t tested_max = 0, contacts_max = 0;
+  double tested_sum = 0.0, contacts_sum = 0.0, nodes_sum = 0.0, inside_sum = 0.0;
+  std::uint32_t tested_max = 0, contacts_max = 0, inside_max = 0;
 };
 
 // The haptic tick's row selection (services/haptic/main/haptic_loop.cpp)
@@ -273,6 +273,8 @@ void replay_states(const Scene& scene, const Options& options, const std::string
           v.contacts_sum += stats.contacts;
           v.tested_max = std::max(v.tested_max, stats.spheres_tested);
           v.contacts_max = std::max(v.contacts_max, stats.contacts);
+          v.inside_sum += stats.spheres_inside;
+          v.inside_max = std::max(v.inside_max, stats.spheres_inside);
         }
         v.buffer.clear();
         const double warm_start = thread_cpu_us();
@@ -286,16 +288,17 @@ void replay_states(const Scene& scene, const Options& options, const std::string
   std::printf("\n## Replay of %s: %zu ticks, %zu FEM states, %zu spheres, %zu kB written before each first run (evicts L2), per tick the least of %d passes (checksum %llu)\n\n",
               path.c_str(), rec.poses.size(), rec.states.size(), layout.size(), options.evict_bytes / 1024, options.replay_passes,
               static_cast<unsigned long long>(sink % 10));
-  std::printf("| query | first run thread CPU: median / p99 / p99.9 / max (us) | warm rerun: median / p99 / p99.9 / max (us) | nodes visited (mean) | spheres tested: mean / max | contacts: mean / max | contact hash: in order / as sets | row hash |\n");
-  std::printf("| --- | --- | --- | --- | --- | --- | --- | --- |\n");
+  std::printf("| query | first run thread CPU: median / p99 / p99.9 / max (us) | warm rerun: median / p99 / p99.9 / max (us) | nodes visited (mean) | spheres tested: mean / max | contacts: mean / max | centre inside: mean / max | contact hash: in order / as sets | row hash |\n");
+  std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const auto& v : variants) {
     char rows[32] = "";
     if (v.keep > 0) std::snprintf(rows, sizeof(rows), "%016llx", static_cast<unsigned long long>(v.row_hash.value));
-    std::printf("| %s | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f | %.0f | %.0f / %u | %.0f / %u | %016llx / %016llx | %s |\n", v.name,
+    std::printf("| %s | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f | %.0f | %.0f / %u | %.0f / %u | %.0f / %u | %016llx / %016llx | %s |\n", v.name,
                 percentile(v.first_us, 50), percentile(v.first_us, 99), percentile(v.first_us, 99.9),
                 percentile(v.first_us, 100), percentile(v.warm_us, 50), percentile(v.warm_us, 99),
                 percentile(v.warm_us, 99.9), percentile(v.warm_us, 100), v.nodes_sum / n, v.tested_sum / n,
-                v.tested_max, v.contacts_sum / n, v.contacts_max, static_cast<unsigned long long>(v.hash.value),
+                v.tested_max, v.contacts_sum / n, v.contacts_max, v.inside_sum / n, v.inside_max,
+                static_cast<unsigned long long>(v.hash.value),
                 static_cast<unsigned long long>(v.set_hash.value), rows);
   }
   std::printf("\nupdate+refit thread CPU: median %.1f us, p99.9 %.1f us.\n", percentile(refit_us, 50),

@@ -253,7 +253,8 @@ struct RunChoices {
   std::string spread = "service";
   std::string held_proxy = "limit";
   bool fem_tool_obstacle = false;
-  std::string row_compliance = "deepest";
+  std::string row_compliance = "scene";
+  int w_normals = 0;
   std::string trace_path;
   std::string tick_trace_path;
 };
@@ -279,6 +280,10 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
       if (body.deformable) body.deformable->material.yeoh_c20_over_c10 = stiffening;
     }
   }
+  if (choices.w_normals > 0) {
+    variant->solver.compliance_columns = scene::ComplianceColumns::kNormals;
+    variant->solver.max_candidate_contacts = choices.w_normals;
+  }
   const auto start = std::chrono::steady_clock::now();
   stack_sim::StackOptions options;
   options.script = device::Script::kOvershoot;
@@ -287,8 +292,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   if (choices.support_ratio >= 0.0) options.fem_support_ratio = choices.support_ratio;
   options.hold_within_limit = choices.held_proxy == "limit";
   options.fem_tool_obstacle = choices.fem_tool_obstacle;
-  options.row_compliance =
-      choices.row_compliance == "keep" ? haptic_service::RowCompliance::kKeep : haptic_service::RowCompliance::kDeepest;
+  if (choices.row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(choices.row_compliance);
   if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
   if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
   stack_sim::StackSim sim(variant, options);
@@ -488,8 +492,13 @@ int main(int argc, char** argv) {
                "ContactSet's spheres (services/fem contact_step.h set_tool_obstacle)");
   app.add_option("--row-compliance", choices.row_compliance,
                  "experimental: which rows get W when the blade touches more spheres than the FEM sends W for: "
-                 "deepest (as shipped) or keep (services/haptic/main haptic_setup.h RowCompliance)")
-      ->check(CLI::IsMember({"deepest", "keep"}));
+                 "scene (its solver.compliance_columns decides), deepest, keep or free (services/haptic/main haptic_setup.h "
+                 "RowCompliance)")
+      ->check(CLI::IsMember({"scene", "deepest", "keep", "free"}));
+  app.add_option("--w-normals", choices.w_normals,
+                 "W along the normals for this many spheres (the scene's solver.compliance_columns: normals and "
+                 "max_candidate_contacts); 0: the scene's")
+      ->check(CLI::Range(0, 64));
   app.add_flag("--check", check, "exit 1 unless the force-aware run meets the targets");
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);

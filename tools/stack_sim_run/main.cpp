@@ -5,10 +5,14 @@
 // Equal hashes show that the in-process run is the distributed one.
 //
 //   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
-//                      [--fem-anatomy on|off] [--fem-support RATIO] [--stiffening C20/C10] [--seconds 4]
+//                      [--fem-anatomy on|off] [--fem-support RATIO] [--stiffening C20/C10]
+//                      [--fem-tool-obstacle] [--w-normals N] [--row-compliance scene|deepest|keep|free]
+//                      [--seconds 4]
 //
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
 // (services/fem compression_stiffening.h; 0: off), instead of the scene's.
+// --w-normals N: W along the ContactSet's normals for N spheres (the
+// scene's solver.compliance_columns: normals), with rows by free depth.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -48,6 +52,16 @@ int main(int argc, char** argv) {
   bool fem_tool_obstacle = false;
   app.add_flag("--fem-tool-obstacle", fem_tool_obstacle,
                "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose");
+  std::string row_compliance = "scene";
+  app.add_option("--row-compliance", row_compliance,
+                 "which rows the haptic tick keeps: scene (its solver.compliance_columns decides), deepest, keep or "
+                 "free (services/haptic/main haptic_setup.h RowCompliance)")
+      ->check(CLI::IsMember({"scene", "deepest", "keep", "free"}));
+  int w_normals = 0;
+  app.add_option("--w-normals", w_normals,
+                 "W along the normals for this many spheres (solver.compliance_columns: normals, "
+                 "max_candidate_contacts); 0: the scene's")
+      ->check(CLI::Range(0, 64));
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -57,11 +71,16 @@ int main(int argc, char** argv) {
     options.fem_anatomy = fem_anatomy == "on";
     if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
     options.fem_tool_obstacle = fem_tool_obstacle;
+    if (row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(row_compliance);
     options.collision =
         collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;
     auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));
     for (auto& body : scene->bodies) {
       if (body.deformable && stiffening >= 0.0) body.deformable->material.yeoh_c20_over_c10 = stiffening;
+    }
+    if (w_normals > 0) {
+      scene->solver.compliance_columns = scene::ComplianceColumns::kNormals;
+      scene->solver.max_candidate_contacts = w_normals;
     }
     stack_sim::StackSim sim(scene, options);
     const auto steps = static_cast<std::uint64_t>(seconds * 1000.0 + 0.5);
@@ -75,7 +94,7 @@ int main(int argc, char** argv) {
     std::uint64_t unconverged = 0;
     // Wall time of the tick's phases (a preempted tick shows in the tail).
     std::vector<double> tissue_query_us, anatomy_query_us, response_us;
-    std::vector<double> query_nodes, query_spheres, query_contacts;  // the AIST query's work per tick
+    std::vector<double> query_nodes, query_spheres, query_contacts, query_inside;  // the AIST query's work per tick
     for (std::uint64_t k = 0; k < steps; ++k) {
       sim.step();
       const auto& report = sim.haptic().response().report();
@@ -90,6 +109,7 @@ int main(int argc, char** argv) {
       query_nodes.push_back(phases.tissue_query.nodes_visited);
       query_spheres.push_back(phases.tissue_query.spheres_tested);
       query_contacts.push_back(phases.tissue_query.contacts);
+      query_inside.push_back(phases.tissue_query.spheres_inside);
       const auto& f = sim.command().force_n();
       peak_force = std::max(peak_force, std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z()));
     }
@@ -128,10 +148,10 @@ int main(int argc, char** argv) {
     print_phase("anatomy query", anatomy_query_us);
     print_phase("response", response_us);
     std::printf("stack_sim: AIST query per tick: tree nodes p50 %.0f p99 %.0f, spheres tested p50 %.0f p99 %.0f, "
-                "contacts p50 %.0f p99 %.0f max %.0f\n",
+                "contacts p50 %.0f p99 %.0f max %.0f, centre inside p99 %.0f max %.0f\n",
                 quantile(query_nodes, 0.5), quantile(query_nodes, 0.99), quantile(query_spheres, 0.5),
                 quantile(query_spheres, 0.99), quantile(query_contacts, 0.5), quantile(query_contacts, 0.99),
-                quantile(query_contacts, 1.0));
+                quantile(query_contacts, 1.0), quantile(query_inside, 0.99), quantile(query_inside, 1.0));
     std::printf("lockstep_clock: hash device_gateway %016llx\n", static_cast<unsigned long long>(sim.gateway_hash()));
     std::printf("lockstep_clock: hash fem %016llx\n", static_cast<unsigned long long>(sim.fem_hash()));
     std::printf("lockstep_clock: hash haptic %016llx\n", static_cast<unsigned long long>(sim.haptic_hash()));

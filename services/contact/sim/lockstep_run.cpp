@@ -52,7 +52,7 @@ void LockstepRun::haptic_tick(const Eigen::Vector3d& device_m, TickRecord& recor
     TickInput input;
     input.device = device;
     input.rows = rows_;
-    input.compliance = TissueCompliance{fem_.step_index(), fem_.compliance_spheres(), fem_.compliance()};
+    input.compliance = TissueCompliance{fem_.step_index(), fem_.compliance_spheres(), fem_.compliance(), {}};
     const auto start = std::chrono::steady_clock::now();
     out = &response_.tick(input);
     record.tick_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

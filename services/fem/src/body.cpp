@@ -374,6 +374,17 @@ StepReport Body::step(const ContactSet* contacts, const SphereLinks* links) {
 }
 
 bool Body::compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links, std::span<float> out) {
+  if (!prepare_compliance_factor()) return false;
+  return compliance_.compute(spheres, links, fixed_dof_, cholmod_, warp_, h_, out);
+}
+
+bool Body::compliance_along(std::span<const std::uint32_t> spheres, std::span<const Eigen::Vector3d> normals,
+                            const SphereLinks& links, std::span<float> out) {
+  if (!prepare_compliance_factor()) return false;
+  return compliance_.compute_along(spheres, normals, links, fixed_dof_, cholmod_, warp_, h_, out);
+}
+
+bool Body::prepare_compliance_factor() {
   const SolverSettings& solver = settings_.solver;
   const bool factor_unused = solver.kind == LinearSolver::kConjugateGradient &&
                              solver.preconditioner == CgPreconditioner::kJacobi;
@@ -384,7 +395,7 @@ bool Body::compliance(std::span<const std::uint32_t> spheres, const SphereLinks&
     if (!refactorise()) return false;
   }
   if (factor_unused) warp_.update_rotations(rest_, rotations_);
-  return compliance_.compute(spheres, links, fixed_dof_, cholmod_, warp_, h_, out);
+  return true;
 }
 
 void Body::set_external_force(std::uint32_t node, const Eigen::Vector3d& force_n) {

@@ -12,6 +12,16 @@ namespace {
 // (CholmodSolver::kColumnCounts) instead of reallocating for every count.
 constexpr std::array<std::size_t, 4> kChunkSpheres{8, 4, 2, 1};
 
+// Row 3s + d of J times a solved column x: the motion of sphere s's centre
+// along d (its weights over its nodes' DOFs).
+double sphere_motion(const SphereLinks& links, std::uint32_t sphere, const double* x, std::size_t d) {
+  const auto nodes = links.nodes(sphere);
+  const auto weights = links.weights(sphere);
+  double sum = 0.0;
+  for (std::size_t m = 0; m < nodes.size(); ++m) sum += weights[m] * x[3 * std::size_t{nodes[m]} + d];
+  return sum;
+}
+
 }  // namespace
 
 void ComplianceBlock::reserve(std::size_t dofs, std::size_t max_spheres) {
@@ -121,15 +131,66 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
   for (std::size_t t = 0; t < rows; ++t) {
     const double* x = column(request_slots_[t / 3], t % 3);
     for (std::size_t s = 0; s < k; ++s) {
-      const auto nodes = links.nodes(spheres[s]);
-      const auto weights = links.weights(spheres[s]);
       for (std::size_t d = 0; d < 3; ++d) {
-        double sum = 0.0;
-        for (std::size_t m = 0; m < nodes.size(); ++m) sum += weights[m] * x[3 * std::size_t{nodes[m]} + d];
-        out[(3 * s + d) * rows + t] = static_cast<float>(h2 * sum);
+        out[(3 * s + d) * rows + t] = static_cast<float>(h2 * sphere_motion(links, spheres[s], x, d));
       }
     }
   }
+  return true;
+}
+
+bool ComplianceBlock::compute_along(std::span<const std::uint32_t> spheres, std::span<const Eigen::Vector3d> normals,
+                                    const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
+                                    CholmodSolver& factor, WarpedFactor& warp, double time_step_s,
+                                    std::span<float> out) {
+  const std::size_t k = spheres.size();
+  last_solved_ = 0;
+  if (k == 0) return true;
+  if (k > max_spheres_ || normals.size() < k || out.size() < 3 * k * k || !factor.factorized()) return false;
+  for (const std::uint32_t s : spheres) {
+    if (s >= links.size()) return false;
+  }
+  // The columns of the 3x3 blocks' cache are not these: leave it alone.
+  const double h2 = time_step_s * time_step_s;
+  const std::size_t per_chunk = rhs_.size() / dofs_;  // columns a chunk holds (3 x kChunkSpheres.front())
+  for (std::size_t done = 0; done < k;) {
+    // Column counts CHOLMOD keeps buffers for: the blocks' 24, 12, 6, 3, then 2 and 1.
+    std::size_t chunk = 1;
+    for (const std::size_t c : {per_chunk, per_chunk / 2, per_chunk / 4, per_chunk / 8, std::size_t{2}}) {
+      if (c > 0 && c <= k - done) {
+        chunk = c;
+        break;
+      }
+    }
+    // B = J^T N: column t holds w_i n_t at node i's DOFs.
+    std::fill(rhs_.begin(), rhs_.begin() + static_cast<std::ptrdiff_t>(dofs_ * chunk), 0.0);
+    for (std::size_t c = 0; c < chunk; ++c) {
+      const std::uint32_t sphere = spheres[done + c];
+      const Eigen::Vector3d& n = normals[done + c];
+      const auto nodes = links.nodes(sphere);
+      const auto weights = links.weights(sphere);
+      double* column = rhs_.data() + dofs_ * c;
+      for (std::size_t m = 0; m < nodes.size(); ++m) {
+        for (std::size_t d = 0; d < 3; ++d) {
+          const std::size_t dof = 3 * std::size_t{nodes[m]} + d;
+          if (fixed_dof[dof] == 0) column[dof] += weights[m] * n[static_cast<Eigen::Index>(d)];
+        }
+      }
+    }
+    warp.solve_columns(factor, {rhs_.data(), dofs_ * chunk}, {solution_.data(), dofs_ * chunk},
+                       static_cast<int>(chunk));
+    for (std::size_t c = 0; c < chunk; ++c) {
+      const double* x = solution_.data() + dofs_ * c;
+      const std::size_t t = done + c;
+      for (std::size_t s = 0; s < k; ++s) {
+        for (std::size_t d = 0; d < 3; ++d) {
+          out[(3 * s + d) * k + t] = static_cast<float>(h2 * sphere_motion(links, spheres[s], x, d));
+        }
+      }
+    }
+    done += chunk;
+  }
+  last_solved_ = k;
   return true;
 }
 

@@ -33,6 +33,7 @@ ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStep
   normals_.reserve(k);
   compliance_.reserve(9 * k * k);
   compliance_of_.reserve(k);
+  normals_of_.reserve(k);
   free_centres_.reserve(k);
 }
 
@@ -177,13 +178,21 @@ void ContactStep::update_compliance(bool refactorised) {
     compliance_.clear();
     return;
   }
-  if (compliance_valid_ && !refactorised && std::equal(spheres_.begin(), spheres_.end(), compliance_of_.begin(),
-                                                       compliance_of_.end())) {
+  const bool along = along_normals();
+  if (compliance_valid_ && !refactorised &&
+      std::equal(spheres_.begin(), spheres_.end(), compliance_of_.begin(), compliance_of_.end()) &&
+      (!along || std::equal(normals_.begin(), normals_.end(), normals_of_.begin(), normals_of_.end()))) {
     ++compliance_reuses_;
     return;
   }
-  compliance_.resize(9 * k * k);
-  compliance_valid_ = body_.compliance(spheres_, links_, compliance_);
+  if (along) {
+    compliance_.resize(3 * k * k);
+    compliance_valid_ = body_.compliance_along(spheres_, normals_, links_, compliance_);
+    normals_of_.assign(normals_.begin(), normals_.end());
+  } else {
+    compliance_.resize(9 * k * k);
+    compliance_valid_ = body_.compliance(spheres_, links_, compliance_);
+  }
   ++compliance_solves_;
   compliance_of_.assign(spheres_.begin(), spheres_.end());
   if (!compliance_valid_ && !fixed_spheres_) {
@@ -199,10 +208,18 @@ void ContactStep::update_free_centres() {
   const std::size_t k = spheres_.size();
   free_centres_.resize(k);
   const double* x = free_positions_.data();
+  const bool along = along_normals();
   for (std::size_t s = 0; s < k; ++s) {
     Eigen::Vector3d shift = Eigen::Vector3d::Zero();
     for (std::size_t t = 0; t < k && compliance_valid_; ++t) {
       if (lambda_n_[t] == 0.0) continue;
+      if (along) {
+        // Column t is W_st n_t, n_t the normal lambda_t pushed along.
+        for (std::size_t d = 0; d < 3; ++d) {
+          shift[static_cast<Eigen::Index>(d)] += lambda_n_[t] * double{compliance_[(3 * s + d) * k + t]};
+        }
+        continue;
+      }
       for (std::size_t d = 0; d < 3; ++d) {
         const float* row = compliance_.data() + (3 * s + d) * 3 * k + 3 * t;
         shift[static_cast<Eigen::Index>(d)] += lambda_n_[t] * (double{row[0]} * normals_[t].x() +

@@ -120,11 +120,23 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   return d;
 }
 
-// RowCompliance::kKeep (haptic_setup.h): the spheres with W first, then by depth.
+// RowCompliance::kKeep, kFreeDepth (haptic_setup.h).
 std::size_t HapticLoop::select_compliance_first(const TissueSnapshot& tissue) {
   const std::size_t n = std::min(tool_contacts_.size(), order_.size());
   std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
   if (n <= tissue_row_budget_) return n;
+  if (setup_.row_compliance == RowCompliance::kFreeDepth) {
+    // |c - c_free| stands for (c - c_free) . n: the FEM's shift is along
+    // the pushing normals.
+    const auto free_depth = [&](std::uint32_t i) {
+      const std::int32_t w = tissue.compliance_index[tool_contacts_[i].sphere_id];
+      return tool_contacts_[i].depth_m + (w >= 0 ? double{tissue.free_shift_m[static_cast<std::size_t>(w)]} : 0.0);
+    };
+    std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
+                      order_.begin() + static_cast<std::ptrdiff_t>(n),
+                      [&](std::uint32_t a, std::uint32_t b) { return free_depth(a) > free_depth(b); });
+    return tissue_row_budget_;
+  }
   const auto has_block = [&](std::uint32_t i) { return tissue.compliance_index[tool_contacts_[i].sphere_id] >= 0; };
   std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
                     order_.begin() + static_cast<std::ptrdiff_t>(n), [&](std::uint32_t a, std::uint32_t b) {

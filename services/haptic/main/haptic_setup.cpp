@@ -62,6 +62,11 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fe
   setup.scene = &scene;
   setup.deformable = &scene.bodies[plan.fem_bodies.front()];
   setup.mesh = runtime::world_tet_mesh(*setup.deformable);
+  // W along the normals covers every row the FEM was sent last: rows by
+  // their free-motion depth keep them (RowCompliance::kFreeDepth).
+  if (scene.solver.compliance_columns == scene::ComplianceColumns::kNormals) {
+    setup.row_compliance = RowCompliance::kFreeDepth;
+  }
   try {
     setup.layout = haptic::fill_spheres(setup.mesh, runtime::fill_settings_for(*setup.deformable));
   } catch (const std::exception& e) {

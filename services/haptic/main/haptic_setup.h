@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include "fahr/contact/contact_response.h"
@@ -49,8 +50,17 @@ struct TriangleCollisionSetup {
 // and their projected centres, and most rows change each FEM state (after
 // its projection the W spheres are the shallowest). kKeep: the spheres the
 // newest state has W for come first, then the deepest of the rest, so the
-// FEM computes W for the same spheres again.
-enum class RowCompliance { kDeepest, kKeep };
+// FEM computes W for the same spheres again. kFreeDepth: the deepest, a W
+// sphere's depth taken on its free-motion centre (the published one reads
+// about zero after the FEM's projection; the others were not projected, so
+// theirs is already free): the depths the solve then uses.
+enum class RowCompliance { kDeepest, kKeep, kFreeDepth };
+// "deepest", "keep" or "free" (the benches' --row-compliance); kDeepest otherwise.
+inline RowCompliance row_compliance_named(std::string_view name) {
+  if (name == "keep") return RowCompliance::kKeep;
+  if (name == "free") return RowCompliance::kFreeDepth;
+  return RowCompliance::kDeepest;
+}
 
 struct HapticSetup {
   const scene::Scene* scene = nullptr;
@@ -76,8 +86,9 @@ struct HapticSetup {
   contact::PenaltySettings penalty_settings;
   CollisionMethod collision = CollisionMethod::kAist;
   std::unique_ptr<TriangleCollisionSetup> triangles;  // set for kTriangle only
-  // Experimental: how rows get W when the tool touches more spheres than
-  // the FEM sends W for (see RowCompliance).
+  // How rows are picked when the tool touches more spheres than the solve
+  // takes (see RowCompliance): kFreeDepth where the scene has W along the
+  // normals (solver.compliance_columns), else kDeepest.
   RowCompliance row_compliance = RowCompliance::kDeepest;
 };
 

@@ -25,7 +25,13 @@ contact::TissueCompliance TissueSnapshot::compliance() const {
   c.fem_step = fem_step;
   if (compliance_count > 0) {
     c.sphere_ids = {compliance_ids.data(), compliance_count};
-    c.w_mpn = {w_mpn.data(), 9 * compliance_count * compliance_count};
+    const std::size_t k = compliance_count;
+    if (have_compliance_normals) {
+      c.w_mpn = {w_mpn.data(), 3 * k * k};
+      c.normals = {compliance_normals.data(), 3 * k};
+    } else {
+      c.w_mpn = {w_mpn.data(), 9 * k * k};
+    }
   }
   return c;
 }
@@ -61,6 +67,8 @@ TissueSnapshot TissueDigest::make_snapshot() {
   s.compliance_ids.assign(msg::MAX_COMPLIANCE_SPHERES, 0);
   s.w_mpn.assign(msg::MAX_COMPLIANCE_ENTRIES, 0.0f);
   s.free_centres_m.assign(msg::MAX_COMPLIANCE_COORDS, 0.0f);
+  s.compliance_normals.assign(msg::MAX_COMPLIANCE_COORDS, 0.0f);
+  s.free_shift_m.assign(msg::MAX_COMPLIANCE_SPHERES, 0.0f);
   s.compliance_index.assign(setup_.layout.size(), contact::kNoCompliance);
   s.obstacle_contacts.assign(kObstacleContactCapacity, fem::Contact{});
   s.obstacle_body_ids.assign(kObstacleContactCapacity, 0);
@@ -99,7 +107,11 @@ void TissueDigest::index_compliance(const msg::DeformationState& state, TissueSn
   out.have_free_centres = false;
   const auto& ids = state.compliance_sphere_ids();
   const std::size_t k = std::min<std::size_t>(ids.size(), out.compliance_ids.size());
-  if (k == 0 || state.compliance_mpn().size() < 9 * k * k) return;  // no usable W: rows use the fallback
+  out.have_compliance_normals = false;
+  const bool along = !state.compliance_normals().empty();
+  if (along && state.compliance_normals().size() < 3 * k) return;
+  const std::size_t entries = along ? 3 * k * k : 9 * k * k;
+  if (k == 0 || state.compliance_mpn().size() < entries) return;  // no usable W: rows use the fallback
   for (std::size_t i = 0; i < k; ++i) {
     // An id beyond the layout would index past the table: the whole W is
     // refused rather than solved with a row missing.
@@ -109,11 +121,20 @@ void TissueDigest::index_compliance(const msg::DeformationState& state, TissueSn
     out.compliance_ids[i] = ids[i];
     out.compliance_index[ids[i]] = static_cast<std::int32_t>(i);
   }
-  std::copy_n(state.compliance_mpn().data(), 9 * k * k, out.w_mpn.data());
+  std::copy_n(state.compliance_mpn().data(), entries, out.w_mpn.data());
+  if (along) {
+    std::copy_n(state.compliance_normals().data(), 3 * k, out.compliance_normals.data());
+    out.have_compliance_normals = true;
+  }
   out.compliance_count = k;
   if (state.compliance_free_centres_m().size() >= 3 * k) {
     std::copy_n(state.compliance_free_centres_m().data(), 3 * k, out.free_centres_m.data());
     out.have_free_centres = true;
+    const auto centres = out.spheres.centres_m();
+    for (std::size_t i = 0; i < k; ++i) {
+      const float* f = out.free_centres_m.data() + 3 * i;
+      out.free_shift_m[i] = static_cast<float>((centres[ids[i]] - Eigen::Vector3d(f[0], f[1], f[2])).norm());
+    }
   }
 }
 

@@ -38,6 +38,12 @@ struct TissueSnapshot {
   std::vector<std::uint32_t> compliance_ids;
   std::vector<float> w_mpn;
   std::vector<float> free_centres_m;
+  // The FEM's normal of each compliance sphere when W came along normals
+  // (DeformationState.compliance_normals).
+  std::vector<float> compliance_normals;
+  // |published - free centre| of each compliance sphere, m (0 without free centres).
+  std::vector<float> free_shift_m;
+  bool have_compliance_normals = false;
   std::size_t compliance_count = 0;
   bool have_free_centres = false;
   // Per sphere id: its index in compliance_ids, or contact::kNoCompliance.

@@ -376,6 +376,7 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       const geometry::SdfSample s =
           one_read ? from_gradient(p, grid, copy->gradient(cell)) : sample(field, p, grid, settings, hint);
       if (s.distance_m > 0.0) memory.remember(slot, p, query, grid);
+      if (!(s.distance_m > 0.0)) ++stats.spheres_inside;
       if (s.exact) memory.remember_nearest(slot, s.closest_point_m);
       Eigen::Vector3d q, n;
       double depth = 0.0;

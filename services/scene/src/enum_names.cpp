@@ -29,6 +29,9 @@ std::string_view to_string(DeviceScript script) {
 std::string_view to_string(LinearSolver solver) {
   return name_of(detail::kLinearSolverNames, solver);
 }
+std::string_view to_string(ComplianceColumns columns) {
+  return name_of(detail::kComplianceColumnsNames, columns);
+}
 std::string_view to_string(ComplianceMode mode) {
   return name_of(detail::kComplianceModeNames, mode);
 }

@@ -47,6 +47,8 @@ inline constexpr std::pair<std::string_view, ComplianceMode> kComplianceModeName
     {"exact", ComplianceMode::kExact},
     {"lagged", ComplianceMode::kLagged},
     {"none", ComplianceMode::kNone}};
+inline constexpr std::pair<std::string_view, ComplianceColumns> kComplianceColumnsNames[] = {
+    {"blocks", ComplianceColumns::kBlocks}, {"normals", ComplianceColumns::kNormals}};
 inline constexpr std::pair<std::string_view, ContactResponse> kContactResponseNames[] = {
     {"force_aware", ContactResponse::kForceAware}, {"penalty", ContactResponse::kPenalty}};
 inline constexpr std::pair<std::string_view, Reliability> kReliabilityNames[] = {

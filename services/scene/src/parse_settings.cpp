@@ -244,7 +244,7 @@ FemSolverSettings parse_solver(const ParseContext& ctx, const MapReader& top) {
   if (!top.has("solver")) return s;
   const MapReader map(ctx.log, top.value("solver"), "solver",
                       {"linear_solver", "cg_tolerance", "cg_max_iterations",
-                       "projection_max_iterations", "projection_tolerance_m", "compliance",
+                       "projection_max_iterations", "projection_tolerance_m", "compliance", "compliance_columns",
                        "max_candidate_contacts", "max_contact_age_ms", "sleep_speed_mps"});
   map.read_enum("linear_solver", kLinearSolverNames, s.linear_solver);
   if (s.linear_solver != LinearSolver::kPcg) {
@@ -257,6 +257,7 @@ FemSolverSettings parse_solver(const ParseContext& ctx, const MapReader& top) {
   map.read("projection_max_iterations", 1, 10000, s.projection_max_iterations);
   map.read("projection_tolerance_m", open_closed(0.0, 1.0e-2), s.projection_tolerance_m);
   map.read_enum("compliance", kComplianceModeNames, s.compliance);
+  map.read_enum("compliance_columns", kComplianceColumnsNames, s.compliance_columns);
   // The compliance block is n^2 floats per DeformationState: 1024 is 4 MiB.
   map.read("max_candidate_contacts", 0, 1024, s.max_candidate_contacts);
   map.read_ms("max_contact_age_ms", open_closed(0.0, 10000.0), s.max_contact_age);

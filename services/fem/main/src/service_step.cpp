@@ -12,7 +12,8 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
       contact_step_(*setup.body, setup.links,
                     fem::ContactStepSettings{.apply_contact_forces = true,
                                              .max_compliance_spheres = setup.settings.max_compliance_spheres,
-                                             .spread = setup.sphere_spread}) {
+                                             .spread = setup.sphere_spread,
+                                             .compliance_along_normals = setup.compliance_along_normals}) {
   const std::size_t cap = setup.settings.max_compliance_spheres;
   std::vector<const fem::ObstacleField*> anatomy;
   if (setup.enforce_anatomy) {
@@ -29,6 +30,7 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
   state_.compliance_sphere_ids().reserve(cap);
   state_.compliance_mpn().reserve(9 * cap * cap);
   state_.compliance_free_centres_m().reserve(3 * cap);
+  state_.compliance_normals().reserve(3 * cap);
 }
 
 void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
@@ -65,6 +67,12 @@ void ServiceStep::fill_compliance() {
   const auto free = contact_step_.free_centres();
   state_.compliance_sphere_ids().assign(ids.begin(), ids.end());
   state_.compliance_mpn().assign(w.begin(), w.end());
+  const auto normals = contact_step_.compliance_normals();
+  auto& along = state_.compliance_normals();
+  along.resize(3 * normals.size());
+  for (std::size_t s = 0; s < normals.size(); ++s) {
+    for (std::size_t d = 0; d < 3; ++d) along[3 * s + d] = static_cast<float>(normals[s][static_cast<Eigen::Index>(d)]);
+  }
   auto& centres = state_.compliance_free_centres_m();
   centres.resize(3 * free.size());
   for (std::size_t s = 0; s < free.size(); ++s) {

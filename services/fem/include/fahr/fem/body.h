@@ -112,6 +112,10 @@ class Body {
   // m/N, from the solver's factorisation: exact when it was refactorised this
   // step (kCholmod with refactor_period 1), the lagged A otherwise.
   bool compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links, std::span<float> out);
+  // The same W along one normal a sphere (ComplianceBlock::compute_along):
+  // (3k x k), entry (3s + d, t) = (W_st n_t)_d.
+  bool compliance_along(std::span<const std::uint32_t> spheres, std::span<const Eigen::Vector3d> normals,
+                        const SphereLinks& links, std::span<float> out);
 
   // Nodes the static anatomy holds (obstacle_support.h): from the next step
   // on, each gets a spring of stiffness_ratio times its diagonal of A along
@@ -173,6 +177,8 @@ class Body {
   void finish_step(StepReport& report);
   void assemble_system();
   bool refactorise();
+  // Brings the factor W is solved on up to date where the solver keeps none.
+  bool prepare_compliance_factor();
   // True if an element rotated more than the setting since the factorisation.
   bool rotated_since_factor() const;
   // True if an element's stiffening scale changed by more than the setting.

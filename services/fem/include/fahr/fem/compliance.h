@@ -10,6 +10,7 @@
 // tongue it changes in most steps while the blade slides).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -38,6 +39,17 @@ class ComplianceBlock {
   bool compute(std::span<const std::uint32_t> spheres, const SphereLinks& links,
                std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor, WarpedFactor& warp,
                double time_step_s, std::span<float> out);
+
+  // W along given normals, one column a sphere: writes (3k x k) row-major
+  // float, m/N, entry (3s + d, t) = (W_st n_t)_d, how sphere s moves per
+  // newton on sphere t along n_t (unit normals, one per sphere). A solve
+  // per sphere where the 3x3 blocks take three: what a contact solve needs
+  // (n_s . W_st n_t) for a third of the solves, if it uses these normals.
+  // Nothing is kept between calls. Same failures as compute(); no
+  // allocation.
+  bool compute_along(std::span<const std::uint32_t> spheres, std::span<const Eigen::Vector3d> normals,
+                     const SphereLinks& links, std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
+                     WarpedFactor& warp, double time_step_s, std::span<float> out);
 
   // Spheres whose columns the last compute() solved (the others were kept).
   std::size_t last_solved_spheres() const { return last_solved_; }

@@ -53,6 +53,11 @@ struct ContactStepSettings {
   // How the ContactSet's sphere corrections are shared by the nodes
   // (projection.h); overrides the body's projection setting.
   SphereSpread spread = SphereSpread::kMassWeighted;
+  // W along each sphere's normal in the ContactSet, one column a sphere
+  // ((3k x k), Body::compliance_along), instead of 3x3 blocks: the same
+  // solves buy three times the spheres. Ignored with fixed spheres (they
+  // have no normals before a set names them).
+  bool compliance_along_normals = false;
 };
 
 class ContactStep {
@@ -107,9 +112,16 @@ class ContactStep {
   bool reset();
 
   // The compliance spheres of the newest step, their W (row-major 3k x 3k,
-  // m/N) and free-motion centres (one per sphere, m).
+  // m/N; along normals: 3k x k, see compliance_normals()) and free-motion
+  // centres (one per sphere, m).
   std::span<const std::uint32_t> compliance_spheres() const { return spheres_; }
   std::span<const float> compliance() const { return compliance_; }
+  // With compliance_along_normals: the normal each column of W is along (the
+  // ContactSet's, a resultant where a sphere had two pushing contacts);
+  // empty for the 3x3 blocks.
+  std::span<const Eigen::Vector3d> compliance_normals() const {
+    return along_normals() ? std::span<const Eigen::Vector3d>(normals_) : std::span<const Eigen::Vector3d>();
+  }
   std::span<const Eigen::Vector3d> free_centres() const { return free_centres_; }
   // Positions after the implicit step, before the projection (3 per node, m).
   std::span<const double> free_positions_m() const { return free_positions_; }
@@ -123,6 +135,7 @@ class ContactStep {
   void add_sphere_force(const Contact& contact);
   void apply_forces(std::span<const double> extra_forces_n);
   void update_compliance(bool refactorised);
+  bool along_normals() const { return settings_.compliance_along_normals && !fixed_spheres_; }
   void update_free_centres();
   // The ContactSet's projection (may be null) and the anatomy's, then the
   // positions and the carried correction written back.
@@ -146,6 +159,7 @@ class ContactStep {
   std::vector<Eigen::Vector3d> normals_;
   std::vector<float> compliance_;
   std::vector<std::uint32_t> compliance_of_;  // spheres the block was solved for
+  std::vector<Eigen::Vector3d> normals_of_;   // and, along normals, their normals
   bool compliance_valid_ = false;
   std::uint64_t compliance_reuses_ = 0;
   std::uint64_t compliance_solves_ = 0;

@@ -214,6 +214,7 @@ struct QueryStats {
   // (PrePenetrationMemory::remember). Not counted in spheres_tested.
   std::uint32_t spheres_bounded = 0;
   std::uint32_t exact_queries = 0;    // reached the narrow phase (exact or grid)
+  std::uint32_t spheres_inside = 0;   // of those, centre inside the body (depth from the pre-penetration centre)
   std::uint32_t contacts = 0;         // found (including those a full buffer dropped)
   bool body_skipped = false;          // the root could not touch the body
   bool overflowed = false;            // the buffer was full

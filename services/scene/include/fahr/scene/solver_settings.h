@@ -20,8 +20,17 @@ enum class ComplianceMode {
   kNone,    // no compliance: the haptic loop sees only positions
 };
 
+// How W is laid out: 3x3 blocks a sphere pair (the haptic loop projects
+// them on its own normals), or one column a sphere along the normal of its
+// ContactSet entry (three times the spheres for the same solves).
+enum class ComplianceColumns {
+  kBlocks,
+  kNormals,
+};
+
 std::string_view to_string(LinearSolver solver);
 std::string_view to_string(ComplianceMode mode);
+std::string_view to_string(ComplianceColumns columns);
 
 struct FemSolverSettings {
   LinearSolver linear_solver = LinearSolver::kCholmod;
@@ -30,6 +39,7 @@ struct FemSolverSettings {
   int projection_max_iterations = kDefaultProjectionMaxIterations;  // [1, 10000]
   double projection_tolerance_m = kDefaultProjectionToleranceM;     // m, (0, 1e-2]
   ComplianceMode compliance = ComplianceMode::kExact;
+  ComplianceColumns compliance_columns = ComplianceColumns::kBlocks;
   int max_candidate_contacts = kDefaultMaxCandidateContacts;  // [0, 1024]
   // ContactSets older than this are ignored and counted, (0, 10 s].
   std::chrono::nanoseconds max_contact_age = kDefaultMaxContactAge;

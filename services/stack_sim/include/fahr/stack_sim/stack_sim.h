@@ -56,8 +56,8 @@ struct StackOptions {
   // ContactSet's tool pose (FemBodySetup::tool), not only the set's spheres;
   // the FEM service's --tool-obstacle.
   bool fem_tool_obstacle = false;
-  // Experimental: HapticSetup::row_compliance.
-  haptic_service::RowCompliance row_compliance = haptic_service::RowCompliance::kDeepest;
+  // Overrides HapticSetup::row_compliance (the scene's choice) when set.
+  std::optional<haptic_service::RowCompliance> row_compliance;
 };
 
 class StackSim {
