@@ -6,7 +6,10 @@
 # output hash must be the same on both: the runs are identical bit for bit,
 # whatever the vendor and the load, so lockstep runs are reproducible. The
 # same run in one process (fahr_stack_sim_run: the services' step code
-# without transport) must give the same hashes too.
+# without transport) must give the same hashes too. Then once more with W
+# along the normals (solver.compliance_columns: normals, 64 spheres, whose
+# columns and normals cross DDS in DeformationState.compliance_normals),
+# on Cyclone DDS against the same in one process.
 #
 # One BLAS thread everywhere: CHOLMOD's supernodal factorisation rounds
 # differently with another OpenBLAS thread count (measured: the FEM hash
@@ -20,11 +23,11 @@ tmp=$(mktemp -d /tmp/fahr-stack-lockstep-XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
 
 run() {
-  local vendor=$1 domain=$2
+  local vendor=$1 domain=$2 scene=${3:-$repo/deployment/scenes/neonatal_intubation.yaml}
   local status=0
   FAHR_NETNS_TIMEOUT=170 FAHR_RUN_LOCAL_IN_NETNS=1 \
     "$repo/tests/run_in_netns.sh" bash "$repo/deployment/run_local.sh" "$build" --mode lockstep \
-    --dds "$vendor" --domain "$domain" --duration-s 4 >"$tmp/$vendor.txt" 2>&1 || status=$?
+    --dds "$vendor" --domain "$domain" --duration-s 4 --scene "$scene" >"$tmp/$vendor.txt" 2>&1 || status=$?
   cat "$tmp/$vendor.txt"
   if [ "$status" -ne 0 ]; then
     echo "FAIL: the $vendor lockstep run exited with $status"
@@ -49,4 +52,24 @@ if ! diff "$tmp/cyclonedds.hashes" "$tmp/inprocess.hashes"; then
 fi
 # The haptic service answered with contact: the blade reached the tongue.
 grep -q "peak |F| 0.00" "$tmp/cyclonedds.txt" && { echo "FAIL: no contact force in 4 s of the script"; exit 1; }
-echo "PASS: identical hashes on both vendors and in one process"
+
+# W along the normals: the shipped scene with two solver keys changed (mesh
+# paths made absolute, the copy living in $tmp).
+sed -e "s|\.\./\.\./meshes/|$repo/meshes/|" \
+    -e "s/^  max_candidate_contacts: 16/  max_candidate_contacts: 64\n  compliance_columns: normals/" \
+    "$repo/deployment/scenes/neonatal_intubation.yaml" >"$tmp/normals.yaml"
+grep -q "^  compliance_columns: normals" "$tmp/normals.yaml" || { echo "FAIL: could not write the normals scene"; exit 1; }
+cp "$tmp/cyclonedds.hashes" "$tmp/blocks.hashes"
+run cyclonedds 63 "$tmp/normals.yaml"
+"$build/tools/stack_sim_run/fahr_stack_sim_run" --seconds 4 --scene "$tmp/normals.yaml" | tee "$tmp/normals_inprocess.txt"
+grep "^lockstep_clock: hash" "$tmp/normals_inprocess.txt" | sort >"$tmp/normals_inprocess.hashes"
+if ! diff "$tmp/cyclonedds.hashes" "$tmp/normals_inprocess.hashes"; then
+  echo "FAIL: with W along the normals the in-process run differs from the DDS run"
+  exit 1
+fi
+# The option changed the physics (the FEM's W and the rows): not the same run.
+if diff -q "$tmp/blocks.hashes" "$tmp/cyclonedds.hashes" >/dev/null; then
+  echo "FAIL: W along the normals gave the same hashes as the 3x3 blocks"
+  exit 1
+fi
+echo "PASS: identical hashes on both vendors and in one process, with W as blocks and along the normals"
