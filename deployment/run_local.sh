@@ -8,12 +8,15 @@
 #                           [--duration-s S] [--scene FILE] [--script intubation|overshoot]
 #                           [--dds-gateway V] [--dds-fem V] [--dds-haptic V]
 #                           [--mode realtime|lockstep] [--haptic-collision aist|triangle]
-#                           [--fem-tool-obstacle]
+#                           [--fem-tool-obstacle] [--cpus-fem LIST] [--cpus-haptic LIST]
 #
 # --haptic-collision triangle: the haptic service finds the blade's contacts
 # with the tongue by the triangle-level baseline instead of the AIST.
 # --fem-tool-obstacle: the FEM service keeps the whole tongue out of the
 # tool at the ContactSet's tool pose (experimental; services/fem/main/README.md).
+# --cpus-fem / --cpus-haptic: run that service on these CPUs only (its
+# --cpus, services/runtime cpu_pinning.h), e.g. --cpus-fem 1 --cpus-haptic 0
+# keeps the FEM's steps off the core the haptic tick runs on.
 # --mode lockstep: the services advance together in simulated time under
 # fahr_lockstep_clock (duration-s of simulated time, as fast as the machine
 # allows); the clock prints each service's output hash, the same on every
@@ -43,6 +46,7 @@ dds_haptic=""
 mode=realtime
 haptic_collision=aist
 fem_extra=()
+haptic_extra=()
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -57,7 +61,9 @@ while [ $# -gt 0 ]; do
     --mode) mode="$2"; shift 2 ;;
     --haptic-collision) haptic_collision="$2"; shift 2 ;;
     --fem-tool-obstacle) fem_extra+=(--tool-obstacle); shift ;;
-    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
+    --cpus-fem) fem_extra+=(--cpus "$2"); shift 2 ;;
+    --cpus-haptic) haptic_extra+=(--cpus "$2"); shift 2 ;;
+    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
@@ -144,7 +150,7 @@ wait_for_line() {
 echo "run_local: gateway $dds_gateway, fem $dds_fem, haptic $dds_haptic, domain $domain, ${duration_s} s of the '$script' script, $mode, logs in $logs"
 stdbuf -oL "$fem" --scene "$scene" "${fem_flags[@]}" "${fem_extra[@]}" --mode "$mode" --duration-s 0 >"$logs/fem.log" 2>&1 &
 fem_pid=$!; pids+=("$fem_pid")
-"$haptic" --scene "$scene" "${haptic_flags[@]}" --mode "$mode" --collision "$haptic_collision" --duration-s 0 \
+"$haptic" --scene "$scene" "${haptic_flags[@]}" "${haptic_extra[@]}" --mode "$mode" --collision "$haptic_collision" --duration-s 0 \
   >"$logs/haptic.log" 2>&1 &
 haptic_pid=$!; pids+=("$haptic_pid")
 # (stdbuf: the services print their start line with printf; line buffering

@@ -8,6 +8,7 @@
 # max over the whole run) and the number of tick periods longer than 1.5 ms.
 #
 #   tools/intubation_bench.sh [BUILD_DIR] [--seconds 60] [--dds cyclonedds] [--scene FILE]
+#                             [--cpus-fem LIST --cpus-haptic LIST] [--only aist|triangle]
 #
 # The script lasts 13 s; the gateway repeats it. Numbers depend on what
 # else the machine runs (three processes share its cores): compare the two
@@ -18,12 +19,16 @@ build="$repo/build"
 seconds=60
 dds=cyclonedds
 scene_flags=()
+pin_flags=()
+collisions=(aist triangle)
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
     --dds) dds="$2"; shift 2 ;;
     --scene) scene_flags=(--scene "$2"); shift 2 ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    --cpus-fem|--cpus-haptic) pin_flags+=("$1" "$2"); shift 2 ;;
+    --only) collisions=("$2"); shift 2 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     -*) echo "intubation_bench: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
@@ -31,16 +36,16 @@ done
 
 out=$(mktemp -d /tmp/fahr-intubation-bench-XXXXXX)
 trap 'rm -rf "$out"' EXIT
-for collision in aist triangle; do
+for collision in "${collisions[@]}"; do
   echo "intubation_bench: $collision, ${seconds} s ..." >&2
   FAHR_RUN_LOG_DIR="$out/$collision" bash "$repo/deployment/run_local.sh" "$build" --dds "$dds" \
-    --duration-s "$seconds" --haptic-collision "$collision" "${scene_flags[@]}" >"$out/$collision.txt" 2>&1 ||
+    --duration-s "$seconds" --haptic-collision "$collision" "${scene_flags[@]}" "${pin_flags[@]}" >"$out/$collision.txt" 2>&1 ||
     { cat "$out/$collision.txt" >&2; exit 1; }
 done
 
 echo "| collision | ticks | tick CPU median us | p99 us | p99.9 us | max us | periods > 1.5 ms | peak tissue reaction N | FEM states used |"
 echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|"
-for collision in aist triangle; do
+for collision in "${collisions[@]}"; do
   log="$out/$collision/haptic.log"
   line=$(grep "tick CPU us median" "$log")
   read -r median p99 p999 max ticks long <<<"$(sed -E 's/.*median ([0-9]+) p99 ([0-9]+) p99.9 ([0-9]+) max ([0-9]+) over ([0-9]+) ticks; periods > 1.5 ms: ([0-9]+).*/\1 \2 \3 \4 \5 \6/' <<<"$line")"

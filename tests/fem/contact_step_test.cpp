@@ -115,6 +115,41 @@ TEST(ContactStep, AlongNormalsGivesTheSameFreeCentresAndTheBlocksAlongTheSetsNor
   EXPECT_EQ(along.compliance_solves(), 2u);
 }
 
+TEST(ContactStep, ADivergedStepResetsTheBodyToRest) {
+  // A force no tissue takes (1e9 N on one sphere, force only) throws the
+  // bar's tip kilometres: with a divergence limit the step resets the body
+  // to rest and says so; without one the body is left where it went.
+  Bar bar;
+  ContactSet set;
+  Contact c;
+  c.sphere_id = 0;
+  c.kind = ContactKind::kForceOnly;
+  c.state = ContactState::kActive;
+  c.normal = Eigen::Vector3d(0, -1, 0);
+  c.force_n = 1e9;
+  set.contacts.push_back(c);
+  auto unchecked_body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  auto checked_body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  ASSERT_TRUE(unchecked_body && checked_body);
+  ContactStep unchecked(*unchecked_body, bar.links);
+  ContactStepSettings limit;
+  limit.divergence_limit_m = 0.1;
+  ContactStep checked(*checked_body, bar.links, limit);
+  set.state_step = unchecked_body->step_index();
+  const StepReport far = unchecked.step(&set);
+  EXPECT_FALSE(far.diverged_reset);
+  EXPECT_GT((unchecked_body->position(bar.top[0]) - unchecked_body->rest_position(bar.top[0])).norm(), 0.1);
+  const StepReport reset = checked.step(&set);
+  EXPECT_TRUE(reset.diverged_reset);
+  for (std::uint32_t n = 0; n < checked_body->node_count(); ++n) {
+    EXPECT_EQ(checked_body->position(n), checked_body->rest_position(n)) << "node " << n;
+  }
+  // And the next step, without the force, is an ordinary one.
+  const StepReport next = checked.step(nullptr);
+  EXPECT_FALSE(next.diverged_reset);
+  EXPECT_TRUE(checked_body->positions_m()[0] == checked_body->positions_m()[0]);
+}
+
 TEST(ContactStep, ReusesComplianceOnlyWhileSpheresAndFactorAreUnchanged) {
   Bar bar;
   auto body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));

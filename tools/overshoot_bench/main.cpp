@@ -75,6 +75,7 @@ struct Result {
   double displacement_after_m = -1.0;  // 1 s after the blade left the tongue
   std::uint64_t lost_ticks = 0;
   bool finite = true;
+  std::uint64_t divergence_resets = 0;  // FEM steps that diverged and reset the tongue to rest
   double wall_s = 0.0;
   // Wall time of the base steps that ran a FEM step (the FEM step, the
   // haptic tick and its digest together: an upper bound of the FEM's), ms.
@@ -448,6 +449,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   r.inverted_at_end.assign(sim.tongue_mesh().tet_count(), 0);
   mark_inverted(sim.body(), sim.tongue_mesh(), r.inverted_at_end);
   count_by_radius_ratio(sim.tongue_mesh(), r);
+  r.divergence_resets = sim.fem().divergence_resets();
   return r;
 }
 
@@ -530,6 +532,8 @@ int main(int argc, char** argv) {
     std::printf("| tongue displacement 1 s after the blade left mm | %.2f | %.2f |\n", mm(fa.displacement_after_m),
                 mm(pe.displacement_after_m));
     std::printf("| all finite | %s | %s |\n", fa.finite ? "yes" : "no", pe.finite ? "yes" : "no");
+    std::printf("| FEM steps that diverged (tongue reset to rest) | %llu | %llu |\n",
+                static_cast<unsigned long long>(fa.divergence_resets), static_cast<unsigned long long>(pe.divergence_resets));
     std::printf("| wall time s | %.1f | %.1f |\n", fa.wall_s, pe.wall_s);
     std::printf("| base step with a FEM step (FEM + haptic tick + digest) ms mean / max | %.2f / %.2f | %.2f / %.2f |\n",
                 fa.fem_base_step_mean_ms, fa.fem_base_step_max_ms, pe.fem_base_step_mean_ms, pe.fem_base_step_max_ms);
@@ -552,7 +556,7 @@ int main(int argc, char** argv) {
       std::printf("%s: %s\n", ok ? "ok" : "FAIL", what);
       failures += ok ? 0 : 1;
     };
-    expect(fa.finite, "force-aware: every force and gap finite");
+    expect(fa.finite && fa.divergence_resets == 0, "force-aware: every force and gap finite, no FEM step diverged");
     expect(fa.max_inverted == 0, "force-aware: no inverted tet");
     expect(fa.lost_ticks > 0, "force-aware: the hand pushed past the limit (lost track)");
     expect(fa.max_reaction_lost_ratio <= 1.05, "force-aware: reaction <= 1.05 x limit while lost track");

@@ -115,11 +115,12 @@ int main(int argc, char** argv) {
     }
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("stack_sim: %llu steps, %.2f s wall (%.2fx real time), peak |F| %.3f N; FEM: %llu steps, stale "
-                "contact sets %llu, max inverted elements %llu\n",
+                "contact sets %llu, max inverted elements %llu, resets after divergence %llu\n",
                 static_cast<unsigned long long>(steps), wall_s, seconds / wall_s, peak_force,
                 static_cast<unsigned long long>(sim.body().step_index()),
                 static_cast<unsigned long long>(sim.fem().stale_sets()),
-                static_cast<unsigned long long>(sim.fem().inverted_max()));
+                static_cast<unsigned long long>(sim.fem().inverted_max()),
+                static_cast<unsigned long long>(sim.fem().divergence_resets()));
     const auto& cpu = sim.haptic_tick_cpu();
     const auto& fem_cpu = sim.fem_step_cpu();
     std::printf("stack_sim: FEM step CPU ms median %.2f p99 %.2f max %.2f\n",

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "fahr/common/lockstep.h"
+#include "fahr/runtime/cpu_pinning.h"
 #include "fahr/runtime/service_options.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/solver_threads.h"
@@ -104,6 +105,7 @@ int run(int argc, char** argv) {
                "experimental: keep the whole body out of the tool at the ContactSet's tool pose, not only the "
                "set's spheres (services/fem contact_step.h set_tool_obstacle)");
   CLI11_PARSE(app, argc, argv);
+  runtime::pin_to_cpus(options.cpus);
 
   const auto scene = scene::load_scene(options.scene_path);
   const auto plan = scene::derive_plan(*scene);
@@ -138,10 +140,12 @@ int run(int argc, char** argv) {
                               : run_realtime(participant, fem_step, *scene, recorder, duration_s);
   reporter.set_state(msg::SERVICE_STOPPING);
   reporter.report();
-  std::printf("fahr_fem_service: %llu steps, stale contact sets %llu, max inverted elements %llu\n",
+  std::printf("fahr_fem_service: %llu steps, stale contact sets %llu, max inverted elements %llu, "
+              "resets after divergence %llu\n",
               static_cast<unsigned long long>(setup.body->step_index()),
               static_cast<unsigned long long>(fem_step.stale_sets()),
-              static_cast<unsigned long long>(fem_step.inverted_max()));
+              static_cast<unsigned long long>(fem_step.inverted_max()),
+              static_cast<unsigned long long>(fem_step.divergence_resets()));
   return status;
 }
 

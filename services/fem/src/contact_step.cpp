@@ -231,6 +231,18 @@ void ContactStep::update_free_centres() {
   }
 }
 
+bool ContactStep::diverged() const {
+  const auto x = body_.positions_m();
+  const double limit2 = settings_.divergence_limit_m * settings_.divergence_limit_m;
+  for (std::size_t n = 0; n < body_.node_count(); ++n) {
+    const Eigen::Vector3d moved =
+        Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]) - body_.rest_position(static_cast<std::uint32_t>(n));
+    // Written so that a NaN counts as diverged.
+    if (!(moved.squaredNorm() <= limit2)) return true;
+  }
+  return false;
+}
+
 // Gauss-Seidel between the tool and the bone: the ContactSet's projection,
 // the tool obstacle's pass (if set), then the anatomy's pass; again while
 // the anatomy's moves broke a tool constraint, up to the round limit. The
@@ -314,6 +326,12 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   projection_.obstacle_supported = static_cast<int>(body_.support_count());
   report.projection = projection_;
   report.contacts_applied = contacts != nullptr;
+  if (settings_.divergence_limit_m > 0.0 && diverged()) {
+    // Rare and off the 1 kHz path: the reset refactorises (CHOLMOD allocates).
+    body_.reset_to_rest();
+    reset();
+    report.diverged_reset = true;
+  }
   return report;
 }
 

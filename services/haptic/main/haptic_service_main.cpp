@@ -26,6 +26,7 @@
 #include "fahr/common/subscriber.h"
 #include "fahr/runtime/scene_transport.h"
 #include "fahr/runtime/service_main.h"
+#include "fahr/runtime/cpu_pinning.h"
 #include "fahr/runtime/service_options.h"
 #include "fahr/scene/load_scene.h"
 #include "haptic_loop.h"
@@ -199,6 +200,7 @@ int run(int argc, char** argv) {
                  "tool-tissue collision: aist (the paper's spheres) or triangle (the baseline it is measured against)")
       ->check(CLI::IsMember({"aist", "triangle"}));
   CLI11_PARSE(app, argc, argv);
+  runtime::pin_to_cpus(options.cpus);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // log lines reach a launcher's log file as they happen
 
   const auto scene = scene::load_scene(options.scene_path);

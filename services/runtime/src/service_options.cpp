@@ -22,6 +22,7 @@ void add_service_options(CLI::App& app, ServiceOptions& o) {
                  "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");
   app.add_option("--mode", o.mode, "realtime or lockstep (default: the scene's run.mode)")
       ->check(CLI::IsMember({"realtime", "lockstep"}));
+  app.add_option("--cpus", o.cpus, "run on these CPUs only, e.g. 0 or 0-1 (default: wherever the kernel puts it)");
 }
 
 }  // namespace fahr::runtime

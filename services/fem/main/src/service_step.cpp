@@ -1,11 +1,23 @@
 // One FEM service step: wire ContactSet in, DeformationState out.
 #include "fahr/fem_service/service_step.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 
 #include "fahr/fem_service/contact_conversion.h"
 
 namespace fahr::fem_service {
+namespace {
+
+// Twice the rest body's box diagonal: no deformation moves a node that far,
+// a diverged step does (ContactStepSettings::divergence_limit_m).
+double divergence_limit_m(const geometry::TetMesh& mesh) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& x : mesh.rest_positions()) box.extend(x);
+  return box.isEmpty() ? 0.0 : 2.0 * box.diagonal().norm();
+}
+
+}  // namespace
 
 ServiceStep::ServiceStep(FemBodySetup& setup)
     : setup_(setup),
@@ -13,7 +25,8 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
                     fem::ContactStepSettings{.apply_contact_forces = true,
                                              .max_compliance_spheres = setup.settings.max_compliance_spheres,
                                              .spread = setup.sphere_spread,
-                                             .compliance_along_normals = setup.compliance_along_normals}) {
+                                             .compliance_along_normals = setup.compliance_along_normals,
+                                             .divergence_limit_m = divergence_limit_m(setup.mesh)}) {
   const std::size_t cap = setup.settings.max_compliance_spheres;
   std::vector<const fem::ObstacleField*> anatomy;
   if (setup.enforce_anatomy) {
@@ -54,6 +67,7 @@ void ServiceStep::step() {
   }
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
   inverted_max_ = std::max<std::uint64_t>(inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
+  if (last_report_.diverged_reset) ++divergence_resets_;
   anatomy_depth_max_m_ = std::max(anatomy_depth_max_m_, last_report_.projection.obstacle_deepest_m);
   fill_state(*setup_.body, setup_.scene_body->id, state_);
   state_.stale_contact_sets(static_cast<std::uint32_t>(stale_sets_));
@@ -84,6 +98,7 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets_));
   out.emplace_back("compliance_reuses", static_cast<double>(contact_step_.compliance_reuses()));
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));
+  out.emplace_back("divergence_resets", static_cast<double>(divergence_resets_));
   out.emplace_back("projection_sweeps_last", static_cast<double>(last_report_.projection.sweeps));
   out.emplace_back("anatomy_nodes_last", static_cast<double>(last_report_.projection.obstacle_nodes));
   out.emplace_back("anatomy_depth_mm_max", 1e3 * anatomy_depth_max_m_);

@@ -65,6 +65,9 @@ struct StepReport {
   bool contacts_applied = false;
   bool contacts_stale = false;
   bool contacts_invalid = false;  // links reference nodes this body lacks
+  // ContactStep: the step left a node non-finite or farther from rest than
+  // ContactStepSettings::divergence_limit_m, so the body was reset to rest.
+  bool diverged_reset = false;
   ProjectionReport projection;
   double kinetic_energy_j = 0.0;  // after the step, J
   double residual_force_n = 0.0;  // |f| over free DOFs at the start, N

@@ -58,6 +58,11 @@ struct ContactStepSettings {
   // solves buy three times the spheres. Ignored with fixed spheres (they
   // have no normals before a set names them).
   bool compliance_along_normals = false;
+  // A step that leaves some node non-finite or farther than this from its
+  // rest position has diverged (no tissue deforms by more than its size):
+  // the body is reset to rest, its carried correction and forces dropped,
+  // and the step reports diverged_reset. 0: no check.
+  double divergence_limit_m = 0.0;
 };
 
 class ContactStep {
@@ -137,6 +142,7 @@ class ContactStep {
   void update_compliance(bool refactorised);
   bool along_normals() const { return settings_.compliance_along_normals && !fixed_spheres_; }
   void update_free_centres();
+  bool diverged() const;
   // The ContactSet's projection (may be null) and the anatomy's, then the
   // positions and the carried correction written back.
   void project(const ContactSet* contacts);

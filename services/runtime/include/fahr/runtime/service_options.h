@@ -17,6 +17,7 @@ struct ServiceOptions {
   std::string profile;  // empty: FAHR_DDS_PROFILE, else none
   std::string mode;     // empty: the scene's run.mode
   double duration_s = -1.0;  // < 0: the scene's run.duration_s; 0: until SIGINT/SIGTERM
+  std::string cpus;          // empty: wherever the kernel puts it (cpu_pinning.h)
 
   // Lockstep when --mode says so, else when the scene does.
   bool lockstep(const scene::Scene& scene) const;
@@ -24,7 +25,7 @@ struct ServiceOptions {
   double duration_or_scene_s(const scene::Scene& scene) const;
 };
 
-// Adds --scene (required), --dds, --domain, --dds-profile, --duration-s, --mode.
+// Adds --scene (required), --dds, --domain, --dds-profile, --duration-s, --mode, --cpus.
 void add_service_options(CLI::App& app, ServiceOptions& options);
 
 }  // namespace fahr::runtime

@@ -42,6 +42,9 @@ class ServiceStep {
   const FemBodySetup& setup() const { return setup_; }
   std::uint64_t stale_sets() const { return stale_sets_; }
   std::uint64_t inverted_max() const { return inverted_max_; }
+  // Steps after which the body had diverged and was reset to rest
+  // (fem::StepReport::diverged_reset).
+  std::uint64_t divergence_resets() const { return divergence_resets_; }
   // Deepest a node went into the anatomy before the step moved it out, m.
   double anatomy_depth_max_m() const { return anatomy_depth_max_m_; }
 
@@ -64,6 +67,7 @@ class ServiceStep {
   msg::DeformationState state_;
   fem::StepReport last_report_;
   std::uint64_t inverted_max_ = 0;
+  std::uint64_t divergence_resets_ = 0;
   double anatomy_depth_max_m_ = 0.0;
   std::uint64_t stale_sets_ = 0;
 };
