@@ -260,6 +260,16 @@ struct RunChoices {
   std::string tick_trace_path;
 };
 
+// PREFIX.<response>.csv with its header line; null when PREFIX is empty.
+std::FILE* open_trace(const std::string& prefix, const std::string& response, const char* header) {
+  if (prefix.empty()) return nullptr;
+  const std::string path = prefix + "." + response + ".csv";
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (file == nullptr) throw std::runtime_error("cannot write " + path);
+  std::fputs(header, file);
+  return file;
+}
+
 Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunChoices& choices) {
   const double factor = choices.factor;
   const double youngs_pa = choices.youngs_pa;
@@ -300,26 +310,14 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   Result r;
   r.name = penalty ? "penalty" : "force-aware";
   r.ever_inverted.assign(sim.tongue_mesh().tet_count(), 0);
-  std::FILE* trace = nullptr;
-  if (!trace_path.empty()) {
-    const std::string path = trace_path + "." + r.name + ".csv";
-    trace = std::fopen(path.c_str(), "w");
-    if (trace == nullptr) throw std::runtime_error("cannot write " + path);
-    std::fprintf(trace,
+  std::FILE* trace = open_trace(trace_path, r.name,
                  "t_s,inverted,inverted_near_anatomy,inverted_near_blade,anatomy_nodes,anatomy_depth_mm,"
                  "anatomy_unresolved,anatomy_rounds,sweeps,tool_active,tool_frozen,force_only,obstacle_contacts,"
                  "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,inverted_free,fem_cpu_ms,supported_nodes\n");
-  }
-  std::FILE* tick_trace = nullptr;
-  if (!tick_trace_path.empty()) {
-    const std::string path = tick_trace_path + "." + r.name + ".csv";
-    tick_trace = std::fopen(path.c_str(), "w");
-    if (tick_trace == nullptr) throw std::runtime_error("cannot write " + path);
-    std::fprintf(tick_trace,
+  std::FILE* tick_trace = open_trace(tick_trace_path, r.name,
                  "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,proxy_z,gap_mm,"
                  "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,obstacle_reaction_n,rows,"
                  "pgs_converged,contacts_found,fem_step,pgs_sweeps,missing_compliance\n");
-  }
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
   bool seen_1x = false, was_lost = false, reengaged = false, left = false;

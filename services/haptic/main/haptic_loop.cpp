@@ -66,6 +66,7 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
       tool_memory_(setup.layout.size()),
       tool_contacts_(kToolContactCapacity),
       order_(kToolContactCapacity, 0),
+      row_key_(kToolContactCapacity, 0.0),
       anatomy_contacts_(kAnatomyContactCapacity),
       anatomy_order_(kAnatomyContactCapacity, 0),
       tissue_row_budget_(std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES, setup.response.max_rows)),
@@ -120,39 +121,36 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   return d;
 }
 
-// RowCompliance::kKeep, kFreeDepth (haptic_setup.h).
-std::size_t HapticLoop::select_compliance_first(const TissueSnapshot& tissue) {
+// The rows' order of choice (haptic_setup.h RowCompliance): the k deepest,
+// the deepest with a W sphere's depth taken on its free centre, or the W
+// spheres first. Keys are worked out once per contact, then partially
+// sorted, as select_deepest does for the depth alone.
+std::size_t HapticLoop::select_rows(const TissueSnapshot& tissue) {
+  if (setup_.row_compliance == RowCompliance::kDeepest) {
+    return haptic::select_deepest(tool_contacts_, tissue_row_budget_, order_);
+  }
   const std::size_t n = std::min(tool_contacts_.size(), order_.size());
   std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
   if (n <= tissue_row_budget_) return n;
-  if (setup_.row_compliance == RowCompliance::kFreeDepth) {
-    // |c - c_free| stands for (c - c_free) . n: the FEM's shift is along
-    // the pushing normals.
-    const auto free_depth = [&](std::uint32_t i) {
-      const std::int32_t w = tissue.compliance_index[tool_contacts_[i].sphere_id];
-      return tool_contacts_[i].depth_m + (w >= 0 ? double{tissue.free_shift_m[static_cast<std::size_t>(w)]} : 0.0);
-    };
-    std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
-                      order_.begin() + static_cast<std::ptrdiff_t>(n),
-                      [&](std::uint32_t a, std::uint32_t b) { return free_depth(a) > free_depth(b); });
-    return tissue_row_budget_;
+  const bool free_depth = setup_.row_compliance == RowCompliance::kFreeDepth;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t w = tissue.compliance_index[tool_contacts_[i].sphere_id];
+    double key = tool_contacts_[i].depth_m;
+    // kFreeDepth: |c - c_free| stands for (c - c_free) . n, the FEM's shift
+    // being along the pushing normals. kKeep: a metre ahead of any depth.
+    if (w >= 0) key += free_depth ? double{tissue.free_shift_m[static_cast<std::size_t>(w)]} : 1.0;
+    row_key_[i] = key;
   }
-  const auto has_block = [&](std::uint32_t i) { return tissue.compliance_index[tool_contacts_[i].sphere_id] >= 0; };
   std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
-                    order_.begin() + static_cast<std::ptrdiff_t>(n), [&](std::uint32_t a, std::uint32_t b) {
-                      const bool wa = has_block(a), wb = has_block(b);
-                      if (wa != wb) return wa;
-                      return tool_contacts_[a].depth_m > tool_contacts_[b].depth_m;
-                    });
+                    order_.begin() + static_cast<std::ptrdiff_t>(n),
+                    [&](std::uint32_t a, std::uint32_t b) { return row_key_[a] > row_key_[b]; });
   return tissue_row_budget_;
 }
 
 void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
   // More than W can cover: keep the deepest (touching before candidates),
   // and only those get their point and normal (defer_outside_contacts).
-  const std::size_t keep = setup_.row_compliance != RowCompliance::kDeepest
-                                ? select_compliance_first(tissue)
-                                : haptic::select_deepest(tool_contacts_, tissue_row_budget_, order_);
+  const std::size_t keep = select_rows(tissue);
   relaxed_add<std::uint64_t>(metrics_.rows_dropped, tool_contacts_.size() - keep);
   haptic::complete_deferred(tissue.tree, tool_body_, tool_query_, tool_contacts_, order_.data(), keep);
   // (The penalty baseline's forces are part of the FEM's step, so it reads

@@ -81,7 +81,7 @@ class HapticLoop {
  private:
   contact::DeviceSample device_sample(const msg::DevicePose& pose);
   void collect_tissue_rows(const TissueSnapshot& tissue);
-  std::size_t select_compliance_first(const TissueSnapshot& tissue);
+  std::size_t select_rows(const TissueSnapshot& tissue);
   void collect_triangle_rows(const TissueSnapshot& tissue);
   void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
   const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device, const TissueSnapshot& tissue);
@@ -100,6 +100,7 @@ class HapticLoop {
   haptic::PrePenetrationMemory tool_memory_;
   haptic::ContactBuffer tool_contacts_;
   std::vector<std::uint32_t> order_;  // indices into tool_contacts_, deepest first when over capacity
+  std::vector<double> row_key_;       // per contact: select_rows' key (RowCompliance other than kDeepest)
   // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
   std::vector<haptic::TriangleContact> triangle_contacts_;
   std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1

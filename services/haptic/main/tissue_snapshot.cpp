@@ -127,6 +127,8 @@ void TissueDigest::index_compliance(const msg::DeformationState& state, TissueSn
     out.have_compliance_normals = true;
   }
   out.compliance_count = k;
+  // Without free centres no sphere has moved off its published centre.
+  std::fill_n(out.free_shift_m.begin(), k, 0.0f);
   if (state.compliance_free_centres_m().size() >= 3 * k) {
     std::copy_n(state.compliance_free_centres_m().data(), 3 * k, out.free_centres_m.data());
     out.have_free_centres = true;
