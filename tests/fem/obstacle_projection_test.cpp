@@ -245,6 +245,35 @@ TEST(ObstacleProjection, ANodeDrivenPastAThinPlateIsPutBackOnItsOwnSide) {
   EXPECT_NEAR(x[4], 0.5e-3 + kMargin, 1e-9);
 }
 
+TEST(ObstacleProjection, ANodeBeyondAPlateFromItsRestMayCrossBackHome) {
+  // Both nodes rest 2 mm above the 1 mm plate. Node 0 is below it (it got
+  // there somehow) and its step takes it back above: with the rest
+  // positions it is let through, without them it is put back below, where
+  // path-following would keep it for good. Node 1 is above, at home, and is
+  // driven through to below: it is stopped at the plate whatever its rest.
+  const Plate plate(0.0, 0.5e-3);
+  const ObstacleField* fields[] = {&plate};
+  const std::vector<double> rest = {0.0, 2e-3, 0.0, 1e-3, 2e-3, 0.0};
+  const std::vector<double> start = {0.0, -1.5e-3, 0.0, 1e-3, 1.5e-3, 0.0};
+  const std::vector<double> end = {0.0, 1.2e-3, 0.0, 1e-3, -1.5e-3, 0.0};
+  const std::vector<double> inverse_mass = {1.0, 1.0};
+  for (const bool with_rest : {true, false}) {
+    ObstacleProjection projection(fields, 2);
+    std::vector<double> x = end;
+    projection.begin_step();
+    ProjectionReport report;
+    projection.project(x, inverse_mass, report, start, with_rest ? std::span<const double>(rest) : std::span<const double>());
+    if (with_rest) {
+      EXPECT_EQ(x[1], end[1]);
+      EXPECT_EQ(projection.nodes_returned(), 1);
+    } else {
+      EXPECT_NEAR(x[1], -0.5e-3 - kMargin, 1e-9);
+      EXPECT_EQ(projection.nodes_returned(), 0);
+    }
+    EXPECT_NEAR(x[4], 0.5e-3 + kMargin, 1e-9) << with_rest;
+  }
+}
+
 TEST(ObstacleProjection, FarNodesAreNotSampledEveryStep) {
   // A floor 20 mm below a bar that stays put: once sampled, every node's
   // clearance proves it clear and the field is not asked again.

@@ -71,6 +71,7 @@ TEST(Projection, TranslationSpreadMovesEveryFreeNodeAlike) {
 TEST(Projection, FrozenConstraintHoldsExactly) {
   const TetMesh mesh = test::bar_mesh(2);
   BodySettings settings;
+  settings.projection.frozen_target = FrozenTarget::kHoldCentre;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
   ASSERT_NE(body, nullptr);
   const std::size_t tip_tet = mesh.tets.size() - 1;
@@ -89,6 +90,68 @@ TEST(Projection, FrozenConstraintHoldsExactly) {
     const Eigen::Vector3d centre = links.centre(0, body->positions_m().data());
     ASSERT_NEAR((centre - hold).norm(), 0.0, 1e-14) << "step " << k;
   }
+}
+
+// The default target, the paper's c' = c: a frozen sphere stays where the
+// step found it, whatever hold centre the set carries, so the bar's tip,
+// frozen mid-fall, stays put under gravity.
+TEST(Projection, FrozenSphereStaysWhereTheStepStarted) {
+  const TetMesh mesh = test::bar_mesh(2);
+  BodySettings settings;
+  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(body, nullptr);
+  const SphereLinks links = links_for_tets(mesh, {mesh.tets.size() - 1}, 0.002);
+  for (int k = 0; k < 20; ++k) body->step();  // falling
+  const Eigen::Vector3d where = links.centre(0, body->positions_m().data());
+  ContactSet set;
+  Contact frozen;
+  frozen.sphere_id = 0;
+  frozen.state = ContactState::kFrozen;
+  frozen.hold_centre_m = where + Eigen::Vector3d(0, 0.005, 0);  // ignored
+  set.contacts.push_back(frozen);
+  for (int k = 0; k < 100; ++k) {
+    set.state_step = body->step_index();
+    body->step(&set, &links);
+    ASSERT_NEAR((links.centre(0, body->positions_m().data()) - where).norm(), 0.0, 1e-12) << "step " << k;
+  }
+}
+
+// Holds that contradict each other: two spheres over the same nodes, their
+// hold centres 6 mm apart. Pulled to such targets in turn, the nodes follow
+// neither (the neonatal overshoot's holds did this, 2-7 mm apart, and moved
+// a node 153 mm in one step); held where the step started they do not move.
+TEST(Projection, ContradictoryHoldsDoNotDragTheNodes) {
+  const TetMesh mesh = test::bar_mesh(2);
+  const std::size_t tip_tet = mesh.tets.size() - 1;
+  double moved[2] = {0.0, 0.0};
+  for (const FrozenTarget target : {FrozenTarget::kStepStart, FrozenTarget::kHoldCentre}) {
+    BodySettings settings;
+    settings.projection.frozen_target = target;
+    settings.gravity_m_per_s2 = Eigen::Vector3d::Zero();
+    auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+    ASSERT_NE(body, nullptr);
+    SphereLinks links;
+    const std::array<double, 4> a = {0.7, 0.1, 0.1, 0.1};
+    const std::array<double, 4> b = {0.1, 0.1, 0.1, 0.7};
+    ASSERT_EQ(links.add_sphere(mesh.tets[tip_tet], a, 0.001), "");
+    ASSERT_EQ(links.add_sphere(mesh.tets[tip_tet], b, 0.001), "");
+    const std::vector<double> rest(body->positions_m().begin(), body->positions_m().end());
+    ContactSet set;
+    for (std::uint32_t s = 0; s < 2; ++s) {
+      Contact frozen;
+      frozen.sphere_id = s;
+      frozen.state = ContactState::kFrozen;
+      frozen.hold_centre_m = links.centre(s, rest.data()) + Eigen::Vector3d(0, s == 0 ? 0.003 : -0.003, 0);
+      set.contacts.push_back(frozen);
+    }
+    set.state_step = body->step_index();
+    body->step(&set, &links);
+    double largest = 0.0;
+    for (std::size_t i = 0; i < rest.size(); ++i) largest = std::max(largest, std::abs(body->positions_m()[i] - rest[i]));
+    moved[target == FrozenTarget::kStepStart ? 0 : 1] = largest;
+  }
+  EXPECT_LT(moved[0], 1e-9);
+  EXPECT_GT(moved[1], 3e-3);  // the contradiction dragged them
 }
 
 TEST(Projection, ActiveConstraintLeavesNoPenetration) {
@@ -140,6 +203,7 @@ TEST(Projection, ActiveConstraintLeavesNoPenetration) {
 std::vector<double> run_schedule(bool (*schedule)(int), bool repeat_old) {
   const TetMesh mesh = test::bar_mesh(2);
   BodySettings settings;
+  settings.projection.frozen_target = FrozenTarget::kHoldCentre;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
   const SphereLinks links = links_for_tets(mesh, {mesh.tets.size() - 1}, 0.002);
   ContactSet set;

@@ -144,6 +144,8 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
   settings.time_step = std::chrono::milliseconds(10);
   settings.solver.refactor_period = 0;  // refactorise on 0.1 rad of rotation
   settings.sleep.enabled = false;
+  // The press is driven through the frozen holds' centres.
+  settings.projection.frozen_target = FrozenTarget::kHoldCentre;
   auto made = Body::create(settings, mesh.nodes_m, mesh.tets, tongue_base(mesh));
   ASSERT_EQ(made.error, "");
   Body& body = *made.body;

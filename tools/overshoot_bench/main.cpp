@@ -8,13 +8,16 @@
 //   fahr_overshoot_bench [--scene FILE] [--factor 3] [--response both|force-aware|penalty]
 //                        [--fem-anatomy on|off] [--fem-support RATIO] [--youngs-pa E] [--tool-stops on|off]
 //                        [--stiffening C20/C10]
-//                        [--sphere-spread service|mass|translation]
+//                        [--sphere-spread service|mass|translation] [--frozen-target service|step-start|hold-centre]
 //                        [--trace FILE] [--check]
 //
 // --fem-anatomy off: the FEM leaves the anatomy to the haptic side's
 // obstacle contacts (as before the FEM kept its own nodes out of bone).
 // --sphere-spread: how the FEM shares a tool contact's correction among the
 // sphere's nodes (services/fem projection.h), instead of the service's choice.
+// --frozen-target: where the FEM holds a frozen sphere (projection.h
+// FrozenTarget): its centre at the step's start (the service's) or the
+// haptic side's hold centre (before).
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
 // (services/fem compression_stiffening.h; 0: off), instead of the scene's.
 // --trace: one CSV line per FEM step of each run (FILE with the response's
@@ -252,6 +255,7 @@ struct RunChoices {
   double stiffening = -1.0;     // < 0: the scene's
   std::string tool_stops = "scene";
   std::string spread = "service";
+  std::string frozen_target = "service";
   std::string held_proxy = "limit";
   bool fem_tool_obstacle = false;
   std::string row_compliance = "scene";
@@ -306,6 +310,8 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   if (choices.row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(choices.row_compliance);
   if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
   if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
+  if (choices.frozen_target == "step-start") options.frozen_target = fem::FrozenTarget::kStepStart;
+  if (choices.frozen_target == "hold-centre") options.frozen_target = fem::FrozenTarget::kHoldCentre;
   stack_sim::StackSim sim(variant, options);
   Result r;
   r.name = penalty ? "penalty" : "force-aware";
@@ -464,6 +470,10 @@ int main(int argc, char** argv) {
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--sphere-spread", choices.spread, "how the FEM spreads a sphere's correction (default: the service's)")
       ->check(CLI::IsMember({"service", "mass", "translation"}));
+  app.add_option("--frozen-target", choices.frozen_target,
+                 "where the FEM holds a frozen sphere: its centre at the step's start or the haptic side's hold centre "
+                 "(default: the service's)")
+      ->check(CLI::IsMember({"service", "step-start", "hold-centre"}));
   app.add_option("--response", response, "which response to run")
       ->check(CLI::IsMember({"both", "force-aware", "penalty"}));
   app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")

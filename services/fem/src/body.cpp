@@ -331,7 +331,8 @@ void Body::integrate_and_project(const ContactSet* contacts, const SphereLinks* 
   }
   report.contacts_applied = true;
   report.projection = project_contacts(*contacts, *links, inverse_mass_, settings_.projection,
-                                       {x_.data(), static_cast<std::size_t>(x_.size())});
+                                       {x_.data(), static_cast<std::size_t>(x_.size())},
+                                       {x_start_.data(), static_cast<std::size_t>(x_start_.size())});
   v_ = (x_ - x_start_) / h_;
 }
 

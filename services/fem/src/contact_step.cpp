@@ -21,6 +21,7 @@ bool carries_force(const Contact& c) {
 ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStepSettings& settings)
     : body_(body), links_(links), settings_(settings), projection_settings_(body.settings().projection) {
   projection_settings_.spread = settings_.spread;
+  projection_settings_.frozen_target = settings_.frozen_target;
   const std::size_t dofs = 3 * body.node_count();
   const std::size_t k = settings_.max_compliance_spheres;
   carry_n_.assign(dofs, 0.0);
@@ -268,7 +269,8 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
   }
   for (int round = 0; round < rounds; ++round) {
     if (tool) {
-      projection_ = project_contacts(*contacts, links_, inverse_mass, projection_settings_, projected_);
+      projection_ =
+          project_contacts(*contacts, links_, inverse_mass, projection_settings_, projected_, start_positions_);
       sweeps += projection_.sweeps;
       // The anatomy's last pass moved nothing the tool constraints needed.
       if (round > 0 && projection_.sweeps <= 1 && projection_.converged) break;
@@ -280,7 +282,9 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
     }
     if (!obstacles_) break;
     ++anatomy.obstacle_rounds;
-    if (obstacles_->project(projected_, inverse_mass, anatomy, start_positions_) == 0 || !tool) break;
+    if (obstacles_->project(projected_, inverse_mass, anatomy, start_positions_, body_.rest_positions_m()) == 0 ||
+        !tool)
+      break;
   }
   projection_.sweeps = sweeps;
   projection_.tool_nodes = tool_nodes;

@@ -23,6 +23,10 @@ constexpr int kEntryIterations = 6;
 constexpr double kMinPathStep = 1e-4;
 // Beyond this many samples a path is left to the push along the normal.
 constexpr int kPathSteps = 32;
+// Samples of the trace that decides whether a node is going home (from its
+// rest position, up to a few centimetres): beyond them it is undecided and
+// the node is treated as not going home.
+constexpr int kHomeTraceSteps = 256;
 
 }  // namespace
 
@@ -41,6 +45,21 @@ ObstacleProjection::ObstacleProjection(std::span<const ObstacleField* const> fie
 void ObstacleProjection::begin_step() {
   std::fill(moved_.begin(), moved_.end(), std::uint8_t{0});
   nodes_moved_ = 0;
+  nodes_returned_ = 0;
+}
+
+bool ObstacleProjection::segment_enters(const ObstacleField& field, const Eigen::Vector3d& a,
+                                        const Eigen::Vector3d& b, double level_m) const {
+  const double length = (b - a).norm();
+  const Eigen::Vector3d direction = length > 0.0 ? Eigen::Vector3d((b - a) / length) : Eigen::Vector3d::Zero();
+  double t = 0.0;
+  for (int i = 0; i < kHomeTraceSteps; ++i) {
+    const double d = field.sample(a + std::min(t, length) * direction).distance_m;
+    if (!std::isfinite(d) || d < level_m) return true;
+    if (t >= length) return false;
+    t += std::max(d - level_m, kMinPathStep);
+  }
+  return true;
 }
 
 void ObstacleProjection::forget_clearances() { std::fill(clearance_m_.begin(), clearance_m_.end(), kUnsampled); }
@@ -115,7 +134,8 @@ double ObstacleProjection::enter_along_path(const ObstacleField& field, const Ei
 // A move out of one obstacle may take a node toward another sampled before;
 // the clearances record it and the next round's pass catches it.
 ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t node, const Eigen::Vector3d* start,
-                                                                 Eigen::Vector3d& x, ProjectionReport& report) {
+                                                                 const Eigen::Vector3d* rest, Eigen::Vector3d& x,
+                                                                 ProjectionReport& report) {
   const double margin = settings_.margin_m;
   spend_clearance(node, (x - sampled_at_m_[node]).norm());
   sampled_at_m_[node] = x;
@@ -129,7 +149,17 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
     if (start != nullptr && s.distance_m - (x - *start).norm() < margin) {
       // The path from the step's start comes closer to this obstacle than
       // the margin somewhere, or may have: follow it from the start.
-      const double back = enter_along_path(*fields_[f], *start, x, s, report);
+      const Eigen::Vector3d end = x;
+      const ObstacleSample end_sample = s;
+      double back = enter_along_path(*fields_[f], *start, x, s, report);
+      if (back > 0.0 && rest != nullptr && s.distance_m >= 0.0 && end_sample.distance_m >= 0.0 &&
+          !segment_enters(*fields_[f], *rest, end, 0.0) && segment_enters(*fields_[f], *rest, *start, 0.0)) {
+        // Beyond the bone and going home through it: let it.
+        x = end;
+        s = end_sample;
+        back = 0.0;
+        ++nodes_returned_;
+      }
       if (back > 0.0) {
         spend_clearance(node, back);
         moved = true;
@@ -159,7 +189,8 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
 }
 
 int ObstacleProjection::project(std::span<double> positions_m, std::span<const double> inverse_mass_per_node,
-                                ProjectionReport& report, std::span<const double> start_positions_m) {
+                                ProjectionReport& report, std::span<const double> start_positions_m,
+                                std::span<const double> rest_positions_m) {
   if (fields_.empty()) return 0;
   int moved_now = 0;
   report.obstacle_unresolved = 0;
@@ -177,7 +208,10 @@ int ObstacleProjection::project(std::span<double> positions_m, std::span<const d
     const bool have_start = start_positions_m.size() >= 3 * (n + 1);
     if (have_start) start = Eigen::Map<const Eigen::Vector3d>(start_positions_m.data() + 3 * n);
     const bool start_usable = have_start && start.allFinite();
-    const NodeOutcome outcome = project_node(n, start_usable ? &start : nullptr, x, report);
+    const bool have_rest = rest_positions_m.size() >= 3 * (n + 1);
+    Eigen::Vector3d rest = Eigen::Vector3d::Zero();
+    if (have_rest) rest = Eigen::Map<const Eigen::Vector3d>(rest_positions_m.data() + 3 * n);
+    const NodeOutcome outcome = project_node(n, start_usable ? &start : nullptr, have_rest ? &rest : nullptr, x, report);
     if (outcome == NodeOutcome::kNonFinite || !x.allFinite()) {
       // Leave the node where the step put it and sample it afresh next time.
       std::fill_n(clearance_m_.data() + n * fields_.size(), fields_.size(), kUnsampled);

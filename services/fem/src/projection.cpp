@@ -66,8 +66,10 @@ bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
 
 ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks& links,
                                   std::span<const double> inverse_mass_per_node,
-                                  const ProjectionSettings& settings, std::span<double> positions_m) {
+                                  const ProjectionSettings& settings, std::span<double> positions_m,
+                                  std::span<const double> step_start_m) {
   ProjectionReport report;
+  const bool hold_at_start = settings.frozen_target == FrozenTarget::kStepStart && !step_start_m.empty();
   for (const Contact& contact : contacts.contacts) {
     if (contact_is_projected(contact, settings)) ++report.constraints;
   }
@@ -87,7 +89,9 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
       const Eigen::Vector3d centre = links.centre(contact.sphere_id, positions_m.data());
       Eigen::Vector3d dc = Eigen::Vector3d::Zero();
       if (contact_is_frozen(contact)) {
-        dc = contact.hold_centre_m - centre;
+        const Eigen::Vector3d target =
+            hold_at_start ? links.centre(contact.sphere_id, step_start_m.data()) : contact.hold_centre_m;
+        dc = target - centre;
       } else {
         const double length = contact.normal.norm();
         if (!(length > kMinNormalLength)) {

@@ -47,6 +47,7 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   fem_setup_.enforce_anatomy = options.fem_anatomy;
   if (options.fem_support_ratio) fem_setup_.anatomy_settings.support_stiffness_ratio = *options.fem_support_ratio;
   if (options.sphere_spread) fem_setup_.sphere_spread = *options.sphere_spread;
+  if (options.frozen_target) fem_setup_.frozen_target = *options.frozen_target;
   if (options.fem_tool_obstacle) fem_setup_.tool = fem_service::load_tool_field(*scene_);
   fem_ = std::make_unique<fem_service::ServiceStep>(fem_setup_);
   contacts_.contacts().reserve(msg::MAX_CONTACTS);

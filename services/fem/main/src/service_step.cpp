@@ -25,6 +25,7 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
                     fem::ContactStepSettings{.apply_contact_forces = true,
                                              .max_compliance_spheres = setup.settings.max_compliance_spheres,
                                              .spread = setup.sphere_spread,
+                                             .frozen_target = setup.frozen_target,
                                              .compliance_along_normals = setup.compliance_along_normals,
                                              .divergence_limit_m = divergence_limit_m(setup.mesh)}) {
   const std::size_t cap = setup.settings.max_compliance_spheres;

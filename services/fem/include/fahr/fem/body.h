@@ -151,6 +151,7 @@ class Body {
   std::span<const double> velocities_m_per_s() const { return {v_.data(), static_cast<std::size_t>(v_.size())}; }
   Eigen::Vector3d position(std::uint32_t node) const { return x_.segment<3>(3 * Eigen::Index{node}); }
   Eigen::Vector3d rest_position(std::uint32_t node) const { return rest_x_.segment<3>(3 * Eigen::Index{node}); }
+  std::span<const double> rest_positions_m() const { return {rest_x_.data(), static_cast<std::size_t>(rest_x_.size())}; }
   std::span<const double> mass_kg() const { return mass_kg_; }
   std::span<const double> inverse_mass_per_kg() const { return inverse_mass_; }
   bool fixed(std::uint32_t node) const { return inverse_mass_[node] == 0.0; }

@@ -18,7 +18,7 @@ enum class ContactKind : std::uint8_t {
 
 enum class ContactState : std::uint8_t {
   kActive,     // (c' - q) . n >= r
-  kFrozen,     // c' = hold_centre_m
+  kFrozen,     // c' = c, where the step found it (or hold_centre_m: projection.h FrozenTarget)
   kCandidate,  // near, not touching: only its compliance is wanted
 };
 
@@ -30,7 +30,9 @@ struct Contact {
   // and the unit normal pointing from that surface toward the sphere centre.
   Eigen::Vector3d plane_point_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
-  Eigen::Vector3d hold_centre_m = Eigen::Vector3d::Zero();  // frozen target, m
+  // The haptic side's estimate of where the tool holds a frozen sphere, m;
+  // the FEM holds it there only with FrozenTarget::kHoldCentre.
+  Eigen::Vector3d hold_centre_m = Eigen::Vector3d::Zero();
   double penetration_m = 0.0;  // as the haptic side saw it, m (reported only)
   double force_n = 0.0;        // contact force lambda the haptic solve found, N
 };

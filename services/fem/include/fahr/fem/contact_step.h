@@ -53,6 +53,8 @@ struct ContactStepSettings {
   // How the ContactSet's sphere corrections are shared by the nodes
   // (projection.h); overrides the body's projection setting.
   SphereSpread spread = SphereSpread::kMassWeighted;
+  // Where a frozen tool contact holds its sphere (projection.h).
+  FrozenTarget frozen_target = FrozenTarget::kStepStart;
   // W along each sphere's normal in the ContactSet, one column a sphere
   // ((3k x k), Body::compliance_along), instead of 3x3 blocks: the same
   // solves buy three times the spheres. Ignored with fixed spheres (they

@@ -16,6 +16,17 @@
 // through (the neonatal tongue under the blade reached 7.7 mm into the jaw
 // in one 5 ms step).
 //
+// A node can still end up beyond a thin bone (pushed through by conflicting
+// constraints, or along the normal from deep inside). Path-following would
+// then keep it there for good: on the neonatal overshoot a node 39 mm from
+// rest, its rest on the other side of the jaw, was pulled 7 mm back through
+// the bone by its elements each step and put back each step, its inverted
+// tets pinned for the rest of the run. So with the rest positions given, a
+// path that crosses a surface is let through when it brings a node home:
+// the segment from the node's rest position to its start enters the
+// obstacle and the segment from its rest position to where the path ends
+// does not.
+//
 // The nodes a pass moved are what obstacle_support.h holds with springs in
 // the next step's system matrix, so the implicit solve and W feel the bone.
 //
@@ -77,10 +88,14 @@ class ObstacleProjection {
   // One pass: moves every free node closer than the margin out of every
   // obstacle, in place (3 per node, m). start_positions_m (3 per node, m, or
   // empty): where the nodes were at the start of the step, for the entry
-  // point of a node that crossed a surface. Adds to report's obstacle fields
-  // and returns how many nodes this pass moved.
+  // point of a node that crossed a surface. rest_positions_m (3 per node, m,
+  // or empty): lets a node beyond a bone cross back home (see above). Adds to
+  // report's obstacle fields and returns how many nodes this pass moved.
   int project(std::span<double> positions_m, std::span<const double> inverse_mass_per_node,
-              ProjectionReport& report, std::span<const double> start_positions_m = {});
+              ProjectionReport& report, std::span<const double> start_positions_m = {},
+              std::span<const double> rest_positions_m = {});
+  // Nodes let back through a surface since begin_step().
+  int nodes_returned() const { return nodes_returned_; }
 
   // Nodes moved since begin_step().
   int nodes_moved() const { return nodes_moved_; }
@@ -94,8 +109,12 @@ class ObstacleProjection {
 
  private:
   enum class NodeOutcome { kClear, kMoved, kUnresolved, kNonFinite };
-  NodeOutcome project_node(std::size_t node, const Eigen::Vector3d* start, Eigen::Vector3d& x,
-                           ProjectionReport& report);
+  NodeOutcome project_node(std::size_t node, const Eigen::Vector3d* start, const Eigen::Vector3d* rest,
+                           Eigen::Vector3d& x, ProjectionReport& report);
+  // Whether the segment a -> b comes within `level` of the field (sphere
+  // traced); true as well when the trace runs out of samples (undecided).
+  bool segment_enters(const ObstacleField& field, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                      double level_m) const;
   // Follows the path start -> x; if it meets the margin, moves x (and its
   // sample s) there and returns how far, else returns 0.
   double enter_along_path(const ObstacleField& field, const Eigen::Vector3d& start, Eigen::Vector3d& x,
@@ -116,6 +135,7 @@ class ObstacleProjection {
   std::vector<std::uint8_t> moved_;            // per node: moved since begin_step()
   std::vector<Eigen::Vector3d> move_normal_;   // per node: normal of its last move
   int nodes_moved_ = 0;
+  int nodes_returned_ = 0;
 };
 
 }  // namespace fahr::fem

@@ -22,6 +22,24 @@ enum class SphereSpread : std::uint8_t {
   kTranslation,
 };
 
+// Where a frozen contact holds its sphere.
+enum class FrozenTarget : std::uint8_t {
+  // The sphere's centre at the start of the step, on the FEM's own
+  // positions: the paper's c' = c, "the old position of the sphere". Every
+  // frozen sphere's target comes from one node configuration, so the holds
+  // can all be met at once and the projection settles.
+  kStepStart,
+  // Contact::hold_centre_m, the haptic side's estimate of where the tool
+  // keeps the sphere (contact_response.cpp capture_holds). It is made from
+  // an older state and, without W, a fallback compliance, so on the pressed
+  // neonatal tongue the holds sat 2-7 mm from the FEM's centres and from
+  // each other; pulled to such targets through shared nodes, alternated with
+  // the anatomy, the projection moved a node 153 mm in one step
+  // (fahr_overshoot_bench --response force-aware, the first frozen step).
+  // Kept to compare.
+  kHoldCentre,
+};
+
 struct ProjectionSettings {
   // Gauss-Seidel sweeps over all constraints at most (one sweep suffices for
   // contacts that share no nodes; coupled contacts need more).
@@ -36,6 +54,9 @@ struct ProjectionSettings {
   // kMassWeighted is the contract's; kTranslation made the neonatal
   // overshoot run diverge (README, "The anatomy") and is kept to compare.
   SphereSpread spread = SphereSpread::kMassWeighted;
+  // kStepStart needs the step's start positions (project_contacts'
+  // step_start_m); without them a frozen contact uses its hold centre.
+  FrozenTarget frozen_target = FrozenTarget::kStepStart;
 };
 
 struct ProjectionReport {
@@ -65,12 +86,15 @@ bool contact_is_projected(const Contact& contact, const ProjectionSettings& sett
 
 // Moves `positions_m` (3 per node) so that every active contact satisfies
 // (c' - q) . n >= r (the sphere, radius included, stays on its side of the
-// rigid surface, which is the plane) and every frozen contact c' = hold.
+// rigid surface, which is the plane) and every frozen contact c' = its
+// target (ProjectionSettings::frozen_target; step_start_m: the positions at
+// the start of the step, empty to use the hold centres).
 // A correction dc moves node i by (w_i / m_i) dc / sum_j (w_j^2 / m_j):
 // inverse_mass_per_node is 0 for fixed nodes, which therefore never move.
 ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks& links,
                                   std::span<const double> inverse_mass_per_node,
-                                  const ProjectionSettings& settings, std::span<double> positions_m);
+                                  const ProjectionSettings& settings, std::span<double> positions_m,
+                                  std::span<const double> step_start_m = {});
 
 // The correction of one sphere, exposed for tests: returns false if all of
 // its nodes are fixed (nothing can move).

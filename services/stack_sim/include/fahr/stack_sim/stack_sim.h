@@ -48,6 +48,8 @@ struct StackOptions {
   std::optional<double> fem_support_ratio;
   // Overrides the FEM service's sphere spread (projection.h) when set.
   std::optional<fem::SphereSpread> sphere_spread;
+  // Overrides the FEM service's frozen target (projection.h) when set.
+  std::optional<fem::FrozenTarget> frozen_target;
   // false: a diagnostic (contact ForceAwareSettings::hold_within_limit): the
   // proxy held while the device has lost track never backs off and the
   // tissue gets the pinned solve's forces unclamped.

@@ -34,6 +34,8 @@ struct FemBodySetup {
   bool enforce_anatomy = true;
   // How a tool contact's correction moves the sphere's nodes (projection.h).
   fem::SphereSpread sphere_spread = fem::SphereSpread::kMassWeighted;
+  // Where a frozen tool contact holds its sphere (projection.h).
+  fem::FrozenTarget frozen_target = fem::FrozenTarget::kStepStart;
   // The scene's solver.compliance_columns: normals (ContactStepSettings).
   bool compliance_along_normals = false;
   // Experimental (null: off): the tool's field, which the step moves to the
