@@ -274,6 +274,47 @@ TEST(ObstacleProjection, ANodeBeyondAPlateFromItsRestMayCrossBackHome) {
   }
 }
 
+TEST(ObstacleProjection, ANodeBeyondAThickBoneIsLeftAloneUntilHome) {
+  // A 6 mm bone. Node 0 rests 2 mm above it and is now below it: its step
+  // takes it 3 mm back up, into the bone, and the bone leaves it alone (it
+  // has to pass through to get home). Node 1, at home above it, is driven
+  // 1 mm into the bone and is put back out, as before.
+  const Plate bone(0.0, 3e-3);
+  const ObstacleField* fields[] = {&bone};
+  const std::vector<double> rest = {0.0, 5e-3, 0.0, 1e-3, 5e-3, 0.0};
+  const std::vector<double> start = {0.0, -5e-3, 0.0, 1e-3, 4e-3, 0.0};
+  std::vector<double> x = {0.0, -2e-3, 0.0, 1e-3, 2e-3, 0.0};
+  const std::vector<double> inverse_mass = {1.0, 1.0};
+  ObstacleProjection projection(fields, 2);
+  projection.begin_step();
+  ProjectionReport report;
+  projection.project(x, inverse_mass, report, start, rest);
+  EXPECT_EQ(x[1], -2e-3);
+  EXPECT_EQ(projection.nodes_beyond(), 1);
+  EXPECT_NEAR(x[4], 3e-3 + kMargin, 1e-9);
+}
+
+TEST(ObstacleProjection, SlidingAfterEntryKeepsTheMotionAlongTheSurface) {
+  // A path from 1 mm above the floor to 1 mm below it, 3 mm along x: it
+  // enters the margin at x = 1.2 mm. Stopped there by default; sliding, it
+  // goes on along the floor to x = 3 mm at the margin.
+  const Floor floor(0.0);
+  const ObstacleField* fields[] = {&floor};
+  const std::vector<double> start = {0.0, 1e-3, 0.0};
+  const std::vector<double> inverse_mass = {1.0};
+  for (const bool slide : {false, true}) {
+    ObstacleProjectionSettings settings;
+    settings.slide_after_entry = slide;
+    ObstacleProjection projection(fields, 1, settings);
+    std::vector<double> x = {3e-3, -1e-3, 0.0};
+    projection.begin_step();
+    ProjectionReport report;
+    projection.project(x, inverse_mass, report, start);
+    EXPECT_NEAR(x[0], slide ? 3e-3 : 1.2e-3, 1e-8) << slide;
+    EXPECT_NEAR(x[1], kMargin, 1e-8) << slide;
+  }
+}
+
 TEST(ObstacleProjection, FarNodesAreNotSampledEveryStep) {
   // A floor 20 mm below a bar that stays put: once sampled, every node's
   // clearance proves it clear and the field is not asked again.

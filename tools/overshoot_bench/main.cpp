@@ -9,6 +9,7 @@
 //                        [--fem-anatomy on|off] [--fem-support RATIO] [--youngs-pa E] [--tool-stops on|off]
 //                        [--stiffening C20/C10]
 //                        [--sphere-spread service|mass|translation] [--frozen-target service|step-start|hold-centre]
+//                        [--fem-anatomy-slide]
 //                        [--trace FILE] [--check]
 //
 // --fem-anatomy off: the FEM leaves the anatomy to the haptic side's
@@ -18,6 +19,9 @@
 // --frozen-target: where the FEM holds a frozen sphere (projection.h
 // FrozenTarget): its centre at the step's start (the service's) or the
 // haptic side's hold centre (before).
+// --fem-anatomy-slide: the FEM's anatomy pass slides a node along the bone
+// after its path enters the margin instead of stopping it there
+// (services/fem obstacle_projection.h slide_after_entry).
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
 // (services/fem compression_stiffening.h; 0: off), instead of the scene's.
 // --trace: one CSV line per FEM step of each run (FILE with the response's
@@ -256,6 +260,7 @@ struct RunChoices {
   std::string tool_stops = "scene";
   std::string spread = "service";
   std::string frozen_target = "service";
+  bool fem_anatomy_slide = false;
   std::string held_proxy = "limit";
   bool fem_tool_obstacle = false;
   std::string row_compliance = "scene";
@@ -312,6 +317,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
   if (choices.frozen_target == "step-start") options.frozen_target = fem::FrozenTarget::kStepStart;
   if (choices.frozen_target == "hold-centre") options.frozen_target = fem::FrozenTarget::kHoldCentre;
+  options.fem_anatomy_slide = choices.fem_anatomy_slide;
   stack_sim::StackSim sim(variant, options);
   Result r;
   r.name = penalty ? "penalty" : "force-aware";
@@ -474,6 +480,8 @@ int main(int argc, char** argv) {
                  "where the FEM holds a frozen sphere: its centre at the step's start or the haptic side's hold centre "
                  "(default: the service's)")
       ->check(CLI::IsMember({"service", "step-start", "hold-centre"}));
+  app.add_flag("--fem-anatomy-slide", choices.fem_anatomy_slide,
+               "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
   app.add_option("--response", response, "which response to run")
       ->check(CLI::IsMember({"both", "force-aware", "penalty"}));
   app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")

@@ -6,7 +6,8 @@
 //
 //   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
 //                      [--fem-anatomy on|off] [--fem-support RATIO] [--stiffening C20/C10]
-//                      [--fem-tool-obstacle] [--w-normals N] [--row-compliance scene|deepest|keep|free]
+//                      [--fem-tool-obstacle] [--fem-anatomy-slide] [--w-normals N]
+//                      [--row-compliance scene|deepest|keep|free]
 //                      [--seconds 4]
 //
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
@@ -49,6 +50,9 @@ int main(int argc, char** argv) {
   app.add_option("--stiffening", stiffening,
                  "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
       ->check(CLI::Range(0.0, 100.0));
+  bool fem_anatomy_slide = false;
+  app.add_flag("--fem-anatomy-slide", fem_anatomy_slide,
+               "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
   bool fem_tool_obstacle = false;
   app.add_flag("--fem-tool-obstacle", fem_tool_obstacle,
                "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose");
@@ -71,6 +75,7 @@ int main(int argc, char** argv) {
     options.fem_anatomy = fem_anatomy == "on";
     if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
     options.fem_tool_obstacle = fem_tool_obstacle;
+    options.fem_anatomy_slide = fem_anatomy_slide;
     if (row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(row_compliance);
     options.collision =
         collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;

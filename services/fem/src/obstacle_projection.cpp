@@ -37,7 +37,8 @@ ObstacleProjection::ObstacleProjection(std::span<const ObstacleField* const> fie
       clearance_m_(node_count * fields.size(), kUnsampled),
       sampled_at_m_(node_count, Eigen::Vector3d::Zero()),
       moved_(node_count, 0),
-      move_normal_(node_count, Eigen::Vector3d::UnitZ()) {
+      move_normal_(node_count, Eigen::Vector3d::UnitZ()),
+      beyond_(node_count * fields.size(), 0) {
   settings_.max_moves_per_node = std::max(1, settings_.max_moves_per_node);
   settings_.max_rounds = std::max(1, settings_.max_rounds);
 }
@@ -46,20 +47,23 @@ void ObstacleProjection::begin_step() {
   std::fill(moved_.begin(), moved_.end(), std::uint8_t{0});
   nodes_moved_ = 0;
   nodes_returned_ = 0;
+  nodes_beyond_ = 0;
+  std::fill(beyond_.begin(), beyond_.end(), std::uint8_t{0});
 }
 
 bool ObstacleProjection::segment_enters(const ObstacleField& field, const Eigen::Vector3d& a,
-                                        const Eigen::Vector3d& b, double level_m) const {
+                                        const Eigen::Vector3d& b, double level_m, bool if_undecided) const {
   const double length = (b - a).norm();
   const Eigen::Vector3d direction = length > 0.0 ? Eigen::Vector3d((b - a) / length) : Eigen::Vector3d::Zero();
   double t = 0.0;
   for (int i = 0; i < kHomeTraceSteps; ++i) {
     const double d = field.sample(a + std::min(t, length) * direction).distance_m;
-    if (!std::isfinite(d) || d < level_m) return true;
+    if (!std::isfinite(d)) return if_undecided;
+    if (d < level_m) return true;
     if (t >= length) return false;
     t += std::max(d - level_m, kMinPathStep);
   }
-  return true;
+  return if_undecided;
 }
 
 void ObstacleProjection::forget_clearances() { std::fill(clearance_m_.begin(), clearance_m_.end(), kUnsampled); }
@@ -118,10 +122,23 @@ double ObstacleProjection::enter_along_path(const ObstacleField& field, const Ei
     if (d_next < margin - settings_.tolerance_m) {
       report.obstacle_deepest_m = std::max(report.obstacle_deepest_m, -s.distance_m);
       const Eigen::Vector3d entry = entry_point(field, start + t * direction, d, next, d_next, margin);
-      const double back = (entry - x).norm();
+      const Eigen::Vector3d end = x;
       x = entry;
       s = field.sample(x);
-      return back;
+      const double normal_length = s.normal.norm();
+      if (settings_.slide_after_entry && normal_length > kMinNormalLength && s.normal.allFinite()) {
+        // The rest of the path slides along the surface (frictionless)
+        // rather than stopping at the entry: stopped there, a node whose
+        // path clips a bone's corner by a few micrometres never moves again.
+        const Eigen::Vector3d n = s.normal / normal_length;
+        const Eigen::Vector3d rest_of_path = end - entry;
+        const Eigen::Vector3d slide = rest_of_path - std::min(0.0, rest_of_path.dot(n)) * n;
+        if (slide.allFinite()) {
+          x = entry + slide;
+          s = field.sample(x);
+        }
+      }
+      return (end - x).norm();
     }
     t = t_next;
     d = d_next;
@@ -144,6 +161,23 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
   bool unresolved = false;
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     if (clearance[f] >= margin) continue;
+    if (rest != nullptr) {
+      // Once a step, and only for nodes near the obstacle: beyond it?
+      std::uint8_t& beyond = beyond_[node * fields_.size() + f];
+      if (beyond == 0) {
+        // A node within beyond_depth_m of its rest position cannot be that
+        // deep along the segment (the distance is 1-Lipschitz), and a node
+        // whose rest is inside the obstacle has no side to be beyond.
+        const Eigen::Vector3d& from = start != nullptr ? *start : x;
+        const bool far_from_rest = (from - *rest).norm() > settings_.beyond_depth_m;
+        beyond = far_from_rest && fields_[f]->sample(*rest).distance_m >= 0.0 &&
+                         segment_enters(*fields_[f], *rest, from, -settings_.beyond_depth_m, false)
+                     ? 2
+                     : 1;
+        if (beyond == 2) ++nodes_beyond_;
+      }
+      if (beyond == 2) continue;
+    }
     const Eigen::Vector3d before = x;
     ObstacleSample s = fields_[f]->sample(x);
     if (start != nullptr && s.distance_m - (x - *start).norm() < margin) {
@@ -153,7 +187,7 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
       const ObstacleSample end_sample = s;
       double back = enter_along_path(*fields_[f], *start, x, s, report);
       if (back > 0.0 && rest != nullptr && s.distance_m >= 0.0 && end_sample.distance_m >= 0.0 &&
-          !segment_enters(*fields_[f], *rest, end, 0.0) && segment_enters(*fields_[f], *rest, *start, 0.0)) {
+          !segment_enters(*fields_[f], *rest, end, 0.0, true) && segment_enters(*fields_[f], *rest, *start, 0.0, false)) {
         // Beyond the bone and going home through it: let it.
         x = end;
         s = end_sample;

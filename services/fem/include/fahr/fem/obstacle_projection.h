@@ -70,6 +70,21 @@ struct ObstacleProjectionSettings {
   // anatomy acts only through this projection. 100: pressing a supported
   // node into the bone moves it a hundredth as far as pressing it free.
   double support_stiffness_ratio = 100.0;
+  // With rest positions: a node whose straight segment from its rest
+  // position to its start passes deeper than this into an obstacle is taken
+  // to be beyond it (it went through), and that obstacle leaves it alone
+  // until it is home, m (> 0). A node sliding over a bone's ridge has a
+  // chord only the ridge's sagitta deep (3 mm over a 5 mm radius: 0.23 mm).
+  double beyond_depth_m = 1e-3;
+  // false: a node whose path enters the margin stops where it enters (as if
+  // the bone held it fast). true: the rest of its path slides along the
+  // surface (frictionless). Stopped, a node whose path clips a bone's corner
+  // by micrometres can stay put for seconds; sliding, the tongue recovers
+  // from an overshoot with fewer tets left inverted, but at 100 kPa its
+  // strain grew under the held blade (tools/overshoot_bench/README.md,
+  // "Frozen spheres held where the step found them"). Off until that is
+  // settled.
+  bool slide_after_entry = false;
 };
 
 class ObstacleProjection {
@@ -94,8 +109,10 @@ class ObstacleProjection {
   int project(std::span<double> positions_m, std::span<const double> inverse_mass_per_node,
               ProjectionReport& report, std::span<const double> start_positions_m = {},
               std::span<const double> rest_positions_m = {});
-  // Nodes let back through a surface since begin_step().
+  // Nodes let back through a surface, and nodes beyond an obstacle left
+  // alone by it, since begin_step().
   int nodes_returned() const { return nodes_returned_; }
+  int nodes_beyond() const { return nodes_beyond_; }
 
   // Nodes moved since begin_step().
   int nodes_moved() const { return nodes_moved_; }
@@ -112,9 +129,10 @@ class ObstacleProjection {
   NodeOutcome project_node(std::size_t node, const Eigen::Vector3d* start, const Eigen::Vector3d* rest,
                            Eigen::Vector3d& x, ProjectionReport& report);
   // Whether the segment a -> b comes within `level` of the field (sphere
-  // traced); true as well when the trace runs out of samples (undecided).
+  // traced); `if_undecided` when the trace runs out of samples or the field
+  // cannot answer.
   bool segment_enters(const ObstacleField& field, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                      double level_m) const;
+                      double level_m, bool if_undecided) const;
   // Follows the path start -> x; if it meets the margin, moves x (and its
   // sample s) there and returns how far, else returns 0.
   double enter_along_path(const ObstacleField& field, const Eigen::Vector3d& start, Eigen::Vector3d& x,
@@ -136,6 +154,10 @@ class ObstacleProjection {
   std::vector<Eigen::Vector3d> move_normal_;   // per node: normal of its last move
   int nodes_moved_ = 0;
   int nodes_returned_ = 0;
+  int nodes_beyond_ = 0;
+  // Per node and field: whether the node is beyond the obstacle this step
+  // (0 not checked yet, 1 no, 2 yes); cleared by begin_step().
+  std::vector<std::uint8_t> beyond_;
 };
 
 }  // namespace fahr::fem

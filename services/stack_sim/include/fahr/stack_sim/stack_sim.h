@@ -46,6 +46,9 @@ struct StackOptions {
   // Overrides the FEM's anatomy support springs (obstacle_support.h), their
   // stiffness over the node's diagonal of A; 0 turns them off.
   std::optional<double> fem_support_ratio;
+  // The FEM's anatomy pass slides a node along the bone after its path
+  // enters the margin (ObstacleProjectionSettings::slide_after_entry).
+  bool fem_anatomy_slide = false;
   // Overrides the FEM service's sphere spread (projection.h) when set.
   std::optional<fem::SphereSpread> sphere_spread;
   // Overrides the FEM service's frozen target (projection.h) when set.
