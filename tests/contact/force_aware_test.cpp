@@ -2,6 +2,7 @@
 // hold, release with hysteresis, catch up without a force step.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "fahr/contact/contact_response.h"
@@ -80,6 +81,55 @@ TEST(ForceAware, DisabledNeverFreezes) {
   ContactResponse response(settings);
   response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
   EXPECT_FALSE(press(response, patch, 0.5, -0.012).froze);
+}
+
+// The gateway lowers the limit while the device has lost track (the Touch
+// X's continuous force after its peak): the pinned reaction is then past the
+// new limit. kBackOff backs the proxy off until it is within it; kStay keeps
+// the proxy where it froze and scales the frozen spheres' forces instead.
+TEST(ForceAware, AStayingProxyMeetsALowerLimitByScalingNotBySlipping) {
+  double drift[2] = {0.0, 0.0};
+  for (const HeldProxy held : {HeldProxy::kBackOff, HeldProxy::kStay}) {
+    test::SyntheticPatch patch = test::make_patch(4, 0.0, 0.002, 0.005);
+    ResponseSettings settings;
+    settings.force_aware.held_proxy = held;
+    ContactResponse response(settings);
+    response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
+    Eigen::Vector3d frozen_at = Eigen::Vector3d::Zero();
+    bool was_lost = false;
+    for (int k = 0; k < 3000; ++k) {
+      const double y = std::max(-0.012, 0.002 - 1e-5 * k);  // down at 10 mm/s, then held there
+      const double limit = k < 2000 ? 0.5 : 0.3;
+      test::set_tool_height(patch, response.proxy().position_m.y());
+      TickInput in;
+      in.device.position_m = Eigen::Vector3d(0, y, 0);
+      in.device.renderable_force_n = limit;
+      in.rows = patch.rows;
+      in.compliance = patch.compliance();
+      const ForceOutput& out = response.tick(in);
+      if (!out.lost_track) {
+        ASSERT_LT(k, 2000) << "released while the hand still pulls";
+        was_lost = false;
+        continue;
+      }
+      if (!was_lost) frozen_at = out.proxy_position_m;
+      was_lost = true;
+      if (k < 2000) continue;
+      drift[held == HeldProxy::kStay ? 1 : 0] =
+          std::max(drift[held == HeldProxy::kStay ? 1 : 0], (out.proxy_position_m - frozen_at).norm());
+      EXPECT_LE(out.tissue_reaction_n, 1.05 * limit) << k;
+      if (held == HeldProxy::kStay) {
+        Eigen::Vector3d sent = Eigen::Vector3d::Zero();
+        for (const fem::Contact& c : response.contacts()) {
+          EXPECT_EQ(c.state, fem::ContactState::kFrozen);
+          sent += c.force_n * c.normal;
+        }
+        EXPECT_LE(sent.norm(), limit * (1.0 + 1e-9)) << k;
+      }
+    }
+  }
+  EXPECT_GT(drift[0], 1e-4);  // backed off
+  EXPECT_EQ(drift[1], 0.0);   // stayed
 }
 
 // A blade sunk into tissue that closes over it: one row below the tool and

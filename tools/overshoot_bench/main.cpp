@@ -310,7 +310,8 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   options.overshoot_factor = factor;
   options.fem_anatomy = choices.fem_anatomy;
   if (choices.support_ratio >= 0.0) options.fem_support_ratio = choices.support_ratio;
-  options.hold_within_limit = choices.held_proxy == "limit";
+  if (choices.held_proxy == "stay") options.held_proxy = contact::HeldProxy::kStay;
+  if (choices.held_proxy == "fixed") options.held_proxy = contact::HeldProxy::kUnclamped;
   options.fem_tool_obstacle = choices.fem_tool_obstacle;
   if (choices.row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(choices.row_compliance);
   if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
@@ -502,9 +503,10 @@ int main(int argc, char** argv) {
   app.add_option("--factor", choices.factor, "overshoot: the hand's pull as a multiple of the device's peak force")
       ->check(CLI::Range(1.0, 10.0));
   app.add_option("--held-proxy", choices.held_proxy,
-                 "while the device has lost track: limit (the response: back off to keep the tissue within the "
-                 "limit) or fixed (a diagnostic: never back off, tissue forces unclamped)")
-      ->check(CLI::IsMember({"limit", "fixed"}));
+                 "while the device has lost track: limit (back off to keep the tissue within the limit), stay "
+                 "(stay where it froze, tissue forces scaled to the limit) or fixed (a diagnostic: stay, tissue "
+                 "forces unclamped)")
+      ->check(CLI::IsMember({"limit", "stay", "fixed"}));
   app.add_flag("--fem-tool-obstacle", choices.fem_tool_obstacle,
                "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose, not only the "
                "ContactSet's spheres (services/fem contact_step.h set_tool_obstacle)");

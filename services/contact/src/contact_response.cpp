@@ -167,7 +167,7 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     }
     if (!release) {
       solver_.solve_pinned(zero, settings_.pgs);
-      if (!settings_.force_aware.hold_within_limit) return zero;
+      if (settings_.force_aware.held_proxy != HeldProxy::kBackOff) return zero;
       const Eigen::Vector3d back = yield_to_limit(zero, limit);
       if (back != zero) capture_holds(input.compliance);
       return back;
@@ -207,7 +207,8 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     // within the limit) and the loaded spheres are held there.
     state_ = TrackingState::kLostTrack;
     solver_.solve_pinned(zero, settings_.pgs);
-    const Eigen::Vector3d back = yield_to_limit(zero, limit);
+    const Eigen::Vector3d back =
+        settings_.force_aware.held_proxy == HeldProxy::kStay ? zero : yield_to_limit(zero, limit);
     capture_holds(input.compliance);
     return back;
   }
@@ -324,8 +325,16 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   // its yield tolerance and the one-tick lag), and the constraints stay.
   const double solved_reaction = solver_.resultant(RowKind::kTissue).norm();
   tissue_force_scale_ = 1.0;
-  if (settings_.mode != ResponseMode::kNaive && settings_.force_aware.hold_within_limit &&
-      solved_reaction > kWedgeBand * device.renderable_force_n) {
+  const HeldProxy held = settings_.force_aware.held_proxy;
+  if (settings_.mode != ResponseMode::kNaive && held == HeldProxy::kStay && state_ == TrackingState::kLostTrack) {
+    // Held where it froze: the spheres stay frozen (the FEM holds them
+    // where it finds them) and their forces are scaled to the limit.
+    if (solved_reaction > device.renderable_force_n) {
+      tissue_force_scale_ = device.renderable_force_n / solved_reaction;
+      report_.tissue_force_scaled_held = true;
+    }
+  } else if (settings_.mode != ResponseMode::kNaive && held != HeldProxy::kUnclamped &&
+             solved_reaction > kWedgeBand * device.renderable_force_n) {
     tissue_force_scale_ = device.renderable_force_n / solved_reaction;
     report_.tissue_force_clamped = true;
   }

@@ -39,7 +39,7 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   hand_ = std::make_unique<device::SimulatedBackend>(std::move(script), hand, gateway_config_.model,
                                                      gateway_config_.mapping, gateway_config_.period);
   gateway_ = std::make_unique<device::ServoCore>(gateway_config_, *hand_);
-  haptic_setup_.response.force_aware.hold_within_limit = options.hold_within_limit;
+  haptic_setup_.response.force_aware.held_proxy = options.held_proxy;
   if (options.row_compliance) haptic_setup_.row_compliance = *options.row_compliance;
   haptic_ = std::make_unique<haptic_service::HapticLoop>(haptic_setup_);
   digest_ = std::make_unique<haptic_service::TissueDigest>(haptic_setup_);

@@ -80,6 +80,9 @@ struct TickReport {
   bool yielded = false;            // a held proxy backed off to keep the reaction at the limit
   bool implausible_step = false;   // the coupled solve's step was refused; the proxy held
   bool tissue_force_clamped = false;  // the tissue forces were scaled down to the limit
+  // HeldProxy::kStay: the held spheres' forces were scaled down to the
+  // limit; they stay frozen (not force-only, unlike tissue_force_clamped).
+  bool tissue_force_scaled_held = false;
   bool force_limited = false;      // the commanded force was scaled to the renderable force
   double obstacle_reaction_n = 0.0;  // |force of rigid obstacles on the tool|, N
 };

@@ -15,6 +15,22 @@ enum class TrackingState : std::uint8_t {
   kCatchingUp,  // reactivated; the proxy moves to equilibrium at a bounded speed
 };
 
+enum class HeldProxy : std::uint8_t {
+  // Backs off along the reaction until the reaction is the limit
+  // (ContactResponse::yield_to_limit): the tissue's reaction is the limit,
+  // the proxy drifts from where it froze.
+  kBackOff,
+  // Stays where it froze (the paper: the proxy stops); the tissue forces
+  // sent to the FEM are scaled so that their resultant is the limit, and
+  // the spheres stay frozen (the FEM holds them where each step finds
+  // them). The published gap is then the hand's pull past the limit.
+  kStay,
+  // A diagnostic, not a response: stays, and the tissue gets whatever the
+  // pinned solve asks, unclamped, so a bench can see whether the frozen
+  // hold is steady by itself.
+  kUnclamped,
+};
+
 struct ForceAwareSettings {
   bool enabled = true;  // false: never freeze (naive mode, or a test of the solve alone)
   // Constraints reactivate when the coupling force falls below
@@ -26,11 +42,10 @@ struct ForceAwareSettings {
   // motion causes: 0.05 m/s x 400 N/m x 1 ms = 0.02 N per tick, 20 N/s,
   // below the ~ 50 N/s at which a force step is felt as a click.
   double catch_up_speed_mps = 0.05;
-  // false: a diagnostic, not a response: a held proxy never backs off and
-  // the tissue gets whatever the pinned solve asks, unclamped, so a bench
-  // can see whether the frozen hold is steady by itself (with a rigid tool
-  // held still the tissue's reaction should settle, not grow).
-  bool hold_within_limit = true;
+  // What a proxy held while the device has lost track does when the pinned
+  // solve's tissue reaction exceeds the limit (the tissue's state changed
+  // under it, or the gateway lowered the limit).
+  HeldProxy held_proxy = HeldProxy::kBackOff;
 };
 
 // Tissue reaction past the limit: freeze.

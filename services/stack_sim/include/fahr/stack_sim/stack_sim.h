@@ -18,6 +18,7 @@
 #include "deformation_state.h"
 #include "device_pose.h"
 #include "fahr/common/lockstep.h"
+#include "fahr/contact/force_aware.h"
 #include "fahr/metrics/duration_histogram.h"
 #include "fahr/device/servo_core.h"
 #include "fahr/device/simulated_backend.h"
@@ -53,10 +54,9 @@ struct StackOptions {
   std::optional<fem::SphereSpread> sphere_spread;
   // Overrides the FEM service's frozen target (projection.h) when set.
   std::optional<fem::FrozenTarget> frozen_target;
-  // false: a diagnostic (contact ForceAwareSettings::hold_within_limit): the
-  // proxy held while the device has lost track never backs off and the
-  // tissue gets the pinned solve's forces unclamped.
-  bool hold_within_limit = true;
+  // What the proxy held while the device has lost track does past the limit
+  // (contact ForceAwareSettings::held_proxy).
+  contact::HeldProxy held_proxy = contact::HeldProxy::kBackOff;
   // Experimental: the FEM keeps the whole tongue out of the tool at the
   // ContactSet's tool pose (FemBodySetup::tool), not only the set's spheres;
   // the FEM service's --tool-obstacle.
