@@ -62,7 +62,11 @@ class ContactMetrics {
   std::vector<double> anchor_candidates_error_m_[kKinds];  // candidates' anchors too
   std::vector<double> sphere_nearest_error_m_[kKinds];  // the old figure, split by kind
   std::vector<double> anchor_distance_m_;
-  std::size_t base_recalled_surface_ = 0;  // a reporting sphere, or a candidate whose anchor is inside
+  std::size_t base_recalled_surface_ = 0;
+  // Per reporting sphere with a verified baseline contact in its region: the
+  // deepest exact penetration there, and the errors of its sphere and
+  // surface depths against it.
+  std::vector<double> contact_deepest_m_, contact_sphere_error_m_, contact_surface_error_m_;  // a reporting sphere, or a candidate whose anchor is inside
 };
 
 }  // namespace fahr::aist_bench
