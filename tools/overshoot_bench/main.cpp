@@ -83,6 +83,7 @@ struct Result {
   std::uint64_t lost_ticks = 0;
   bool finite = true;
   std::uint64_t divergence_resets = 0;  // FEM steps that diverged and reset the tongue to rest
+  std::uint64_t anatomy_returned = 0, anatomy_beyond_steps = 0;  // the FEM's bone rules (service_step.h)
   double wall_s = 0.0;
   // Wall time of the base steps that ran a FEM step (the FEM step, the
   // haptic tick and its digest together: an upper bound of the FEM's), ms.
@@ -461,6 +462,8 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   mark_inverted(sim.body(), sim.tongue_mesh(), r.inverted_at_end);
   count_by_radius_ratio(sim.tongue_mesh(), r);
   r.divergence_resets = sim.fem().divergence_resets();
+  r.anatomy_returned = sim.fem().anatomy_returned();
+  r.anatomy_beyond_steps = sim.fem().anatomy_beyond_steps();
   return r;
 }
 
@@ -552,6 +555,9 @@ int main(int argc, char** argv) {
     std::printf("| all finite | %s | %s |\n", fa.finite ? "yes" : "no", pe.finite ? "yes" : "no");
     std::printf("| FEM steps that diverged (tongue reset to rest) | %llu | %llu |\n",
                 static_cast<unsigned long long>(fa.divergence_resets), static_cast<unsigned long long>(pe.divergence_resets));
+    std::printf("| FEM: nodes let back through a bone / node-steps beyond a bone | %llu / %llu | %llu / %llu |\n",
+                static_cast<unsigned long long>(fa.anatomy_returned), static_cast<unsigned long long>(fa.anatomy_beyond_steps),
+                static_cast<unsigned long long>(pe.anatomy_returned), static_cast<unsigned long long>(pe.anatomy_beyond_steps));
     std::printf("| wall time s | %.1f | %.1f |\n", fa.wall_s, pe.wall_s);
     std::printf("| base step with a FEM step (FEM + haptic tick + digest) ms mean / max | %.2f / %.2f | %.2f / %.2f |\n",
                 fa.fem_base_step_mean_ms, fa.fem_base_step_max_ms, pe.fem_base_step_mean_ms, pe.fem_base_step_max_ms);

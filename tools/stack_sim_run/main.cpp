@@ -126,6 +126,9 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(sim.fem().stale_sets()),
                 static_cast<unsigned long long>(sim.fem().inverted_max()),
                 static_cast<unsigned long long>(sim.fem().divergence_resets()));
+    std::printf("stack_sim: FEM anatomy: nodes let back through a bone %llu, node-steps beyond a bone %llu\n",
+                static_cast<unsigned long long>(sim.fem().anatomy_returned()),
+                static_cast<unsigned long long>(sim.fem().anatomy_beyond_steps()));
     const auto& cpu = sim.haptic_tick_cpu();
     const auto& fem_cpu = sim.fem_step_cpu();
     std::printf("stack_sim: FEM step CPU ms median %.2f p99 %.2f max %.2f\n",

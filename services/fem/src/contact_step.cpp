@@ -293,6 +293,8 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
   projection_.obstacle_unresolved = anatomy.obstacle_unresolved;
   projection_.obstacle_non_finite = anatomy.obstacle_non_finite;
   projection_.obstacle_deepest_m = anatomy.obstacle_deepest_m;
+  projection_.obstacle_returned = obstacles_ ? obstacles_->nodes_returned() : 0;
+  projection_.obstacle_beyond = obstacles_ ? obstacles_->nodes_beyond() : 0;
 }
 
 void ContactStep::project(const ContactSet* contacts) {

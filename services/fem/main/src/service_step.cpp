@@ -69,6 +69,8 @@ void ServiceStep::step() {
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
   inverted_max_ = std::max<std::uint64_t>(inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
   if (last_report_.diverged_reset) ++divergence_resets_;
+  anatomy_returned_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_returned);
+  anatomy_beyond_steps_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_beyond);
   anatomy_depth_max_m_ = std::max(anatomy_depth_max_m_, last_report_.projection.obstacle_deepest_m);
   fill_state(*setup_.body, setup_.scene_body->id, state_);
   state_.stale_contact_sets(static_cast<std::uint32_t>(stale_sets_));
@@ -103,6 +105,8 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("projection_sweeps_last", static_cast<double>(last_report_.projection.sweeps));
   out.emplace_back("anatomy_nodes_last", static_cast<double>(last_report_.projection.obstacle_nodes));
   out.emplace_back("anatomy_depth_mm_max", 1e3 * anatomy_depth_max_m_);
+  out.emplace_back("anatomy_nodes_returned", static_cast<double>(anatomy_returned_));
+  out.emplace_back("anatomy_node_steps_beyond", static_cast<double>(anatomy_beyond_steps_));
   out.emplace_back("anatomy_unresolved_last", static_cast<double>(last_report_.projection.obstacle_unresolved));
   out.emplace_back("solver_iterations_last", static_cast<double>(last_report_.solver_iterations));
   out.emplace_back("asleep", setup_.body->asleep() ? 1.0 : 0.0);

@@ -76,6 +76,10 @@ struct ProjectionReport {
   double obstacle_deepest_m = 0.0; // deepest node inside an obstacle before its move, m (>= 0)
   int obstacle_supported = 0;      // nodes held by a support spring from the next step on (obstacle_support.h)
   int tool_nodes = 0;              // node moves out of the tool obstacle (ContactStep::set_tool_obstacle)
+  // Nodes beyond a bone this step (obstacle_projection.h): let back through
+  // it on their way home, and left alone by it.
+  int obstacle_returned = 0;
+  int obstacle_beyond = 0;
 };
 
 // Whether the contact is projected, and how. Obstacles are always hard: a
