@@ -15,13 +15,19 @@ SphereLinks tip_spheres(const TetMesh& mesh, std::size_t count) {
   return links;
 }
 
+// No gravity, so a body at rest stays there (f = 0), and 10 ms steps.
+BodySettings still_settings() {
+  BodySettings settings;
+  settings.gravity_m_per_s2.setZero();
+  settings.time_step = std::chrono::milliseconds(10);
+  return settings;
+}
+
 TEST(Compliance, MatchesTheResponseOfOneStep) {
   // At rest without gravity f = 0, so one step with force F on sphere t
   // (spread as J^T F) moves sphere s by exactly W_st F.
   const TetMesh mesh = test::bar_mesh(2);
-  BodySettings settings;
-  settings.gravity_m_per_s2.setZero();
-  settings.time_step = std::chrono::milliseconds(10);
+  const BodySettings settings = still_settings();
   const SphereLinks links = tip_spheres(mesh, 3);
   const std::vector<std::uint32_t> spheres = {0, 1, 2};
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
@@ -59,9 +65,7 @@ TEST(Compliance, AlongNormalsIsTheBlocksTimesTheNormals) {
   // One column a sphere, W_st n_t, is the 3x3 blocks applied to n_t; the
   // 3x3 blocks' kept columns are not disturbed by it.
   const TetMesh mesh = test::bar_mesh(2);
-  BodySettings settings;
-  settings.gravity_m_per_s2.setZero();
-  settings.time_step = std::chrono::milliseconds(10);
+  const BodySettings settings = still_settings();
   const SphereLinks links = tip_spheres(mesh, 3);
   const std::vector<std::uint32_t> spheres = {2, 0, 1};
   const std::vector<Eigen::Vector3d> normals = {Eigen::Vector3d(0.0, 0.6, 0.8), Eigen::Vector3d(-1.0, 0.0, 0.0),

@@ -31,6 +31,12 @@ BodySettings rest_factor_settings() {
   return s;
 }
 
+// A bar body with the settings above (every test that compares two steps
+// makes two).
+std::unique_ptr<Body> bar_body(const Bar& bar) {
+  return test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+}
+
 // A tool pressing the first sphere down with 0.01 N, active on its plane.
 ContactSet press(const Bar& bar, const Body& body, double force_n) {
   ContactSet set;
@@ -49,8 +55,8 @@ ContactSet press(const Bar& bar, const Body& body, double force_n) {
 
 TEST(ContactStep, FreeCentresAreTheMotionWithoutTheContactForces) {
   Bar bar;
-  auto pushed = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
-  auto free = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  auto pushed = bar_body(bar);
+  auto free = bar_body(bar);
   ASSERT_TRUE(pushed && free);
   ContactStep with(*pushed, bar.links);
   ContactStepSettings no_forces;
@@ -76,8 +82,8 @@ TEST(ContactStep, AlongNormalsGivesTheSameFreeCentresAndTheBlocksAlongTheSetsNor
   // free-motion centres as the 3x3 blocks, and its columns are the blocks
   // times those normals; a turned normal is solved again, not reused.
   Bar bar;
-  auto blocks_body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
-  auto along_body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  auto blocks_body = bar_body(bar);
+  auto along_body = bar_body(bar);
   ASSERT_TRUE(blocks_body && along_body);
   ContactStep blocks(*blocks_body, bar.links);
   ContactStepSettings along_settings;
@@ -128,8 +134,8 @@ TEST(ContactStep, ADivergedStepResetsTheBodyToRest) {
   c.normal = Eigen::Vector3d(0, -1, 0);
   c.force_n = 1e9;
   set.contacts.push_back(c);
-  auto unchecked_body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
-  auto checked_body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  auto unchecked_body = bar_body(bar);
+  auto checked_body = bar_body(bar);
   ASSERT_TRUE(unchecked_body && checked_body);
   ContactStep unchecked(*unchecked_body, bar.links);
   ContactStepSettings limit;
@@ -152,7 +158,7 @@ TEST(ContactStep, ADivergedStepResetsTheBodyToRest) {
 
 TEST(ContactStep, ReusesComplianceOnlyWhileSpheresAndFactorAreUnchanged) {
   Bar bar;
-  auto body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  auto body = bar_body(bar);
   ASSERT_TRUE(body);
   ContactStep step(*body, bar.links);
   ContactSet set = press(bar, *body, 0.0);
@@ -197,7 +203,7 @@ TEST(ContactStep, AResetBodyStepsAsANewOne) {
 TEST(ContactStep, StepAllocatesNothingOnceSized) {
   test::hook_suitesparse_allocations();
   Bar bar;
-  auto body = test::make_body(rest_factor_settings(), bar.mesh, test::fixed_x0(bar.mesh));
+  auto body = bar_body(bar);
   ASSERT_TRUE(body);
   ContactStep step(*body, bar.links);
   ContactSet set = press(bar, *body, 0.01);

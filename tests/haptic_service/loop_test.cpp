@@ -203,11 +203,16 @@ msg::DeformationState rest_state(const HapticSetup& setup) {
   return state;
 }
 
-TEST(TissueDigest, IndexesTheComplianceSpheres) {
+// The neonatal scene's digest, a fresh snapshot and a state at rest.
+class TissueDigestAtRest : public ::testing::Test {
+ protected:
   const HapticSetup& setup = neonatal_scene().setup;
-  TissueDigest digest(setup);
+  TissueDigest digest{setup};
   TissueSnapshot snapshot = digest.make_snapshot();
   msg::DeformationState state = rest_state(setup);
+};
+
+TEST_F(TissueDigestAtRest, IndexesTheComplianceSpheres) {
   state.compliance_sphere_ids({5, 9});
   state.compliance_mpn().assign(36, 1e-3f);
   state.compliance_free_centres_m().assign(6, 0.01f);
@@ -230,14 +235,10 @@ TEST(TissueDigest, IndexesTheComplianceSpheres) {
   EXPECT_EQ(snapshot.compliance_count, 0u);
 }
 
-TEST(TissueDigest, TakesWAlongTheFemsNormals) {
+TEST_F(TissueDigestAtRest, TakesWAlongTheFemsNormals) {
   // (3k x k) columns with k normals: the view reads them as W along the
   // normals; without enough normals, or with a block of the 3x3 size but
   // normals present, W is refused (rows then use the fallback).
-  const HapticSetup& setup = neonatal_scene().setup;
-  TissueDigest digest(setup);
-  TissueSnapshot snapshot = digest.make_snapshot();
-  msg::DeformationState state = rest_state(setup);
   state.compliance_sphere_ids({5, 9});
   state.compliance_mpn().assign(12, 0.0f);
   state.compliance_mpn()[(3 * 1 + 1) * 2 + 0] = 2e-3f;  // sphere 9 moves +y per newton on sphere 5 along its normal

@@ -22,6 +22,19 @@ double sphere_motion(const SphereLinks& links, std::uint32_t sphere, const doubl
   return sum;
 }
 
+// Adds J_s^T v to `column`: w_i v at node i's DOFs, fixed DOFs left at 0.
+void add_spread(const SphereLinks& links, std::uint32_t sphere, const Eigen::Vector3d& v,
+                std::span<const std::uint8_t> fixed_dof, double* column) {
+  const auto nodes = links.nodes(sphere);
+  const auto weights = links.weights(sphere);
+  for (std::size_t m = 0; m < nodes.size(); ++m) {
+    for (std::size_t d = 0; d < 3; ++d) {
+      const std::size_t dof = 3 * std::size_t{nodes[m]} + d;
+      if (fixed_dof[dof] == 0) column[dof] += weights[m] * v[static_cast<Eigen::Index>(d)];
+    }
+  }
+}
+
 }  // namespace
 
 void ComplianceBlock::reserve(std::size_t dofs, std::size_t max_spheres) {
@@ -69,15 +82,9 @@ void ComplianceBlock::solve_chunk(std::span<const std::size_t> slots, const Sphe
   // B = J^T: column 3s + d holds w_i at row 3 n_i + d.
   std::fill(rhs_.begin(), rhs_.begin() + static_cast<std::ptrdiff_t>(dofs_ * columns), 0.0);
   for (std::size_t s = 0; s < slots.size(); ++s) {
-    const std::uint32_t sphere = slots_[slots[s]].sphere;
-    const auto nodes = links.nodes(sphere);
-    const auto weights = links.weights(sphere);
     for (std::size_t d = 0; d < 3; ++d) {
-      double* column = rhs_.data() + dofs_ * (3 * s + d);
-      for (std::size_t m = 0; m < nodes.size(); ++m) {
-        const std::size_t dof = 3 * std::size_t{nodes[m]} + d;
-        if (fixed_dof[dof] == 0) column[dof] += weights[m];
-      }
+      add_spread(links, slots_[slots[s]].sphere, Eigen::Vector3d::Unit(static_cast<Eigen::Index>(d)), fixed_dof,
+                 rhs_.data() + dofs_ * (3 * s + d));
     }
   }
   warp.solve_columns(factor, {rhs_.data(), dofs_ * columns}, {solution_.data(), dofs_ * columns},
@@ -165,17 +172,7 @@ bool ComplianceBlock::compute_along(std::span<const std::uint32_t> spheres, std:
     // B = J^T N: column t holds w_i n_t at node i's DOFs.
     std::fill(rhs_.begin(), rhs_.begin() + static_cast<std::ptrdiff_t>(dofs_ * chunk), 0.0);
     for (std::size_t c = 0; c < chunk; ++c) {
-      const std::uint32_t sphere = spheres[done + c];
-      const Eigen::Vector3d& n = normals[done + c];
-      const auto nodes = links.nodes(sphere);
-      const auto weights = links.weights(sphere);
-      double* column = rhs_.data() + dofs_ * c;
-      for (std::size_t m = 0; m < nodes.size(); ++m) {
-        for (std::size_t d = 0; d < 3; ++d) {
-          const std::size_t dof = 3 * std::size_t{nodes[m]} + d;
-          if (fixed_dof[dof] == 0) column[dof] += weights[m] * n[static_cast<Eigen::Index>(d)];
-        }
-      }
+      add_spread(links, spheres[done + c], normals[done + c], fixed_dof, rhs_.data() + dofs_ * c);
     }
     warp.solve_columns(factor, {rhs_.data(), dofs_ * chunk}, {solution_.data(), dofs_ * chunk},
                        static_cast<int>(chunk));
