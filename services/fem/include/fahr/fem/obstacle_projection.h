@@ -18,10 +18,10 @@
 //
 // A node can still end up beyond a thin bone (pushed through by conflicting
 // constraints, or along the normal from deep inside). Path-following would
-// then keep it there for good: on the neonatal overshoot a node 39 mm from
-// rest, its rest on the other side of the jaw, was pulled 7 mm back through
-// the bone by its elements each step and put back each step, its inverted
-// tets pinned for the rest of the run. So with the rest positions given, a
+// then keep it there for good: on the neonatal overshoot a node far from
+// rest, its rest on the other side of the jaw, was pulled back through the
+// bone by its elements each step and put back each step, its inverted tets
+// pinned for the rest of the run. So with the rest positions given, a
 // path that crosses a surface is let through when it brings a node home:
 // the segment from the node's rest position to its start enters the
 // obstacle and the segment from its rest position to where the path ends

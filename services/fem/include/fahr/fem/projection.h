@@ -32,10 +32,11 @@ enum class FrozenTarget : std::uint8_t {
   // Contact::hold_centre_m, the haptic side's estimate of where the tool
   // keeps the sphere (contact_response.cpp capture_holds). It is made from
   // an older state and, without W, a fallback compliance, so on the pressed
-  // neonatal tongue 11 of 27 holds sat 2-7 mm from the FEM's centres and
-  // from each other; pulled to such targets through shared nodes, alternated with
-  // the anatomy, the projection moved a node 153 mm in one step
-  // (fahr_overshoot_bench --response force-aware, the first frozen step).
+  // neonatal tongue the holds sat millimetres from the FEM's centres and
+  // from each other; pulled to such targets through shared nodes, alternated
+  // with the anatomy, the projection moved a node past the divergence limit
+  // in one step (fahr_overshoot_bench --response force-aware at ae54ed4,
+  // the first frozen step).
   // Kept to compare.
   kHoldCentre,
 };
