@@ -100,6 +100,11 @@ int main(int argc, char** argv) {
     // Wall time of the tick's phases (a preempted tick shows in the tail).
     std::vector<double> tissue_query_us, anatomy_query_us, response_us;
     std::vector<double> query_nodes, query_spheres, query_contacts, query_inside;  // the AIST query's work per tick
+    // The tissue query on the first tick of a FEM state (every sphere moved:
+    // the floors of the last query bound less, and the refit left the data
+    // cold) and on the ticks after it (only the blade moved).
+    std::vector<double> query_new_state_us, query_same_state_us, spheres_new_state, spheres_same_state;
+    std::uint64_t states_seen = sim.haptic().metrics().snapshots.load(std::memory_order_relaxed);
     for (std::uint64_t k = 0; k < steps; ++k) {
       sim.step();
       const auto& report = sim.haptic().response().report();
@@ -115,6 +120,10 @@ int main(int argc, char** argv) {
       query_spheres.push_back(phases.tissue_query.spheres_tested);
       query_contacts.push_back(phases.tissue_query.contacts);
       query_inside.push_back(phases.tissue_query.spheres_inside);
+      const std::uint64_t states = sim.haptic().metrics().snapshots.load(std::memory_order_relaxed);
+      (states != states_seen ? query_new_state_us : query_same_state_us).push_back(phases.tissue_query_us);
+      (states != states_seen ? spheres_new_state : spheres_same_state).push_back(phases.tissue_query.spheres_tested);
+      states_seen = states;
       const auto& f = sim.command().force_n();
       peak_force = std::max(peak_force, std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z()));
     }
@@ -154,6 +163,8 @@ int main(int argc, char** argv) {
                   quantile(wall_us, 0.99), quantile(wall_us, 0.999));
     };
     print_phase("tissue query", tissue_query_us);
+    print_phase("  new state", query_new_state_us);
+    print_phase("  same state", query_same_state_us);
     print_phase("anatomy query", anatomy_query_us);
     print_phase("response", response_us);
     std::printf("stack_sim: AIST query per tick: tree nodes p50 %.0f p99 %.0f, spheres tested p50 %.0f p99 %.0f, "
@@ -161,6 +172,9 @@ int main(int argc, char** argv) {
                 quantile(query_nodes, 0.5), quantile(query_nodes, 0.99), quantile(query_spheres, 0.5),
                 quantile(query_spheres, 0.99), quantile(query_contacts, 0.5), quantile(query_contacts, 0.99),
                 quantile(query_contacts, 1.0), quantile(query_inside, 0.99), quantile(query_inside, 1.0));
+    std::printf("stack_sim: AIST spheres tested on a new FEM state p50 %.0f p99 %.0f, on the same state p50 %.0f p99 %.0f\n",
+                quantile(spheres_new_state, 0.5), quantile(spheres_new_state, 0.99), quantile(spheres_same_state, 0.5),
+                quantile(spheres_same_state, 0.99));
     std::printf("lockstep_clock: hash device_gateway %016llx\n", static_cast<unsigned long long>(sim.gateway_hash()));
     std::printf("lockstep_clock: hash fem %016llx\n", static_cast<unsigned long long>(sim.fem_hash()));
     std::printf("lockstep_clock: hash haptic %016llx\n", static_cast<unsigned long long>(sim.haptic_hash()));

@@ -220,9 +220,17 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   // each within a cell plus twice the storage error e; beyond the grid the
   // clamp adds slope 1. The sphere floors below
   // (PrePenetrationMemory::remember) use it.
+  // Between two points both on the grid (a box, so the segment is too) the
+  // clamp's slope does not enter: L = sqrt(3) (1 + 2 e / h).
   const double storage_error = copy != nullptr ? copy->storage_error_m() : 0.0;
-  const double lipschitz = std::sqrt(3.0) * (1.0 + 2.0 * storage_error / sdf.cell_size_m()) + 1.0;
-  const double lipschitz_squared = lipschitz * lipschitz;
+  const double lipschitz_on_grid = std::sqrt(3.0) * (1.0 + 2.0 * storage_error / sdf.cell_size_m());
+  const double lipschitz = lipschitz_on_grid + 1.0;
+  // What a decision taken from the grid (or a floor of it) must leave for
+  // the grid's error. The exact narrow phase decides on the true distance,
+  // within grid_error of the grid. The grid narrow phase's contacts are the
+  // grid's own values (a contact is r - grid > -margin): a floor of the grid
+  // decides them with nothing to spare.
+  const double decision_error = settings.exact_narrow_phase ? grid_error : 0.0;
 
   // Lower bound of the grid value at any point of a node's spheres (grown by
   // the skin and the candidate margin), m. On the grid: the grid at the box's
@@ -238,13 +246,15 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   const Eigen::Vector3d inset = Eigen::Vector3d::Constant(sdf.band_m() + 2.0 * sdf.cell_size_m());
   const Eigen::Vector3d surface_low = grid_low + inset;
   const Eigen::Vector3d surface_high = grid_high - inset;
+  auto on_grid = [&](const Eigen::Vector3d& p) noexcept {
+    return (p.array() >= grid_low.array()).all() && (p.array() <= grid_high.array()).all();
+  };
   auto node_middle = [&](const SphereTreeNode& node) noexcept {
     return frame.to_body(0.5 * (node.box_min_m + node.box_max_m));
   };
   auto bound_at = [&](const SphereTreeNode& node, const Eigen::Vector3d& middle) noexcept {
     const double reach = node.reach_m + settings.contact_skin_m + settings.candidate_margin_m;
-    const bool on_grid = (middle.array() >= grid_low.array()).all() && (middle.array() <= grid_high.array()).all();
-    if (on_grid) return field.distance(middle) - 2.0 * grid_error - reach;
+    if (on_grid(middle)) return field.distance(middle) - 2.0 * grid_error - reach;
     const double to_surface_box = (middle - middle.cwiseMax(surface_low).cwiseMin(surface_high)).norm();
     return to_surface_box - grid_error - reach;  // a NaN pose gives NaN: the caller prunes it
   };
@@ -278,8 +288,8 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     }
     return count;
   };
-  // The grid read at a sphere decides first whether grid - error > r +
-  // candidate margin (then it is only remembered). Its memory's floor of the
+  // The grid read at a sphere decides first whether grid - decision_error >
+  // r + candidate margin (then it is only remembered). Its memory's floor of the
   // grid at the centre it last remembered decides that without the read
   // when floor - L |p - centre| is still beyond it. No square root unless
   // the read is skipped: the new floor needs it.
@@ -288,10 +298,12 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     for (std::size_t k = 0; k < count; ++k) {
       const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
       const double r = slots[slot][3] + settings.contact_skin_m;
-      const double spare = memory.grid_floor_m(slot) - grid_error - r - settings.candidate_margin_m;
-      const double moved_squared = (leaf_body[k] - memory.last_centre_body_m(slot)).squaredNorm();
-      if (spare > 0.0 && spare * spare > lipschitz_squared * moved_squared) {
-        leaf_floor[k] = memory.grid_floor_m(slot) - lipschitz * std::sqrt(moved_squared);
+      const double spare = memory.grid_floor_m(slot) - decision_error - r - settings.candidate_margin_m;
+      const Eigen::Vector3d& last = memory.last_centre_body_m(slot);
+      const double moved_squared = (leaf_body[k] - last).squaredNorm();
+      const double slope = on_grid(leaf_body[k]) && on_grid(last) ? lipschitz_on_grid : lipschitz;
+      if (spare > 0.0 && spare * spare > slope * slope * moved_squared) {
+        leaf_floor[k] = memory.grid_floor_m(slot) - slope * std::sqrt(moved_squared);
       } else {
         leaf_floor[k] = std::numeric_limits<double>::quiet_NaN();
         if (copy != nullptr) copy->prefetch(leaf_body[k]);
@@ -299,8 +311,8 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     }
   };
   // A leaf whose bound proves every centre outside, with its margin to
-  // spare: each sphere would pass the leaf test's first check (grid - error
-  // > r + candidate margin) and only be remembered, so it is remembered
+  // spare: each sphere would pass the leaf test's first check (grid -
+  // decision_error > r + candidate margin) and only be remembered, so it is remembered
   // without its grid read (and its cells are not prefetched: lines nobody
   // reads only evict others). The same memory and contacts as testing it.
   // The floor it leaves: the grid at a sphere is at least the bound + r +
@@ -339,8 +351,8 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       FieldGrid::Read cell;
       if (one_read) cell = copy->read(p);
       const double grid = one_read ? cell.value : field.distance(p);
-      if (grid - grid_error > r + settings.candidate_margin_m) {
-        if (grid - grid_error > 0.0) memory.remember(slot, p, query, grid);
+      if (grid - decision_error > r + settings.candidate_margin_m) {
+        memory.remember(slot, p, query, grid);  // outside: grid - error > r > 0
         continue;
       }
       // The grid narrow phase's distance is this read: with the centre
@@ -458,7 +470,7 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       }
       // bound - error > 0: every centre is outside by more than its radius,
       // the skin and the candidate margin plus the sphere test's own error.
-      if (next.bound_m - grid_error > kDecisionSlackM) {
+      if (next.bound_m - decision_error > kDecisionSlackM) {
         remember_leaf(node, next.bound_m);
       } else {
         test_leaf(node);
