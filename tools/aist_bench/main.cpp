@@ -2,7 +2,7 @@
 // (default: all), record / replay FILE (replay.cpp: the query alone on
 // recorded states, contact hashes), detection (the trajectory with the FEM driven by node
 // contacts, both detectors judged on the same states). Usage: aist_bench
-// [coverage|trajectory|detection|sweep|all] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe anchor|face] [--spread W] [--sweep-steps N] [--file PATH] [--evict-kb K] [--replay-only K] [--replay-passes P]
+// [coverage|trajectory|detection|sweep|all] [--scene-dir DIR] [--max-spheres N] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe anchor|face] [--spread W] [--sweep-steps N] [--file PATH] [--evict-kb K] [--replay-only K] [--replay-passes P]
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -15,8 +15,13 @@ int main(int argc, char** argv) {
   using namespace fahr::aist_bench;
   std::string section = "all";
   Options options;
+  std::string scene_dir = FAHR_NEONATAL_DIR;
   for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--ticks") == 0 && i + 1 < argc) {
+    if (std::strcmp(argv[i], "--scene-dir") == 0 && i + 1 < argc) {
+      scene_dir = argv[++i];
+    } else if (std::strcmp(argv[i], "--max-spheres") == 0 && i + 1 < argc) {
+      options.max_spheres = static_cast<std::size_t>(std::stoul(argv[++i]));
+    } else if (std::strcmp(argv[i], "--ticks") == 0 && i + 1 < argc) {
       options.ticks = std::stoi(argv[++i]);
     } else if (std::strcmp(argv[i], "--spread") == 0 && i + 1 < argc) {
       options.weight_spread = std::stod(argv[++i]);
@@ -59,8 +64,9 @@ int main(int argc, char** argv) {
     }
   }
   try {
-    const auto scene = load_scene(0.5e-3);
+    const auto scene = load_scene(0.5e-3, scene_dir);
     std::printf("# AIST benchmark (neonatal scene, Miller 1 blade)\n\n");
+    if (scene_dir != FAHR_NEONATAL_DIR) std::printf("scene: %s\n\n", scene_dir.c_str());
     std::printf("tongue: %zu nodes, %zu tets, %zu boundary triangles (mean edge %.2f mm); blade: %zu triangles\n",
                 scene->tongue.node_count(), scene->tongue.tet_count(), scene->boundary.triangle_count(),
                 scene->mean_boundary_edge_m * 1e3, scene->blade.triangle_count());

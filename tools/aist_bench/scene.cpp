@@ -41,8 +41,7 @@ geometry::SignedDistanceField make_field(const geometry::SurfaceMesh& surface, d
 
 }  // namespace
 
-std::unique_ptr<Scene> load_scene(double blade_cell_m) {
-  const std::string dir = FAHR_NEONATAL_DIR;
+std::unique_ptr<Scene> load_scene(double blade_cell_m, const std::string& dir) {
   auto tongue = geometry::load_tetgen(dir + "/tongue", kMillimetre);
   std::vector<geometry::Index> s2n;
   auto boundary = tongue.boundary_surface(&s2n);

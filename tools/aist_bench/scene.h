@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "fahr/fem/body.h"
@@ -31,8 +32,10 @@ struct Scene {
   double dorsum_x0_m = 0.0;
 };
 
-// Loads meshes/neonatal; the blade's field has `blade_cell_m` cells.
-std::unique_ptr<Scene> load_scene(double blade_cell_m);
+// Loads the neonatal scene from `dir` (meshes/neonatal, or a scene that
+// tools/scene_generator wrote elsewhere, e.g. a finer tongue); the blade's
+// field has `blade_cell_m` cells.
+std::unique_ptr<Scene> load_scene(double blade_cell_m, const std::string& dir);
 
 // The scripted trajectory, s in [0, 1]. The README's initial pose (tip
 // (12, 0.5, 0) mm) and pressing pose (tip x -33 mm, pitch 8 deg) set where it

@@ -23,6 +23,7 @@ struct Options {
   double approach_margin_m = haptic::QuerySettings{}.approach_margin_m;  // QuerySettings of the trajectory
   double anchor_depth_factor = haptic::FillSettings{}.hugging_anchor_depth_factor;
   double anchor_gap_m = haptic::FillSettings{}.anchor_gap_m;  // FillSettings::anchor_gap_m
+  std::size_t max_spheres = haptic::FillSettings{}.max_spheres;  // FillSettings::max_spheres (a finer tongue needs more)
   haptic::QuerySettings::SurfaceProbe surface_probe = haptic::QuerySettings{}.surface_probe;  // --surface-probe anchor|face
   // true (section "detection"): the trajectory's FEM is driven by node
   // contacts (node_contacts.h) instead of the AIST's, so both detectors are

@@ -98,6 +98,7 @@ haptic::FillSettings trajectory_fill(const Options& options) {
   fill.hugging_radius_fraction = options.hugging_radius_fraction;
   fill.hugging_anchor_depth_factor = options.anchor_depth_factor;
   fill.anchor_gap_m = options.anchor_gap_m;
+  fill.max_spheres = options.max_spheres;
   return fill;
 }
 

@@ -264,6 +264,7 @@ struct RunChoices {
   bool fem_anatomy_slide = false;
   std::string held_proxy = "limit";
   bool fem_tool_obstacle = false;
+  double candidate_margin_mm = -1.0;
   std::string row_compliance = "scene";
   int w_normals = 0;
   std::string trace_path;
@@ -314,6 +315,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   if (choices.held_proxy == "stay") options.held_proxy = contact::HeldProxy::kStay;
   if (choices.held_proxy == "fixed") options.held_proxy = contact::HeldProxy::kUnclamped;
   options.fem_tool_obstacle = choices.fem_tool_obstacle;
+  if (choices.candidate_margin_mm >= 0.0) options.candidate_margin_m = 1e-3 * choices.candidate_margin_mm;
   if (choices.row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(choices.row_compliance);
   if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
   if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
@@ -510,6 +512,9 @@ int main(int argc, char** argv) {
                  "(stay where it froze, tissue forces scaled to the limit) or fixed (a diagnostic: stay, tissue "
                  "forces unclamped)")
       ->check(CLI::IsMember({"limit", "stay", "fixed"}));
+  app.add_option("--candidate-margin-mm", choices.candidate_margin_mm,
+                 "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; default the service's 1")
+      ->check(CLI::Range(0.0, 5.0));
   app.add_flag("--fem-tool-obstacle", choices.fem_tool_obstacle,
                "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose, not only the "
                "ContactSet's spheres (services/fem contact_step.h set_tool_obstacle)");

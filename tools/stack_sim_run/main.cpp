@@ -66,6 +66,10 @@ int main(int argc, char** argv) {
                  "W along the normals for this many spheres (solver.compliance_columns: normals, "
                  "max_candidate_contacts); 0: the scene's")
       ->check(CLI::Range(0, 64));
+  double candidate_margin_mm = -1.0;
+  app.add_option("--candidate-margin-mm", candidate_margin_mm,
+                 "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; default the service's 1")
+      ->check(CLI::Range(0.0, 5.0));
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -76,6 +80,7 @@ int main(int argc, char** argv) {
     if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
     options.fem_tool_obstacle = fem_tool_obstacle;
     options.fem_anatomy_slide = fem_anatomy_slide;
+    if (candidate_margin_mm >= 0.0) options.candidate_margin_m = 1e-3 * candidate_margin_mm;
     if (row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(row_compliance);
     options.collision =
         collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;

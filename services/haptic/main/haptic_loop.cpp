@@ -80,9 +80,9 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
   tool_body_.id = setup.tool->scene_body->id;
   tool_body_.sdf = setup.tool->sdf.get();
   tool_body_.grid = setup.tool_grid.get();
-  // Spheres within 1 mm of the blade are sent as candidates, so the FEM
-  // computes their compliance before they touch.
-  tool_query_.candidate_margin_m = 1e-3;
+  // Spheres near the blade are sent as candidates, so the FEM computes
+  // their compliance before they touch.
+  tool_query_.candidate_margin_m = setup.candidate_margin_m;
   // The grid's distance (~0.1 us a sphere) rather than the triangles' (1-3
   // us on the 19k-triangle blade): with a few hundred spheres near the blade
   // the exact query alone can take the whole 1 ms period on a shared core.

@@ -90,6 +90,11 @@ struct HapticSetup {
   // takes (see RowCompliance): kFreeDepth where the scene has W along the
   // normals (solver.compliance_columns), else kDeepest.
   RowCompliance row_compliance = RowCompliance::kDeepest;
+  // Spheres within this gap of the tool are rows too (candidates, lambda = 0
+  // until the proxy moves into them), m, >= 0: the solve then stops the
+  // proxy within the tick instead of one tick late. The walk also visits
+  // spheres 1 mm beyond it, to remember their centres outside.
+  double candidate_margin_m = 1e-3;
 };
 
 // Throws std::runtime_error naming the body and what is wrong.

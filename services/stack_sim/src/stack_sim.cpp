@@ -41,6 +41,7 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   gateway_ = std::make_unique<device::ServoCore>(gateway_config_, *hand_);
   haptic_setup_.response.force_aware.held_proxy = options.held_proxy;
   if (options.row_compliance) haptic_setup_.row_compliance = *options.row_compliance;
+  if (options.candidate_margin_m) haptic_setup_.candidate_margin_m = *options.candidate_margin_m;
   haptic_ = std::make_unique<haptic_service::HapticLoop>(haptic_setup_);
   digest_ = std::make_unique<haptic_service::TissueDigest>(haptic_setup_);
   tissue_ = digest_->make_snapshot();

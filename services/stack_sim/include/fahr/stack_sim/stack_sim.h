@@ -63,6 +63,8 @@ struct StackOptions {
   bool fem_tool_obstacle = false;
   // Overrides HapticSetup::row_compliance (the scene's choice) when set.
   std::optional<haptic_service::RowCompliance> row_compliance;
+  // Overrides HapticSetup::candidate_margin_m when set, m.
+  std::optional<double> candidate_margin_m;
 };
 
 class StackSim {
