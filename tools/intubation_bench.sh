@@ -5,7 +5,8 @@
 # separate processes over DDS) for S seconds, once with the AIST and once
 # with the triangle-level baseline finding the blade's contacts with the
 # tongue; prints the haptic tick's thread-CPU time (median, p99, p99.9,
-# max over the whole run) and the number of tick periods longer than 1.5 ms.
+# max over the whole run) and the number of tick periods longer than 1.5 ms,
+# then each run's tick parts as the haptic service prints them.
 #
 #   tools/intubation_bench.sh [BUILD_DIR] [--seconds 60] [--dds cyclonedds] [--scene FILE]
 #                             [--cpus-fem LIST --cpus-haptic LIST] [--only aist|triangle]
@@ -28,7 +29,7 @@ while [ $# -gt 0 ]; do
     --scene) scene_flags=(--scene "$2"); shift 2 ;;
     --cpus-fem|--cpus-haptic) pin_flags+=("$1" "$2"); shift 2 ;;
     --only) collisions=("$2"); shift 2 ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     -*) echo "intubation_bench: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
@@ -52,4 +53,10 @@ for collision in "${collisions[@]}"; do
   reaction=$(awk -F'|' '{ gsub(/^ +| +$/, "", $2) } $2 == "peak tissue reaction N" { gsub(/ /, "", $3); print $3 }' "$out/$collision.txt")
   used=$(sed -nE 's/.* ticks on ([0-9]+) FEM states.*/\1/p' "$log")
   echo "| $collision | $ticks | $median | $p99 | $p999 | $max | $long | ${reaction:-?} | ${used:-?} |"
+done
+# Where the tick's time goes (the haptic service's own breakdown).
+for collision in "${collisions[@]}"; do
+  echo
+  echo "$collision:"
+  sed -nE 's/^fahr_haptic_service: (tick part .*)/  \1/p' "$out/$collision/haptic.log"
 done

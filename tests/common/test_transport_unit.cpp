@@ -2,10 +2,12 @@
 // errors): the API behaves the same whichever vendor carries it.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
+#include "fahr/common/background_publisher.h"
 #include "fahr/common/config_error.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/subscriber.h"
@@ -191,6 +193,43 @@ TEST(ServiceReporter, ReportsTickStatisticsLatePeriodsAndQosEvents) {
   bool saw_match = false;
   for (const auto& e : events.newest().qos_events()) saw_match |= e.kind() == msg::QOS_PUBLICATION_MATCHED;
   EXPECT_TRUE(saw_match) << "the reporter's own publications matched the test's readers";
+}
+
+TEST(BackgroundPublisher, WritesTheNewestAndAccountsForEverySample) {
+  Participant p(in_process(7));
+  common::Subscriber<msg::ContactSet> sub(p);
+  constexpr std::uint32_t kSamples = 500;
+  std::uint64_t handed = 0;
+  std::uint64_t written = 0;
+  {
+    common::BackgroundPublisher<msg::ContactSet> pub(p, [] {
+      msg::ContactSet c;
+      c.contacts().reserve(msg::MAX_CONTACTS);
+      return c;
+    });
+    for (std::uint32_t i = 1; i <= kSamples; ++i) {
+      msg::ContactSet& c = pub.back();
+      c.haptic_tick(i);
+      c.contacts().resize(i % 64);  // the slot held an older sample: overwritten whole
+      pub.publish();
+    }
+    // The thread writes the last one handed over, however many it skipped.
+    std::uint64_t seen = 0;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (std::chrono::steady_clock::now() < deadline) {
+      seen = sub.wait_for_samples(seen, std::chrono::milliseconds(50));
+      if (sub.fetch_newest() && sub.newest().haptic_tick() == kSamples) break;
+    }
+    ASSERT_EQ(sub.newest().haptic_tick(), kSamples);
+    EXPECT_EQ(sub.newest().contacts().size(), kSamples % 64);
+    handed = pub.handed();
+    written = pub.written();
+    EXPECT_EQ(pub.refused(), 0U);
+  }  // joins the thread
+  EXPECT_EQ(handed, kSamples);
+  EXPECT_GE(written, 1U);
+  EXPECT_LE(written, handed);
+  EXPECT_EQ(sub.newest_info().seq, written) << "one write per sample written, none twice";
 }
 
 TEST(TickRecorder, DropsWhenFullInsteadOfBlocking) {

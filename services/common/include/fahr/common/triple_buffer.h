@@ -57,6 +57,9 @@ class TripleBuffer {
   }
   bool has_value() const { return has_value_; }
   const T& front() const { return slots_[consumer_index_]; }
+  // The consumer's slot is its own until the next fetch(): it may change it
+  // (a publisher stamps the sample's header before writing it).
+  T& front() { return slots_[consumer_index_]; }
 
   // Values published so far (any thread).
   std::uint64_t published() const { return published_.load(std::memory_order_seq_cst); }
