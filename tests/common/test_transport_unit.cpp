@@ -202,7 +202,7 @@ TEST(BackgroundPublisher, WritesTheNewestAndAccountsForEverySample) {
   std::uint64_t handed = 0;
   std::uint64_t written = 0;
   {
-    common::BackgroundPublisher<msg::ContactSet> pub(p, [] {
+    common::BackgroundPublisher<msg::ContactSet> pub(p, std::chrono::microseconds(200), [] {
       msg::ContactSet c;
       c.contacts().reserve(msg::MAX_CONTACTS);
       return c;

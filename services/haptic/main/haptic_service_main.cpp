@@ -63,10 +63,11 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
   common::Subscriber<msg::DevicePose> poses(participant);
   common::Publisher<msg::ForceCommand> commands(participant);
   // The ContactSet's write (tens of microseconds: serialisation and send)
-  // leaves the tick for a thread of its own; the FEM takes the newest set
-  // at its own rate anyway. The ForceCommand, which the gateway's servo
-  // loop waits on, is written on the tick.
-  common::BackgroundPublisher<msg::ContactSet> contact_sets(participant, [] {
+  // leaves the tick for a thread of its own, which looks for a new set
+  // every 0.5 ms; the FEM takes the newest set at its own rate (5 ms) anyway.
+  // The ForceCommand, which the gateway's servo loop waits on, is written
+  // on the tick.
+  common::BackgroundPublisher<msg::ContactSet> contact_sets(participant, 500us, [] {
     msg::ContactSet contacts;
     contacts.contacts().reserve(msg::MAX_CONTACTS);
     return contacts;
