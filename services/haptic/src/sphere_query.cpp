@@ -289,9 +289,9 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     return count;
   };
   // The grid read at a sphere decides first whether grid - decision_error >
-  // r + candidate margin (then it is only remembered). Its memory's floor of the
-  // grid at the centre it last remembered decides that without the read
-  // when floor - L |p - centre| is still beyond it. No square root unless
+  // r + candidate margin (then it is only remembered). Its memory's floor of
+  // the grid at the centre it last remembered decides that without the
+  // read when floor - L |p - centre| is still beyond it. No square root unless
   // the read is skipped: the new floor needs it.
   std::array<double, SphereTree::kLeafSize> leaf_floor;  // new floor of a sphere whose read is skipped, else NaN
   auto bound_leaf = [&](const SphereTreeNode& node, std::size_t count) noexcept {
@@ -312,9 +312,9 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   };
   // A leaf whose bound proves every centre outside, with its margin to
   // spare: each sphere would pass the leaf test's first check (grid -
-  // decision_error > r + candidate margin) and only be remembered, so it is remembered
-  // without its grid read (and its cells are not prefetched: lines nobody
-  // reads only evict others). The same memory and contacts as testing it.
+  // decision_error > r + candidate margin) and only be remembered, so it is
+  // remembered without its grid read (and its cells are not prefetched:
+  // lines nobody reads only evict others). The same memory and contacts as testing it.
   // The floor it leaves: the grid at a sphere is at least the bound + r +
   // candidate margin (|c - middle| + r <= reach, the bound's derivation).
   auto remember_leaf = [&](const SphereTreeNode& node, double bound) noexcept {
@@ -468,8 +468,9 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
         if (passes(right_bound)) push(node.first + 1, right_bound);
         continue;
       }
-      // bound - error > 0: every centre is outside by more than its radius,
-      // the skin and the candidate margin plus the sphere test's own error.
+      // bound - decision_error > 0: every centre is outside by more than its
+      // radius, the skin and the candidate margin plus the sphere test's own
+      // error (none in the grid narrow phase).
       if (next.bound_m - decision_error > kDecisionSlackM) {
         remember_leaf(node, next.bound_m);
       } else {

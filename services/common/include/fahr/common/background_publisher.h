@@ -5,11 +5,12 @@
 // tens of microseconds of CPU (tools/intubation_bench.sh prints the tick's
 // parts). The thread looks for a new sample every `period`: waking it on
 // each hand-over instead costs the tick a futex wake, a system call whose
-// tail showed in the tick's publishing part on this machine. A sample superseded before the thread got
-// to it is not written: the reader (the FEM, at its own rate) only ever
-// takes the newest, now up to one period later. Only for samples nobody
-// waits on within the tick: the ForceCommand, which the device's servo loop
-// does wait on, stays on the tick's thread.
+// tail showed in the tick's publishing part on this machine. A sample
+// superseded before the thread got to it is not written: the reader (the
+// FEM, at its own rate) only ever takes the newest, now up to one period
+// later. Only for samples nobody waits on within the tick: the
+// ForceCommand, which the device's servo loop does wait on, stays on the
+// tick's thread.
 #pragma once
 
 #include <atomic>
