@@ -1,8 +1,8 @@
 // aist_bench: prints Markdown tables. Sections: coverage, trajectory, sweep
 // (default: all), record / replay FILE (replay.cpp: the query alone on
-// recorded states, contact hashes), detection (the trajectory with the FEM driven by node
-// contacts, both detectors judged on the same states). Usage: aist_bench
-// [coverage|trajectory|detection|sweep|all] [--scene-dir DIR] [--max-spheres N] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe anchor|face] [--spread W] [--sweep-steps N] [--file PATH] [--evict-kb K] [--replay-only K] [--replay-passes P]
+// recorded states, contact hashes), detection (the trajectory with the FEM driven by its boundary
+// points' contacts, both detectors judged on the same states). Usage: aist_bench
+// [coverage|trajectory|detection|sweep|all] [--scene-dir DIR] [--max-spheres N] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe anchor|face] [--spread W] [--driver-subdivision N] [--sweep-steps N] [--file PATH] [--evict-kb K] [--replay-only K] [--replay-passes P]
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -57,6 +57,12 @@ int main(int argc, char** argv) {
       options.replay_only = std::stoi(argv[++i]);
     } else if (std::strcmp(argv[i], "--evict-kb") == 0 && i + 1 < argc) {
       options.evict_bytes = static_cast<std::size_t>(std::stoul(argv[++i])) * 1024;
+    } else if (std::strcmp(argv[i], "--driver-subdivision") == 0 && i + 1 < argc) {
+      options.driver_subdivision = std::stoi(argv[++i]);
+      if (options.driver_subdivision < 1) {
+        std::fprintf(stderr, "aist_bench: --driver-subdivision must be >= 1\n");
+        return 2;
+      }
     } else if (std::strcmp(argv[i], "--sweep-steps") == 0 && i + 1 < argc) {
       options.sweep_steps = std::stoi(argv[++i]);
     } else {

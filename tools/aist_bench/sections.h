@@ -25,10 +25,13 @@ struct Options {
   double anchor_gap_m = haptic::FillSettings{}.anchor_gap_m;  // FillSettings::anchor_gap_m
   std::size_t max_spheres = haptic::FillSettings{}.max_spheres;  // FillSettings::max_spheres (a finer tongue needs more)
   haptic::QuerySettings::SurfaceProbe surface_probe = haptic::QuerySettings{}.surface_probe;  // --surface-probe anchor|face
-  // true (section "detection"): the trajectory's FEM is driven by node
-  // contacts (node_contacts.h) instead of the AIST's, so both detectors are
-  // judged on states neither of them made.
+  // true (section "detection"): the trajectory's FEM is driven by contacts
+  // of its own boundary points (surface_contacts.h) instead of the AIST's,
+  // so both detectors are judged on states neither of them made.
   bool node_driven = false;
+  // --driver-subdivision N: segments per boundary face edge of those points
+  // (1: the nodes only); also the sweep's reference.
+  int driver_subdivision = 1;
   // true (--radius-rule stretch): the trajectory's SphereState uses the
   // smallest-stretch radius rule instead of the volume rule.
   bool stretch_radius = false;

@@ -5,11 +5,12 @@
 #include <deque>
 #include <numeric>
 #include <random>
+#include <string>
 #include <chrono>
 #include <cstdio>
 
 #include "contact_metrics.h"
-#include "node_contacts.h"
+#include "surface_contacts.h"
 #include "node_metrics.h"
 #include "fahr/haptic/field_grid.h"
 #include "fahr/haptic/fill_spheres.h"
@@ -151,7 +152,7 @@ void trajectory_table(const Scene& scene, const Options& options) {
   set.contacts.reserve(4096);
   ContactMetrics metrics(scene), grid_metrics(scene);
   NodeMetrics node_metrics(scene), grid_node_metrics(scene);
-  NodeContacts node_driver(scene);
+  SurfaceContacts node_driver(scene, options.driver_subdivision);
   const haptic::ContactBuffer& buffer = variants[0].buffer;  // drives the FEM in the closed loop
 
   Timings base;
@@ -265,8 +266,13 @@ void trajectory_table(const Scene& scene, const Options& options) {
     node_metrics.add_tick(buffer, state, base_contacts, blade.world_from_body, body->positions_m());
   }
 
+  const std::string driver_text =
+      options.driver_subdivision == 1
+          ? std::string("every boundary node (surface_contacts.h), neither detector")
+          : std::to_string(node_driver.point_count()) + " boundary points, the nodes and each face at subdivision " +
+                std::to_string(options.driver_subdivision) + " (surface_contacts.h), neither detector";
   std::printf("\n## %s: Miller 1 pressing and levering the FEM tongue (%d ticks at 1 kHz, FEM every %d ticks, contact skin %.2f mm, candidate margin %.2f mm)\n\n",
-              options.node_driven ? "Detection only (the FEM driven by node contacts)" : "Trajectory", options.ticks,
+              options.node_driven ? "Detection only (the FEM driven by its boundary points' contacts)" : "Trajectory", options.ticks,
               options.fem_every, options.skin_m * 1e3, kCandidateMarginM * 1e3);
   std::printf("Layout: %zu spheres (%zu grid level 0, %zu level 1, %zu hugging; %zu with a surface anchor, anchor gap %.2f mm, surface probe: %s), ratio %.0f, levels %d, weight spread %.2f (hugging %.2f), radius rule: %s. "
               "FEM (fahr::fem, corotational, implicit Euler, Algorithm 1 projection of %s): "
@@ -276,7 +282,7 @@ void trajectory_table(const Scene& scene, const Options& options) {
               layout.anchor_count(), fill.anchor_gap_m * 1e3,
               options.surface_probe == haptic::QuerySettings::SurfaceProbe::kAnchor ? "fixed anchor" : "face point under the contact",
               fill.volume_ratio, fill.refinement_levels, fill.weight_spread, fill.hugging_weight_spread,
-              options.stretch_radius ? "smallest stretch" : "volume", options.node_driven ? "every boundary node (node_contacts.h), neither detector" : "the AIST contacts", fem_steps,
+              options.stretch_radius ? "smallest stretch" : "volume", options.node_driven ? driver_text.c_str() : "the AIST contacts", fem_steps,
               fem_ms / static_cast<double>(fem_steps), max_aist_contacts, max_base_contacts, overflows,
               static_cast<unsigned long long>(tree.rebuild_count()), static_cast<unsigned long long>(baseline.rebuild_count()));
   std::printf("| method | query median (us) | query p99 | query p99.9 | query thread CPU: median / p99 / p99.9 (us) | best of %d: median / p99 / p99.9 (us) | warm rerun thread CPU: median / p99 / p99.9 (us) | update+refit median (us) | update+refit p99.9 | tick median (us) | tick p99 | tick p99.9 |\n",
