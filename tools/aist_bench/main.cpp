@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
       if (section == "replay") replay_states(*scene, options, options.file);
     }
     if (section == "detection") {
-      options.node_driven = true;
+      options.reference_driven = true;
       trajectory_table(*scene, options);
     }
   } catch (const std::exception& e) {

@@ -28,7 +28,7 @@ struct Options {
   // true (section "detection"): the trajectory's FEM is driven by contacts
   // of its own boundary points (surface_contacts.h) instead of the AIST's,
   // so both detectors are judged on states neither of them made.
-  bool node_driven = false;
+  bool reference_driven = false;
   // --driver-subdivision N: segments per boundary face edge of those points
   // (1: the nodes only); also the sweep's reference.
   int driver_subdivision = 1;

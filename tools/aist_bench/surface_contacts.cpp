@@ -6,25 +6,34 @@
 #include <set>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace fahr::aist_bench {
 namespace {
 
-// A point inside the box by less than this is still queried: the field's
-// exact distance decides, the box only skips what is plainly far.
+// The box is widened by this so that it holds the blade with room to
+// spare: a point outside it is outside the blade whatever the rounding of
+// the blade's bounds, and is skipped without a field query.
 constexpr double kBoxMarginM = 1e-3;
+
+// Adds a point; the weights are built to sum to 1, so a refusal is a bug
+// that would shift every later point's id.
+void add_point(fem::SphereLinks& links, std::span<const std::uint32_t> nodes, std::span<const double> weights) {
+  const std::string error = links.add_sphere(nodes, weights, 0.0);
+  if (!error.empty()) throw std::logic_error("surface contacts: " + error);
+}
 
 }  // namespace
 
-SurfaceContacts::SurfaceContacts(const Scene& scene, int subdivision) : scene_(scene), subdivision_(subdivision) {
+SurfaceContacts::SurfaceContacts(const Scene& scene, int subdivision) : scene_(scene) {
   if (subdivision < 1) throw std::invalid_argument("surface contacts: subdivision must be >= 1");
   std::vector<std::uint32_t> nodes;
   for (const auto n : scene.surface_to_node) nodes.push_back(static_cast<std::uint32_t>(n));
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   const double one = 1.0;
-  for (const auto n : nodes) links_.add_sphere(std::span<const std::uint32_t>(&n, 1), std::span<const double>(&one, 1), 0.0);
+  for (const auto n : nodes) add_point(links_, std::span<const std::uint32_t>(&n, 1), std::span<const double>(&one, 1));
 
   const double n_inv = 1.0 / subdivision;
   const auto node_of = [&](geometry::Index v) { return static_cast<std::uint32_t>(scene.surface_to_node[v]); };
@@ -39,7 +48,7 @@ SurfaceContacts::SurfaceContacts(const Scene& scene, int subdivision) : scene_(s
       for (int m = 1; m < subdivision; ++m) {
         const std::array<std::uint32_t, 2> ends{a, b};
         const std::array<double, 2> w{1.0 - m * n_inv, m * n_inv};
-        links_.add_sphere(ends, w, 0.0);
+        add_point(links_, ends, w);
       }
     }
     // The face's inner points: i + j + k = N, all >= 1.
@@ -47,7 +56,7 @@ SurfaceContacts::SurfaceContacts(const Scene& scene, int subdivision) : scene_(s
       for (int j = 1; i + j < subdivision; ++j) {
         const int k = subdivision - i - j;
         const std::array<double, 3> w{i * n_inv, j * n_inv, k * n_inv};
-        links_.add_sphere(face, w, 0.0);
+        add_point(links_, face, w);
       }
     }
   }
@@ -58,20 +67,12 @@ SurfaceContacts::SurfaceContacts(const Scene& scene, int subdivision) : scene_(s
   remembered_.assign(links_.size(), false);
 }
 
-Eigen::Vector3d SurfaceContacts::position(const fem::Body& body, std::size_t point) const {
-  const auto nodes = links_.nodes(point);
-  const auto weights = links_.weights(point);
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < nodes.size(); ++i) p += weights[i] * body.position(nodes[i]);
-  return p;
-}
-
 void SurfaceContacts::fill(const fem::Body& body, const Eigen::Isometry3d& world_from_blade, fem::ContactSet& set) {
   set.state_step = body.step_index();
   set.contacts.clear();
   const Eigen::Isometry3d blade_from_world = world_from_blade.inverse();
   for (std::size_t k = 0; k < links_.size(); ++k) {
-    const Eigen::Vector3d p = blade_from_world * position(body, k);
+    const Eigen::Vector3d p = blade_from_world * links_.centre(k, body.positions_m().data());
     if (!blade_box_.contains(p)) {
       outside_[k] = p;
       remembered_[k] = true;

@@ -12,11 +12,12 @@
 // subdivision N every boundary face is also sampled at the barycentric
 // points (i, j, k) / N (each edge point once), carried by the face's three
 // nodes with those weights: the rim then meets a point about edge / N away
-// and the face is pushed out as a whole. This is the triangle-resolved
-// reference the AIST's depth is judged against.
+// and the face is pushed out as a whole. With N > 1 this is the
+// triangle-resolved reference the AIST's depth is judged against.
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -37,13 +38,9 @@ class SurfaceContacts {
   void fill(const fem::Body& body, const Eigen::Isometry3d& world_from_blade, fem::ContactSet& set);
   const fem::SphereLinks& links() const { return links_; }
   std::size_t point_count() const { return links_.size(); }
-  int subdivision() const { return subdivision_; }
 
  private:
-  Eigen::Vector3d position(const fem::Body& body, std::size_t point) const;
-
   const Scene& scene_;
-  int subdivision_;
   fem::SphereLinks links_;
   // Points outside this box (the blade's, blade frame, widened by a margin)
   // are outside the blade: no field query for them.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <string>
@@ -152,7 +153,10 @@ void trajectory_table(const Scene& scene, const Options& options) {
   set.contacts.reserve(4096);
   ContactMetrics metrics(scene), grid_metrics(scene);
   NodeMetrics node_metrics(scene), grid_node_metrics(scene);
-  SurfaceContacts node_driver(scene, options.driver_subdivision);
+  // The reference driver, built only when it drives (its face points cost
+  // set-up at a high subdivision).
+  std::unique_ptr<SurfaceContacts> reference_driver;
+  if (options.reference_driven) reference_driver = std::make_unique<SurfaceContacts>(scene, options.driver_subdivision);
   const haptic::ContactBuffer& buffer = variants[0].buffer;  // drives the FEM in the closed loop
 
   Timings base;
@@ -167,10 +171,10 @@ void trajectory_table(const Scene& scene, const Options& options) {
     const bool new_state = tick % options.fem_every == 0;
     const bool aist_first = tick % 2 == 0;  // interleaved: neither always runs on a warm cache
     double aist_update = 0.0, base_update = 0.0;
-    if (new_state && options.node_driven) {
-      node_driver.fill(*body, blade.world_from_body, set);
+    if (new_state && options.reference_driven) {
+      reference_driver->fill(*body, blade.world_from_body, set);
       const auto fem_start = Clock::now();
-      body->step(&set, &node_driver.links());
+      body->step(&set, &reference_driver->links());
       fem_ms += elapsed_us(fem_start) / 1e3;
       ++fem_steps;
     } else if (new_state) {
@@ -267,12 +271,13 @@ void trajectory_table(const Scene& scene, const Options& options) {
   }
 
   const std::string driver_text =
-      options.driver_subdivision == 1
+      !reference_driver ? std::string()
+      : options.driver_subdivision == 1
           ? std::string("every boundary node (surface_contacts.h), neither detector")
-          : std::to_string(node_driver.point_count()) + " boundary points, the nodes and each face at subdivision " +
+          : std::to_string(reference_driver->point_count()) + " boundary points, the nodes and each face at subdivision " +
                 std::to_string(options.driver_subdivision) + " (surface_contacts.h), neither detector";
   std::printf("\n## %s: Miller 1 pressing and levering the FEM tongue (%d ticks at 1 kHz, FEM every %d ticks, contact skin %.2f mm, candidate margin %.2f mm)\n\n",
-              options.node_driven ? "Detection only (the FEM driven by its boundary points' contacts)" : "Trajectory", options.ticks,
+              options.reference_driven ? "Detection only (the FEM driven by its boundary points' contacts)" : "Trajectory", options.ticks,
               options.fem_every, options.skin_m * 1e3, kCandidateMarginM * 1e3);
   std::printf("Layout: %zu spheres (%zu grid level 0, %zu level 1, %zu hugging; %zu with a surface anchor, anchor gap %.2f mm, surface probe: %s), ratio %.0f, levels %d, weight spread %.2f (hugging %.2f), radius rule: %s. "
               "FEM (fahr::fem, corotational, implicit Euler, Algorithm 1 projection of %s): "
@@ -282,7 +287,7 @@ void trajectory_table(const Scene& scene, const Options& options) {
               layout.anchor_count(), fill.anchor_gap_m * 1e3,
               options.surface_probe == haptic::QuerySettings::SurfaceProbe::kAnchor ? "fixed anchor" : "face point under the contact",
               fill.volume_ratio, fill.refinement_levels, fill.weight_spread, fill.hugging_weight_spread,
-              options.stretch_radius ? "smallest stretch" : "volume", options.node_driven ? driver_text.c_str() : "the AIST contacts", fem_steps,
+              options.stretch_radius ? "smallest stretch" : "volume", options.reference_driven ? driver_text.c_str() : "the AIST contacts", fem_steps,
               fem_ms / static_cast<double>(fem_steps), max_aist_contacts, max_base_contacts, overflows,
               static_cast<unsigned long long>(tree.rebuild_count()), static_cast<unsigned long long>(baseline.rebuild_count()));
   std::printf("| method | query median (us) | query p99 | query p99.9 | query thread CPU: median / p99 / p99.9 (us) | best of %d: median / p99 / p99.9 (us) | warm rerun thread CPU: median / p99 / p99.9 (us) | update+refit median (us) | update+refit p99.9 | tick median (us) | tick p99 | tick p99.9 |\n",
@@ -315,7 +320,7 @@ void trajectory_table(const Scene& scene, const Options& options) {
                 percentile(base.best_query_us, 50) / percentile(t.best_query_us, 50),
                 percentile(base.best_query_us, 99.9) / percentile(t.best_query_us, 99.9));
   }
-  std::printf("\n### AIST, exact narrow phase%s\n", options.node_driven ? "" : " (its contacts drive the FEM)");
+  std::printf("\n### AIST, exact narrow phase%s\n", options.reference_driven ? "" : " (its contacts drive the FEM)");
   metrics.print();
   node_metrics.print();
   std::printf("\n### AIST, grid narrow phase\n");
