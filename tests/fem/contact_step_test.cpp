@@ -205,18 +205,23 @@ TEST(ContactStep, StepAllocatesNothingOnceSized) {
   Bar bar;
   auto body = bar_body(bar);
   ASSERT_TRUE(body);
-  ContactStep step(*body, bar.links);
+  // A floor just under the rest volume, so the pressed tets exercise it.
+  ContactStepSettings settings;
+  settings.volume_floor.ratio = 0.999;
+  ContactStep step(*body, bar.links, settings);
   ContactSet set = press(bar, *body, 0.01);
   std::vector<double> extra(3 * body->node_count(), 0.0);
   extra[3 * bar.top[1] + 1] = -0.001;
   for (int k = 0; k < 3; ++k) step.step(&set, extra);
   test::reset_allocation_counts();
   test::enable_allocation_counting(true);
+  int floor_moves = 0;
   for (int k = 0; k < 20; ++k) {
     set.state_step = body->step_index();
-    step.step(&set, extra);
+    floor_moves += step.step(&set, extra).projection.volume_floor_below;
   }
   test::enable_allocation_counting(false);
+  EXPECT_GT(floor_moves, 0);
   EXPECT_EQ(test::new_count(), 0u);
   EXPECT_EQ(test::suitesparse_alloc_count(), 0u);
 }

@@ -66,6 +66,7 @@ TEST(SceneDefaults, MinimalSceneGetsEveryDefault) {
   EXPECT_EQ(scene->solver.compliance, ComplianceMode::kExact);
   EXPECT_EQ(scene->solver.compliance_columns, ComplianceColumns::kBlocks);
   EXPECT_EQ(scene->solver.max_candidate_contacts, kDefaultMaxCandidateContacts);
+  EXPECT_EQ(scene->solver.volume_floor_ratio, 0.0);
   EXPECT_EQ(scene->solver.max_contact_age, kDefaultMaxContactAge);
 
   EXPECT_EQ(scene->contact.response, ContactResponse::kForceAware);
@@ -137,6 +138,7 @@ TEST(SceneDefaults, ExplicitSettingsAreRead) {
                      "    workspace_m: [0.16, 0.12, 0.07]\n  motion_scale: 2") +
             "solver:\n  linear_solver: pcg\n  cg_tolerance: 1e-8\n  cg_max_iterations: 50\n"
             "  compliance: lagged\n  compliance_columns: normals\n  max_contact_age_ms: 2.5\n"
+            "  volume_floor_ratio: 0.6\n"
             "contact:\n  response: penalty\n  coupling_stiffness_npm: 250\n  tool_stops_at_anatomy: false\n"
             "dds:\n  vendor: fastdds\n  domain_id: 42\n"
             "qos:\n  DevicePose: {deadline_ms: 2, reliability: best_effort}\n"
@@ -152,6 +154,7 @@ TEST(SceneDefaults, ExplicitSettingsAreRead) {
   EXPECT_EQ(scene->solver.compliance, ComplianceMode::kLagged);
   EXPECT_EQ(scene->solver.compliance_columns, ComplianceColumns::kNormals);
   EXPECT_EQ(scene->solver.max_contact_age, 2500us);
+  EXPECT_EQ(scene->solver.volume_floor_ratio, 0.6);
   EXPECT_EQ(scene->contact.response, ContactResponse::kPenalty);
   EXPECT_EQ(scene->contact.coupling_stiffness_npm, 250.0);
   EXPECT_FALSE(scene->contact.tool_stops_at_anatomy);

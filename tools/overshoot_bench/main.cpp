@@ -267,6 +267,7 @@ struct RunChoices {
   double candidate_margin_mm = -1.0;
   std::string row_compliance = "scene";
   int w_normals = 0;
+  double volume_floor = -1.0;  // < 0: the scene's
   std::string trace_path;
   std::string tick_trace_path;
 };
@@ -302,6 +303,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
       if (body.deformable) body.deformable->material.yeoh_c20_over_c10 = stiffening;
     }
   }
+  if (choices.volume_floor >= 0.0) variant->solver.volume_floor_ratio = choices.volume_floor;
   if (choices.w_normals > 0) {
     variant->solver.compliance_columns = scene::ComplianceColumns::kNormals;
     variant->solver.max_candidate_contacts = choices.w_normals;
@@ -329,7 +331,8 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   std::FILE* trace = open_trace(trace_path, r.name,
                  "t_s,inverted,inverted_near_anatomy,inverted_near_blade,anatomy_nodes,anatomy_depth_mm,"
                  "anatomy_unresolved,anatomy_rounds,sweeps,tool_active,tool_frozen,force_only,obstacle_contacts,"
-                 "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,inverted_free,fem_cpu_ms,supported_nodes\n");
+                 "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,inverted_free,fem_cpu_ms,supported_nodes,"
+                 "volume_floor_below,volume_floor_unresolved\n");
   std::FILE* tick_trace = open_trace(tick_trace_path, r.name,
                  "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,proxy_z,gap_mm,"
                  "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,obstacle_reaction_n,rows,"
@@ -429,14 +432,15 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
         // 1 mm: a tet that close to bone or blade is pressed by it.
         const Inversions inv = locate_inversions(sim, 1e-3);
         const ToolContacts tc = count_contacts(sim.contacts());
-        std::fprintf(trace, "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d\n", sim.time_s(), inv.count,
+        std::fprintf(trace, "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,%d,%d\n", sim.time_s(), inv.count,
                      inv.near_anatomy, inv.near_blade, report.projection.obstacle_nodes,
                      1e3 * report.projection.obstacle_deepest_m, report.projection.obstacle_unresolved,
                      report.projection.obstacle_rounds, report.projection.sweeps, tc.active, tc.frozen, tc.force_only,
                      tc.obstacle, c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
                      1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio, inverted_free(sim),
                      1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
-                     report.projection.obstacle_supported);
+                     report.projection.obstacle_supported, report.projection.volume_floor_below,
+                     report.projection.volume_floor_unresolved);
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
@@ -486,6 +490,10 @@ int main(int argc, char** argv) {
                  "where the FEM holds a frozen sphere: its centre at the step's start or the haptic side's hold centre "
                  "(default: the service's)")
       ->check(CLI::IsMember({"service", "step-start", "hold-centre"}));
+  app.add_option("--volume-floor", choices.volume_floor,
+                 "no tet ends a FEM step below this share of its rest volume (solver.volume_floor_ratio); 0: off "
+                 "(default: the scene's)")
+      ->check(CLI::Range(0.0, 0.9));
   app.add_flag("--fem-anatomy-slide", choices.fem_anatomy_slide,
                "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
   app.add_option("--response", response, "which response to run")

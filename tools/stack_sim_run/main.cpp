@@ -50,6 +50,11 @@ int main(int argc, char** argv) {
   app.add_option("--stiffening", stiffening,
                  "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
       ->check(CLI::Range(0.0, 100.0));
+  double volume_floor = -1.0;
+  app.add_option("--volume-floor", volume_floor,
+                 "no tet ends a FEM step below this share of its rest volume (solver.volume_floor_ratio); 0: off "
+                 "(default: the scene's)")
+      ->check(CLI::Range(0.0, 0.9));
   bool fem_anatomy_slide = false;
   app.add_flag("--fem-anatomy-slide", fem_anatomy_slide,
                "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
@@ -85,6 +90,7 @@ int main(int argc, char** argv) {
     options.collision =
         collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;
     auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));
+    if (volume_floor >= 0.0) scene->solver.volume_floor_ratio = volume_floor;
     for (auto& body : scene->bodies) {
       if (body.deformable && stiffening >= 0.0) body.deformable->material.yeoh_c20_over_c10 = stiffening;
     }

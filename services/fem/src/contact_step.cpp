@@ -34,6 +34,9 @@ ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStep
   normals_.reserve(k);
   compliance_.reserve(9 * k * k);
   compliance_of_.reserve(k);
+  if (settings_.volume_floor.ratio > 0.0) {
+    volume_floor_ = std::make_unique<VolumeFloor>(body.element_rest(), settings_.volume_floor);
+  }
   normals_of_.reserve(k);
   free_centres_.reserve(k);
 }
@@ -256,6 +259,8 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
   int sweeps = 0;
   if (obstacles_) obstacles_->begin_step();
   int tool_nodes = 0;
+  int volume_below = 0;
+  int volume_unresolved = 0;
   if (tool_pass_) {
     // The tool moved since the last step: no clearance from then holds, and
     // each node's path is taken relative to the tool.
@@ -272,22 +277,34 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
       projection_ =
           project_contacts(*contacts, links_, inverse_mass, projection_settings_, projected_, start_positions_);
       sweeps += projection_.sweeps;
-      // The anatomy's last pass moved nothing the tool constraints needed.
-      if (round > 0 && projection_.sweeps <= 1 && projection_.converged) break;
+      // The anatomy's last pass moved nothing the tool constraints needed
+      // (with a floor, nor squeezed a tet below it: checked after its pass).
+      if (round > 0 && projection_.sweeps <= 1 && projection_.converged && !volume_floor_) break;
     }
     if (tool_pass_) {
       ProjectionReport tool_report;
       tool_pass_->project(projected_, inverse_mass, tool_report, tool_start_);
       tool_nodes += tool_report.obstacle_nodes;
     }
+    if (volume_floor_) {
+      const VolumeFloorReport floor = volume_floor_->project(projected_, inverse_mass);
+      volume_below += floor.below;
+      volume_unresolved = floor.unresolved;
+      const bool tool_settled = !tool || (projection_.sweeps <= 1 && projection_.converged);
+      if (round > 0 && floor.below == 0 && tool_settled) break;
+    }
     if (!obstacles_) break;
     ++anatomy.obstacle_rounds;
+    // Without tool constraints or a floor, nothing the anatomy moved can
+    // need another round.
     if (obstacles_->project(projected_, inverse_mass, anatomy, start_positions_, body_.rest_positions_m()) == 0 ||
-        !tool)
+        (!tool && !volume_floor_))
       break;
   }
   projection_.sweeps = sweeps;
   projection_.tool_nodes = tool_nodes;
+  projection_.volume_floor_below = volume_below;
+  projection_.volume_floor_unresolved = volume_unresolved;
   projection_.obstacle_rounds = anatomy.obstacle_rounds;
   projection_.obstacle_nodes = anatomy.obstacle_nodes;
   projection_.obstacle_unresolved = anatomy.obstacle_unresolved;
@@ -325,7 +342,9 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   update_compliance(report.refactorised);
   update_free_centres();
   projection_ = {};
-  if (obstacles_ || tool_pass_ || (contacts != nullptr && !contacts->contacts.empty())) project(contacts);
+  if (obstacles_ || tool_pass_ || volume_floor_ || (contacts != nullptr && !contacts->contacts.empty())) {
+    project(contacts);
+  }
   if (supports_ && supports_->update(*obstacles_, start_positions_, free_positions_)) {
     body_.set_supports(supports_->supports(), obstacles_->settings().support_stiffness_ratio);
   }

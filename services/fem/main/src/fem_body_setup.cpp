@@ -81,6 +81,7 @@ FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body) {
   setup.fixed_nodes = fixed_nodes(body, setup.mesh);
   setup.settings = body_settings(scene, body);
   setup.compliance_along_normals = scene.solver.compliance_columns == scene::ComplianceColumns::kNormals;
+  setup.volume_floor.ratio = scene.solver.volume_floor_ratio;
   const haptic::SphereLayout layout = haptic::fill_spheres(setup.mesh, runtime::fill_settings_for(body));
   for (std::size_t i = 0; i < layout.size(); ++i) {
     const std::string error = setup.links.add_sphere(layout.nodes(i), layout.weights(i), layout.sphere(i).rest_radius_m);

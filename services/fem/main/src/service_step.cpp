@@ -27,7 +27,8 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
                                              .spread = setup.sphere_spread,
                                              .frozen_target = setup.frozen_target,
                                              .compliance_along_normals = setup.compliance_along_normals,
-                                             .divergence_limit_m = divergence_limit_m(setup.mesh)}) {
+                                             .divergence_limit_m = divergence_limit_m(setup.mesh),
+                                             .volume_floor = setup.volume_floor}) {
   const std::size_t cap = setup.settings.max_compliance_spheres;
   std::vector<const fem::ObstacleField*> anatomy;
   if (setup.enforce_anatomy) {

@@ -147,6 +147,7 @@ class Body {
 
   std::size_t node_count() const { return mass_kg_.size(); }
   std::size_t element_count() const { return rest_.size(); }
+  const ElementRest& element_rest() const { return rest_; }
   std::span<const double> positions_m() const { return {x_.data(), static_cast<std::size_t>(x_.size())}; }
   std::span<const double> velocities_m_per_s() const { return {v_.data(), static_cast<std::size_t>(v_.size())}; }
   Eigen::Vector3d position(std::uint32_t node) const { return x_.segment<3>(3 * Eigen::Index{node}); }

@@ -18,7 +18,10 @@
 //      the ContactSet's projection so the tool cannot press a node into bone;
 //      its moves join the same carried correction; the nodes it moved are
 //      held by springs along the bone's normal in the next step's A
-//      (obstacle_support.h), so the implicit solve and W feel the bone.
+//      (obstacle_support.h), so the implicit solve and W feel the bone;
+//   5. with a volume floor, each round of that alternation also keeps every
+//      tet above a share of its rest volume (volume_floor.h), so tissue
+//      squeezed between tool and bone gives way sideways, not flat.
 // The projection is done here, not by Body::step, because step 2 needs the
 // motion before it. Staleness of a ContactSet is the caller's decision.
 // Capacities are fixed at construction: nothing allocates per step once the
@@ -39,6 +42,7 @@
 #include "fahr/fem/obstacle_support.h"
 #include "fahr/fem/projection.h"
 #include "fahr/fem/sphere_links.h"
+#include "fahr/fem/volume_floor.h"
 
 namespace fahr::fem {
 
@@ -65,6 +69,9 @@ struct ContactStepSettings {
   // the body is reset to rest, its carried correction and forces dropped,
   // and the step reports diverged_reset. 0: no check.
   double divergence_limit_m = 0.0;
+  // A floor under every tet's volume, projected in each round between the
+  // tool's constraints and the anatomy's (volume_floor.h); ratio 0: off.
+  VolumeFloorSettings volume_floor{};
 };
 
 class ContactStep {
@@ -179,6 +186,7 @@ class ContactStep {
   Eigen::Isometry3d tool_motion_ = Eigen::Isometry3d::Identity();
   std::vector<double> tool_start_;  // the step's start positions carried by the tool's motion, 3 per node, m
   std::unique_ptr<ObstacleSupport> supports_;  // with obstacles_ and a ratio > 0
+  std::unique_ptr<VolumeFloor> volume_floor_;   // with a floor ratio > 0
   ProjectionReport projection_;
 };
 

@@ -81,6 +81,10 @@ struct ProjectionReport {
   // it on their way home, and left alone by it.
   int obstacle_returned = 0;
   int obstacle_beyond = 0;
+  // The volume floor (volume_floor.h), summed over the step's rounds: tets
+  // found below it, and those its last pass left below.
+  int volume_floor_below = 0;
+  int volume_floor_unresolved = 0;
 };
 
 // Whether the contact is projected, and how. Obstacles are always hard: a

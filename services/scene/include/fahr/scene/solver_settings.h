@@ -44,6 +44,9 @@ struct FemSolverSettings {
   // ContactSets older than this are ignored and counted, (0, 10 s].
   std::chrono::nanoseconds max_contact_age = kDefaultMaxContactAge;
   double sleep_speed_mps = kDefaultSleepSpeedMps;  // m/s, [0, 1]
+  // No tet ends a FEM step below this share of its rest volume
+  // (services/fem volume_floor.h), [0, 0.9]; 0: no floor.
+  double volume_floor_ratio = 0.0;
 };
 
 }  // namespace fahr::scene

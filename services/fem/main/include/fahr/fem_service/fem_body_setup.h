@@ -12,6 +12,7 @@
 #include "fahr/fem/body.h"
 #include "fahr/fem/obstacle_projection.h"
 #include "fahr/fem/sphere_links.h"
+#include "fahr/fem/volume_floor.h"
 #include "fahr/fem_service/anatomy_fields.h"
 #include "fahr/geometry/tet_mesh.h"
 #include "fahr/scene/scene.h"
@@ -38,6 +39,8 @@ struct FemBodySetup {
   fem::FrozenTarget frozen_target = fem::FrozenTarget::kStepStart;
   // The scene's solver.compliance_columns: normals (ContactStepSettings).
   bool compliance_along_normals = false;
+  // The scene's solver.volume_floor_ratio (services/fem volume_floor.h).
+  fem::VolumeFloorSettings volume_floor{};
   // Experimental (null: off): the tool's field, which the step moves to the
   // ContactSet's tool pose and keeps the whole body out of
   // (fem::ContactStep::set_tool_obstacle). Set before the ServiceStep is

@@ -1,0 +1,72 @@
+// A floor under every tet's volume, projected with the step's other
+// position constraints (Algorithm 1's Gauss-Seidel): no tet may end a step
+// with less than `ratio` of its rest volume.
+//
+// Why: squeezed between the blade and bone, a soft linear tongue is driven
+// flat. The tool's and the anatomy's projections move only the nodes they
+// touch, along their own normals, and nothing in them resists a layer of
+// tissue being pressed to nothing between the two; the implicit step's
+// linearised corotational force, with the large velocities those moves
+// carry, then inverts it (tools/overshoot_bench/README.md, "At 10 kPa the
+// tongue is crushed against bone at 2 N"). Soft tissue is nearly
+// incompressible (the tongue's nu is 0.45): no load the device can apply
+// takes a piece of it below half its volume. Projecting the floor gives the
+// squeezed layer the way real tissue takes: sideways, out from between the
+// two surfaces.
+//
+// The constraint C = V - ratio V0 >= 0, V the signed volume
+// (x1 - x0) . ((x2 - x0) x (x3 - x0)) / 6. A tet below its floor moves its
+// nodes along grad V, mass-weighted (the contact projection's rule):
+// dx_a = -C w_a g_a / sum_b w_b |g_b|^2, w the inverse nodal mass (0 for a
+// fixed node, which never moves). V is cubic in the positions, so one move
+// lands near, not on, the floor; sweeps repeat it. Only tets below their
+// floor cost more than the volume test.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "fahr/fem/element_rest.h"
+
+namespace fahr::fem {
+
+struct VolumeFloorSettings {
+  // Smallest volume a tet may end the step with, as a share of its rest
+  // volume, in [0, 1); 0: no floor (no pass at all).
+  double ratio = 0.0;
+  // Gauss-Seidel sweeps over all tets per pass, >= 1. Between two, up to
+  // `inner_sweeps` sweeps over just the tets the last one found below.
+  int max_sweeps = 32;
+  int inner_sweeps = 8;
+};
+
+struct VolumeFloorReport {
+  int below = 0;       // tets below their floor when the pass started
+  int unresolved = 0;  // still below it after the last sweep
+  int sweeps = 0;
+};
+
+class VolumeFloor {
+ public:
+  // `rest` must outlive this object.
+  VolumeFloor(const ElementRest& rest, const VolumeFloorSettings& settings);
+
+  // Moves positions_m (3 per node, m) so every tet keeps its floor, as far
+  // as the sweeps allow. No allocation.
+  VolumeFloorReport project(std::span<double> positions_m, std::span<const double> inverse_mass_per_kg);
+
+  const VolumeFloorSettings& settings() const { return settings_; }
+
+ private:
+  // One tet's move toward its floor; false if it was not below (slack
+  // included).
+  bool open(std::size_t tet, std::span<double> positions_m, std::span<const double> inverse_mass_per_kg) const;
+
+  const ElementRest& rest_;
+  VolumeFloorSettings settings_;
+  std::vector<double> floor_m3_;          // ratio x rest volume, per tet
+  std::vector<std::size_t> below_;  // tets the last full sweep found below; capacity: every tet
+};
+
+}  // namespace fahr::fem

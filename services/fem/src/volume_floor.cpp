@@ -1,0 +1,94 @@
+#include "fahr/fem/volume_floor.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+
+namespace fahr::fem {
+
+namespace {
+
+Eigen::Vector3d node(std::span<const double> x, std::uint32_t n) {
+  return {x[3 * std::size_t{n}], x[3 * std::size_t{n} + 1], x[3 * std::size_t{n} + 2]};
+}
+
+// A tet counts as below its floor under this share of it, and a move aims
+// at the floor itself: V is cubic in the positions, so without the slack a
+// tet landing a hair under its floor would take every sweep.
+constexpr double kSlack = 0.99;
+
+}  // namespace
+
+VolumeFloor::VolumeFloor(const ElementRest& rest, const VolumeFloorSettings& settings)
+    : rest_(rest), settings_(settings), floor_m3_(rest.size()) {
+  for (std::size_t e = 0; e < rest.size(); ++e) floor_m3_[e] = settings.ratio * rest.volume_m3[e];
+  below_.reserve(rest.size());
+}
+
+bool VolumeFloor::open(std::size_t e, std::span<double> positions_m,
+                       std::span<const double> inverse_mass_per_kg) const {
+  const Tet& tet = rest_.tets[e];
+  const Eigen::Vector3d x0 = node(positions_m, tet[0]);
+  const Eigen::Vector3d d1 = node(positions_m, tet[1]) - x0;
+  const Eigen::Vector3d d2 = node(positions_m, tet[2]) - x0;
+  const Eigen::Vector3d d3 = node(positions_m, tet[3]) - x0;
+  const double volume = d1.dot(d2.cross(d3)) / 6.0;
+  // Written so that a NaN volume is left alone: the step's divergence
+  // check, not this pass, deals with non-finite positions.
+  if (!(volume < kSlack * floor_m3_[e])) return false;
+  std::array<Eigen::Vector3d, 4> gradient;
+  gradient[1] = d2.cross(d3) / 6.0;
+  gradient[2] = d3.cross(d1) / 6.0;
+  gradient[3] = d1.cross(d2) / 6.0;
+  gradient[0] = -(gradient[1] + gradient[2] + gradient[3]);
+  double weight = 0.0;
+  for (int a = 0; a < 4; ++a) weight += inverse_mass_per_kg[tet[a]] * gradient[a].squaredNorm();
+  // A tet collapsed to a line or a point has no direction to open in, and
+  // one with only fixed nodes cannot move; its neighbours' moves may open
+  // it in a later sweep.
+  if (!(weight > 0.0) || !std::isfinite(weight)) return true;
+  const double scale = (floor_m3_[e] - volume) / weight;
+  for (int a = 0; a < 4; ++a) {
+    const double w = inverse_mass_per_kg[tet[a]];
+    if (w == 0.0) continue;
+    const Eigen::Vector3d move = scale * w * gradient[a];
+    for (int d = 0; d < 3; ++d) positions_m[3 * std::size_t{tet[a]} + d] += move[d];
+  }
+  return true;
+}
+
+VolumeFloorReport VolumeFloor::project(std::span<double> positions_m, std::span<const double> inverse_mass_per_kg) {
+  VolumeFloorReport report;
+  if (settings_.ratio <= 0.0) return report;
+  for (int sweep = 0; sweep < settings_.max_sweeps; ++sweep) {
+    below_.clear();
+    for (std::size_t e = 0; e < rest_.size(); ++e) {
+      if (open(e, positions_m, inverse_mass_per_kg)) below_.push_back(e);
+    }
+    if (sweep == 0) report.below = static_cast<int>(below_.size());
+    report.sweeps = sweep + 1;
+    if (below_.empty()) return report;
+    // Coupled tets (sharing nodes) settle over several sweeps; only the
+    // ones found below can still be, until their moves push a neighbour
+    // under, which the next full sweep finds.
+    for (int inner = 0; inner < settings_.inner_sweeps; ++inner) {
+      bool any = false;
+      for (const std::size_t e : below_) any = open(e, positions_m, inverse_mass_per_kg) || any;
+      if (!any) break;
+    }
+  }
+  // A count without moves, for the report.
+  for (std::size_t e = 0; e < rest_.size(); ++e) {
+    const Tet& tet = rest_.tets[e];
+    const Eigen::Vector3d x0 = node(positions_m, tet[0]);
+    const Eigen::Vector3d d1 = node(positions_m, tet[1]) - x0;
+    if (d1.dot((node(positions_m, tet[2]) - x0).cross(node(positions_m, tet[3]) - x0)) / 6.0 <
+        kSlack * floor_m3_[e]) {
+      ++report.unresolved;
+    }
+  }
+  return report;
+}
+
+}  // namespace fahr::fem
