@@ -109,6 +109,9 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("anatomy_nodes_returned", static_cast<double>(anatomy_returned_));
   out.emplace_back("anatomy_node_steps_beyond", static_cast<double>(anatomy_beyond_steps_));
   out.emplace_back("anatomy_unresolved_last", static_cast<double>(last_report_.projection.obstacle_unresolved));
+  out.emplace_back("volume_floor_below_last", static_cast<double>(last_report_.projection.volume_floor_below));
+  out.emplace_back("volume_floor_unresolved_last",
+                   static_cast<double>(last_report_.projection.volume_floor_unresolved));
   out.emplace_back("solver_iterations_last", static_cast<double>(last_report_.solver_iterations));
   out.emplace_back("asleep", setup_.body->asleep() ? 1.0 : 0.0);
   out.emplace_back("nodes", static_cast<double>(setup_.mesh.node_count()));
