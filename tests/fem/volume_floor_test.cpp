@@ -34,16 +34,11 @@ struct OneTet {
   }
 };
 
-double volume(std::span<const double> x, const Tet& t) {
-  auto at = [&](std::uint32_t n) { return Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]); };
-  return (at(t[1]) - at(t[0])).dot((at(t[2]) - at(t[0])).cross(at(t[3]) - at(t[0]))) / 6.0;
-}
-
 double smallest_volume_ratio(const Body& body) {
   const ElementRest& rest = body.element_rest();
   double smallest = 1e300;
   for (std::size_t e = 0; e < rest.size(); ++e) {
-    smallest = std::min(smallest, volume(body.positions_m(), rest.tets[e]) / rest.volume_m3[e]);
+    smallest = std::min(smallest, signed_volume(body.positions_m(), rest.tets[e]) / rest.volume_m3[e]);
   }
   return smallest;
 }
@@ -56,7 +51,7 @@ TEST(VolumeFloor, ASquashedTetIsOpenedToItsFloor) {
   const VolumeFloorReport report = floor.project(x, inverse_mass);
   EXPECT_EQ(report.below, 1);
   EXPECT_EQ(report.unresolved, 0);
-  EXPECT_GE(volume(x, tet.tets[0]), 0.99 * 0.5 * tet.element.volume_m3[0]);
+  EXPECT_GE(signed_volume(x, tet.tets[0]), kVolumeFloorSlack * 0.5 * tet.element.volume_m3[0]);
 }
 
 TEST(VolumeFloor, AnInvertedTetIsTurnedBackAndFixedNodesStay) {
@@ -68,7 +63,7 @@ TEST(VolumeFloor, AnInvertedTetIsTurnedBackAndFixedNodesStay) {
   const std::vector<double> inverse_mass{0.0, 0.0, 1.0, 1.0};
   const VolumeFloorReport report = floor.project(x, inverse_mass);
   EXPECT_EQ(report.unresolved, 0);
-  EXPECT_GE(volume(x, tet.tets[0]), 0.99 * 0.3 * tet.element.volume_m3[0]);
+  EXPECT_GE(signed_volume(x, tet.tets[0]), kVolumeFloorSlack * 0.3 * tet.element.volume_m3[0]);
   for (int i = 0; i < 6; ++i) EXPECT_EQ(x[i], before[i]) << "a fixed node moved";
 }
 
@@ -104,7 +99,6 @@ struct CrushedBar {
   int steps_at_floor = 0;       // steps that ended with every tet at its floor
   int last_unresolved = 0;
 };
-constexpr double kSlack = 0.99;  // volume_floor.cpp's
 
 CrushedBar crush_bar(double floor_ratio) {
   CrushedBar result;
@@ -129,7 +123,7 @@ CrushedBar crush_bar(double floor_ratio) {
     EXPECT_TRUE(test::all_finite(*body));
     const double now = smallest_volume_ratio(*body);
     smallest = std::min(smallest, now);
-    if (now >= kSlack * floor_ratio) ++result.steps_at_floor;
+    if (now >= kVolumeFloorSlack * floor_ratio) ++result.steps_at_floor;
     result.last_unresolved = report.projection.volume_floor_unresolved;
   }
   result.smallest_ratio = smallest;

@@ -273,13 +273,16 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
     }
   }
   for (int round = 0; round < rounds; ++round) {
+    // After a round: whether the anatomy's last pass left nothing to redo.
+    bool settled = round > 0;
     if (tool) {
       projection_ =
           project_contacts(*contacts, links_, inverse_mass, projection_settings_, projected_, start_positions_);
       sweeps += projection_.sweeps;
-      // The anatomy's last pass moved nothing the tool constraints needed
-      // (with a floor, nor squeezed a tet below it: checked after its pass).
-      if (round > 0 && projection_.sweeps <= 1 && projection_.converged && !volume_floor_) break;
+      // It moved nothing the tool constraints needed (with a floor: nor
+      // squeezed a tet below it, checked after the floor's pass).
+      settled = settled && projection_.sweeps <= 1 && projection_.converged;
+      if (settled && !volume_floor_) break;
     }
     if (tool_pass_) {
       ProjectionReport tool_report;
@@ -290,8 +293,7 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
       const VolumeFloorReport floor = volume_floor_->project(projected_, inverse_mass);
       volume_below += floor.below;
       volume_unresolved = floor.unresolved;
-      const bool tool_settled = !tool || (projection_.sweeps <= 1 && projection_.converged);
-      if (round > 0 && floor.below == 0 && tool_settled) break;
+      if (settled && floor.below == 0) break;
     }
     if (!obstacles_) break;
     ++anatomy.obstacle_rounds;

@@ -13,12 +13,12 @@ Eigen::Vector3d node(std::span<const double> x, std::uint32_t n) {
   return {x[3 * std::size_t{n}], x[3 * std::size_t{n} + 1], x[3 * std::size_t{n} + 2]};
 }
 
-// A tet counts as below its floor under this share of it, and a move aims
-// at the floor itself: V is cubic in the positions, so without the slack a
-// tet landing a hair under its floor would take every sweep.
-constexpr double kSlack = 0.99;
-
 }  // namespace
+
+double signed_volume(std::span<const double> positions_m, const Tet& t) {
+  const Eigen::Vector3d x0 = node(positions_m, t[0]);
+  return (node(positions_m, t[1]) - x0).dot((node(positions_m, t[2]) - x0).cross(node(positions_m, t[3]) - x0)) / 6.0;
+}
 
 VolumeFloor::VolumeFloor(const ElementRest& rest, const VolumeFloorSettings& settings)
     : rest_(rest), settings_(settings), floor_m3_(rest.size()) {
@@ -29,14 +29,14 @@ VolumeFloor::VolumeFloor(const ElementRest& rest, const VolumeFloorSettings& set
 bool VolumeFloor::open(std::size_t e, std::span<double> positions_m,
                        std::span<const double> inverse_mass_per_kg) const {
   const Tet& tet = rest_.tets[e];
+  const double volume = signed_volume(positions_m, tet);
+  // Written so that a NaN volume is left alone: the step's divergence
+  // check, not this pass, deals with non-finite positions.
+  if (!(volume < kVolumeFloorSlack * floor_m3_[e])) return false;
   const Eigen::Vector3d x0 = node(positions_m, tet[0]);
   const Eigen::Vector3d d1 = node(positions_m, tet[1]) - x0;
   const Eigen::Vector3d d2 = node(positions_m, tet[2]) - x0;
   const Eigen::Vector3d d3 = node(positions_m, tet[3]) - x0;
-  const double volume = d1.dot(d2.cross(d3)) / 6.0;
-  // Written so that a NaN volume is left alone: the step's divergence
-  // check, not this pass, deals with non-finite positions.
-  if (!(volume < kSlack * floor_m3_[e])) return false;
   std::array<Eigen::Vector3d, 4> gradient;
   gradient[1] = d2.cross(d3) / 6.0;
   gradient[2] = d3.cross(d1) / 6.0;
@@ -80,13 +80,7 @@ VolumeFloorReport VolumeFloor::project(std::span<double> positions_m, std::span<
   }
   // A count without moves, for the report.
   for (std::size_t e = 0; e < rest_.size(); ++e) {
-    const Tet& tet = rest_.tets[e];
-    const Eigen::Vector3d x0 = node(positions_m, tet[0]);
-    const Eigen::Vector3d d1 = node(positions_m, tet[1]) - x0;
-    if (d1.dot((node(positions_m, tet[2]) - x0).cross(node(positions_m, tet[3]) - x0)) / 6.0 <
-        kSlack * floor_m3_[e]) {
-      ++report.unresolved;
-    }
+    if (signed_volume(positions_m, rest_.tets[e]) < kVolumeFloorSlack * floor_m3_[e]) ++report.unresolved;
   }
   return report;
 }

@@ -31,6 +31,15 @@
 
 namespace fahr::fem {
 
+// A tet counts as below its floor under this share of it, while a move aims
+// at the floor itself: V is cubic in the positions, so without the slack a
+// tet landing a hair under its floor would take every sweep.
+inline constexpr double kVolumeFloorSlack = 0.99;
+
+// The signed volume of tet `t` at positions_m (3 per node), m^3; negative
+// when inverted.
+double signed_volume(std::span<const double> positions_m, const Tet& t);
+
 struct VolumeFloorSettings {
   // Smallest volume a tet may end the step with, as a share of its rest
   // volume, in [0, 1); 0: no floor (no pass at all).
@@ -65,7 +74,7 @@ class VolumeFloor {
 
   const ElementRest& rest_;
   VolumeFloorSettings settings_;
-  std::vector<double> floor_m3_;          // ratio x rest volume, per tet
+  std::vector<double> floor_m3_;    // ratio x rest volume, per tet
   std::vector<std::size_t> below_;  // tets the last full sweep found below; capacity: every tet
 };
 
