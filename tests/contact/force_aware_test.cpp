@@ -17,6 +17,7 @@ struct Trace {
   Eigen::Vector3d frozen_proxy = Eigen::Vector3d::Zero();
   double proxy_drift_lost = 0.0;
   int frozen_contacts = 0;
+  int force_only_contacts = 0;
 };
 
 // Device down at 10 mm/s to `bottom`, then back up; rows follow the proxy.
@@ -42,9 +43,13 @@ Trace press(ContactResponse& response, test::SyntheticPatch& patch, double limit
       trace.froze = true;
       trace.max_reaction_lost = std::max(trace.max_reaction_lost, out.tissue_reaction_n);
       trace.proxy_drift_lost = std::max(trace.proxy_drift_lost, (out.proxy_position_m - trace.frozen_proxy).norm());
-      int frozen = 0;
-      for (const fem::Contact& c : response.contacts()) frozen += c.state == fem::ContactState::kFrozen;
+      int frozen = 0, force_only = 0;
+      for (const fem::Contact& c : response.contacts()) {
+        frozen += c.state == fem::ContactState::kFrozen;
+        force_only += c.kind == fem::ContactKind::kForceOnly;
+      }
       trace.frozen_contacts = std::max(trace.frozen_contacts, frozen);
+      trace.force_only_contacts = std::max(trace.force_only_contacts, force_only);
     }
     if (was_lost && !out.lost_track) trace.released = true;
     if (trace.released && response.state() == TrackingState::kTracking) trace.tracking_again = true;
@@ -55,23 +60,59 @@ Trace press(ContactResponse& response, test::SyntheticPatch& patch, double limit
   return trace;
 }
 
+// Both ways of holding: kBackOff holds the spheres (kFrozen), kHoldLoad
+// (the default) holds the tissue by its load (force only).
 TEST(ForceAware, FreezesPastTheLimitHoldsAndCatchesUpSmoothly) {
+  for (const HeldProxy held : {HeldProxy::kHoldLoad, HeldProxy::kBackOff}) {
+    SCOPED_TRACE(static_cast<int>(held));
+    test::SyntheticPatch patch = test::make_patch(4, 0.0, 0.002, 0.005);
+    ResponseSettings settings;
+    settings.force_aware.held_proxy = held;
+    ContactResponse response(settings);
+    response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
+    const double limit = 0.5;
+    const Trace t = press(response, patch, limit, -0.012);
+    EXPECT_TRUE(t.froze);
+    EXPECT_TRUE(t.released);
+    EXPECT_TRUE(t.tracking_again);
+    EXPECT_LE(t.max_reaction_lost, 1.05 * limit);
+    EXPECT_EQ(t.proxy_drift_lost, 0.0);
+    EXPECT_EQ(t.frozen_contacts, held == HeldProxy::kBackOff ? 4 : 0);
+    EXPECT_EQ(t.force_only_contacts, held == HeldProxy::kHoldLoad ? 4 : 0);
+    // Bound (README): K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c); the device's
+    // turn-around changes v_d by 0.02 m/s in one tick.
+    const double bound = 400.0 * (1e-5 + 0.05 * 0.001) + 1.0 * (0.02 + 0.05);
+    EXPECT_LE(t.max_step, bound);
+  }
+}
+
+// A hand that draws back out of the tissue while the tool is held stretches
+// the coupling the other way, as far as a hand pressing on would: kHoldLoad
+// tells them apart by the pull along the push it froze with, and releases.
+TEST(ForceAware, AHeldLoadReleasesWhenTheHandDrawsBackOut) {
   test::SyntheticPatch patch = test::make_patch(4, 0.0, 0.002, 0.005);
-  ResponseSettings settings;
-  ContactResponse response(settings);
+  ContactResponse response{ResponseSettings{}};
   response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
-  const double limit = 0.5;
-  const Trace t = press(response, patch, limit, -0.012);
-  EXPECT_TRUE(t.froze);
-  EXPECT_TRUE(t.released);
-  EXPECT_TRUE(t.tracking_again);
-  EXPECT_LE(t.max_reaction_lost, 1.05 * limit);
-  EXPECT_EQ(t.proxy_drift_lost, 0.0);
-  EXPECT_EQ(t.frozen_contacts, 4);
-  // Bound (README): K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c); the device's
-  // turn-around changes v_d by 0.02 m/s in one tick.
-  const double bound = 400.0 * (1e-5 + 0.05 * 0.001) + 1.0 * (0.02 + 0.05);
-  EXPECT_LE(t.max_step, bound);
+  const auto tick = [&](double y) -> const ForceOutput& {
+    test::set_tool_height(patch, response.proxy().position_m.y());
+    TickInput in;
+    in.device.position_m = Eigen::Vector3d(0, y, 0);
+    in.device.renderable_force_n = 0.5;
+    in.rows = patch.rows;
+    in.compliance = patch.compliance();
+    return response.tick(in);
+  };
+  double y = 0.002;
+  while (!tick(y).lost_track) {
+    y -= 1e-5;
+    ASSERT_GT(y, -0.02) << "never froze";
+  }
+  const double held_y = response.proxy().position_m.y();
+  // Still pressing 5 mm past the proxy (2 N of pull against a 0.5 N limit): held.
+  for (int k = 0; k < 50; ++k) ASSERT_TRUE(tick(held_y - 0.005).lost_track);
+  // Drawn back 5 mm above it: the spring's stretch is as long, but it pulls out.
+  EXPECT_FALSE(tick(held_y + 0.005).lost_track);
+  EXPECT_EQ(response.state(), TrackingState::kCatchingUp);
 }
 
 TEST(ForceAware, DisabledNeverFreezes) {
@@ -85,11 +126,14 @@ TEST(ForceAware, DisabledNeverFreezes) {
 
 // The gateway lowers the limit while the device has lost track (the Touch
 // X's continuous force after its peak): the pinned reaction is then past the
-// new limit. kBackOff backs the proxy off until it is within it; kStay keeps
-// the proxy where it froze and scales the frozen spheres' forces instead.
+// new limit. kBackOff backs the proxy off until it is within it; kStay and
+// kHoldLoad keep the proxy where it froze and scale the tissue's forces
+// instead (kStay's spheres stay frozen, kHoldLoad's are held by that load).
 TEST(ForceAware, AStayingProxyMeetsALowerLimitByScalingNotBySlipping) {
-  double drift[2] = {0.0, 0.0};
-  for (const HeldProxy held : {HeldProxy::kBackOff, HeldProxy::kStay}) {
+  const HeldProxy modes[] = {HeldProxy::kBackOff, HeldProxy::kStay, HeldProxy::kHoldLoad};
+  double drift[3] = {0.0, 0.0, 0.0};
+  for (int m = 0; m < 3; ++m) {
+    const HeldProxy held = modes[m];
     test::SyntheticPatch patch = test::make_patch(4, 0.0, 0.002, 0.005);
     ResponseSettings settings;
     settings.force_aware.held_proxy = held;
@@ -115,21 +159,24 @@ TEST(ForceAware, AStayingProxyMeetsALowerLimitByScalingNotBySlipping) {
       if (!was_lost) frozen_at = out.proxy_position_m;
       was_lost = true;
       if (k < 2000) continue;
-      drift[held == HeldProxy::kStay ? 1 : 0] =
-          std::max(drift[held == HeldProxy::kStay ? 1 : 0], (out.proxy_position_m - frozen_at).norm());
+      drift[m] = std::max(drift[m], (out.proxy_position_m - frozen_at).norm());
       EXPECT_LE(out.tissue_reaction_n, 1.05 * limit) << k;
-      if (held == HeldProxy::kStay) {
-        Eigen::Vector3d sent = Eigen::Vector3d::Zero();
-        for (const fem::Contact& c : response.contacts()) {
+      if (held == HeldProxy::kBackOff) continue;
+      Eigen::Vector3d sent = Eigen::Vector3d::Zero();
+      for (const fem::Contact& c : response.contacts()) {
+        if (held == HeldProxy::kStay) {
           EXPECT_EQ(c.state, fem::ContactState::kFrozen);
-          sent += c.force_n * c.normal;
+        } else {
+          EXPECT_EQ(c.kind, fem::ContactKind::kForceOnly);
         }
-        EXPECT_LE(sent.norm(), limit * (1.0 + 1e-9)) << k;
+        sent += c.force_n * c.normal;
       }
+      EXPECT_LE(sent.norm(), limit * (1.0 + 1e-9)) << k;
     }
   }
   EXPECT_GT(drift[0], 1e-4);  // backed off
   EXPECT_EQ(drift[1], 0.0);   // stayed
+  EXPECT_EQ(drift[2], 0.0);   // stayed
 }
 
 // A blade sunk into tissue that closes over it: one row below the tool and

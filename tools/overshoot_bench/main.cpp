@@ -262,7 +262,7 @@ struct RunChoices {
   std::string spread = "service";
   std::string frozen_target = "service";
   bool fem_anatomy_slide = false;
-  std::string held_proxy = "limit";
+  std::string held_proxy = "load";
   bool fem_tool_obstacle = false;
   double candidate_margin_mm = -1.0;
   std::string row_compliance = "scene";
@@ -314,8 +314,10 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   options.overshoot_factor = factor;
   options.fem_anatomy = choices.fem_anatomy;
   if (choices.support_ratio >= 0.0) options.fem_support_ratio = choices.support_ratio;
+  if (choices.held_proxy == "limit") options.held_proxy = contact::HeldProxy::kBackOff;
   if (choices.held_proxy == "stay") options.held_proxy = contact::HeldProxy::kStay;
   if (choices.held_proxy == "fixed") options.held_proxy = contact::HeldProxy::kUnclamped;
+  if (choices.held_proxy == "load") options.held_proxy = contact::HeldProxy::kHoldLoad;
   options.fem_tool_obstacle = choices.fem_tool_obstacle;
   if (choices.candidate_margin_mm >= 0.0) options.candidate_margin_m = 1e-3 * choices.candidate_margin_mm;
   if (choices.row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(choices.row_compliance);
@@ -517,9 +519,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 10.0));
   app.add_option("--held-proxy", choices.held_proxy,
                  "while the device has lost track: limit (back off to keep the tissue within the limit), stay "
-                 "(stay where it froze, tissue forces scaled to the limit) or fixed (a diagnostic: stay, tissue "
+                 "(stay where it froze, tissue forces scaled to the limit), load (stay, the tissue held by that load alone, "
+                 "force only) or fixed (a diagnostic: stay, tissue "
                  "forces unclamped)")
-      ->check(CLI::IsMember({"limit", "stay", "fixed"}));
+      ->check(CLI::IsMember({"limit", "stay", "load", "fixed"}));
   app.add_option("--candidate-margin-mm", choices.candidate_margin_mm,
                  "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; default the service's 1")
       ->check(CLI::Range(0.0, 5.0));

@@ -194,7 +194,8 @@ OvershootResult run_overshoot_experiment(Method method, double limit_n, double d
           const double energy = fem.body().energy().elastic_j;
           result.max_elastic_energy_j = std::max(result.max_elastic_energy_j, energy);
           result.final_elastic_energy_j = energy;
-          result.max_penetration_m = std::max(result.max_penetration_m, rec.active_penetration_m);
+          result.max_penetration_m =
+              std::max({result.max_penetration_m, rec.active_penetration_m, rec.force_only_penetration_m});
         }
         result.max_penetration_m = std::max(result.max_penetration_m, rec.max_row_penetration_m);
         if (released && rec.tick == release_tick + 1000) result.displacement_1s_after_release_m = fem.max_displacement_m();

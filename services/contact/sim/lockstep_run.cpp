@@ -75,14 +75,13 @@ void LockstepRun::fem_step(TickRecord& record) {
   record.fem = fem_.step(penalty ? nullptr : &applied_, penalty ? std::span<const double>(applied_forces_)
                                                                 : std::span<const double>());
   record.fem_stepped = true;
-  double worst = 0.0;
   const auto centres = fem_.centres();
   for (const fem::Contact& c : applied_.contacts) {
     if (c.state != fem::ContactState::kActive) continue;
     const double depth = fem_.radii()[c.sphere_id] - (centres[c.sphere_id] - c.plane_point_m).dot(c.normal);
+    double& worst = c.kind == fem::ContactKind::kForceOnly ? record.force_only_penetration_m : record.active_penetration_m;
     worst = std::max(worst, depth);
   }
-  record.active_penetration_m = worst;
 }
 
 void LockstepRun::run(std::uint64_t ticks, const std::function<Eigen::Vector3d(std::uint64_t)>& device,

@@ -127,6 +127,7 @@ PropertyRunResult run_property(int run, double seconds, PropertyScenes& scenes, 
            " N at tick " + std::to_string(rec.tick));
     }
     if (rec.fem_stepped) {
+      result.max_force_only_penetration_m = std::max(result.max_force_only_penetration_m, rec.force_only_penetration_m);
       const double kept = persistence.push(rec.active_penetration_m);
       result.max_persistent_penetration_m = std::max(result.max_persistent_penetration_m, kept);
       if (kept > limits.penetration_tolerance_m) {

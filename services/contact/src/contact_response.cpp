@@ -52,6 +52,7 @@ void ContactResponse::reset(const Eigen::Vector3d& position_m, const Eigen::Quat
   proxy_ = ToolProxy{position_m, orientation, Eigen::Vector3d::Zero()};
   state_ = TrackingState::kTracking;
   previous_reaction_n_ = 0.0;
+  held_push_direction_ = Eigen::Vector3d::Zero();
   hold_count_ = 0;
   contact_count_ = 0;
   solver_.clear_warm_start();
@@ -151,11 +152,38 @@ bool ContactResponse::plausible_step(const Eigen::Vector3d& step_m, const Eigen:
   return step_m.allFinite() && step_m.norm() <= target_offset_m.norm() + deepest + kYieldCapMarginM;
 }
 
+// A catch-up step toward `toward` (the coupled equilibrium's offset): at
+// most max_step long, and differing from the proxy's last step by at most
+// the catch-up acceleration times dt^2.
+Eigen::Vector3d ContactResponse::catch_up_step(const Eigen::Vector3d& toward, double max_step, double dt_s) const {
+  const Eigen::Vector3d last = proxy_.velocity_mps * dt_s;
+  Eigen::Vector3d turn = toward * (max_step / toward.norm()) - last;
+  const double max_turn = settings_.force_aware.catch_up_acceleration_mps2 * dt_s * dt_s;
+  if (turn.norm() > max_turn) turn *= max_turn / turn.norm();
+  Eigen::Vector3d step = last + turn;
+  if (step.norm() > max_step) step *= max_step / step.norm();
+  return step;
+}
+
 Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const EffectiveCoupling& coupling) {
   const DeviceSample& device = input.device;
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   const double limit = device.renderable_force_n;
-  if (state_ == TrackingState::kLostTrack) {
+  const bool hold_load = settings_.force_aware.held_proxy == HeldProxy::kHoldLoad;
+  // kHoldLoad decides on the hand's pull into the tissue along the push the
+  // tool froze with: a hand pressing on keeps the tool held, one that eases
+  // off or draws back out (the spring then stretches the other way) releases
+  // it, and one that presses past the limit again while the proxy catches up
+  // holds it again. No solve decides it, so the state does not flicker with
+  // the rows or with a tissue still relaxing under the released tool.
+  const double pull = coupling.stiffness_npm * (device.position_m - proxy_.position_m).dot(held_push_direction_);
+  if (state_ == TrackingState::kLostTrack && hold_load) {
+    if (!should_release(settings_.force_aware, pull, limit)) {
+      solver_.solve_pinned(zero, settings_.pgs);
+      return zero;
+    }
+    state_ = TrackingState::kCatchingUp;
+  } else if (state_ == TrackingState::kLostTrack) {
     const double spring = coupling.stiffness_npm * (device.position_m - proxy_.position_m).norm();
     bool release = should_release(settings_.force_aware, spring, limit);
     if (!release) {
@@ -181,7 +209,7 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     // term) rather than jump; the next tick's warm start solves from here.
     report_.implausible_step = true;
     solver_.solve_pinned(zero, settings_.pgs);
-    return yield_to_limit(zero, limit);
+    return hold_load ? zero : yield_to_limit(zero, limit);
   }
   if (state_ == TrackingState::kCatchingUp) {
     // Reactivated: the equilibrium may be a few mm away (the tissue relaxed
@@ -189,9 +217,11 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     // changes smoothly, holding the tool where the bound leaves it.
     const double max_step = settings_.force_aware.catch_up_speed_mps * device.dt_s;
     if (step.norm() > max_step) {
-      step *= max_step / step.norm();
+      step = catch_up_step(step, max_step, device.dt_s);
       solver_.solve_pinned(step, settings_.pgs);
-      step = yield_to_limit(step, limit);
+      // kHoldLoad never backs off: a back-off is not bounded by the
+      // catch-up speed, and tick() scales what the tissue receives instead.
+      if (!hold_load) step = yield_to_limit(step, limit);
       report_.catch_up_limited = true;
     } else {
       state_ = TrackingState::kTracking;
@@ -201,14 +231,20 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
   // While catching up the tissue may still push at the frozen level (up to
   // the limit and a little over); freeze again only if it grows, i.e. the
   // hand pushes back in, so the two states cannot chatter.
-  const bool growing = state_ != TrackingState::kCatchingUp || reaction > previous_reaction_n_;
-  if (should_freeze(settings_.force_aware, reaction, limit) && growing) {
+  const bool catching_up = state_ == TrackingState::kCatchingUp;
+  const bool growing = !catching_up || reaction > previous_reaction_n_;
+  const bool freeze = hold_load && catching_up ? should_freeze(settings_.force_aware, pull, limit)
+                                               : should_freeze(settings_.force_aware, reaction, limit) && growing;
+  if (freeze) {
     // The proxy stops where it was (the last tick's pose, whose reaction was
     // within the limit) and the loaded spheres are held there.
     state_ = TrackingState::kLostTrack;
     solver_.solve_pinned(zero, settings_.pgs);
+    const Eigen::Vector3d push = solver_.resultant(RowKind::kTissue);
+    held_push_direction_ = push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
+    const HeldProxy held = settings_.force_aware.held_proxy;
     const Eigen::Vector3d back =
-        settings_.force_aware.held_proxy == HeldProxy::kStay ? zero : yield_to_limit(zero, limit);
+        held == HeldProxy::kStay || held == HeldProxy::kHoldLoad ? zero : yield_to_limit(zero, limit);
     capture_holds(input.compliance);
     return back;
   }
@@ -226,6 +262,7 @@ void ContactResponse::push_contact(const fem::Contact& contact) {
 void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector3d& plane_shift_m) {
   contact_count_ = 0;
   const bool frozen = state_ == TrackingState::kLostTrack;
+  const bool load_only = report_.tissue_force_clamped || report_.tissue_held_by_load;
   for (std::size_t i = 0; i < solver_.size(); ++i) {
     const ContactRow& row = solver_.row(i);
     if (row.kind != RowKind::kTissue) continue;
@@ -238,10 +275,11 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
     c.force_n = tissue_force_scale_ * solver_.lambda(i);
     c.hold_centre_m = row.other_point_m;
     const Hold* hold = frozen ? find_hold(row.id) : nullptr;
-    if (report_.tissue_force_clamped) {
+    if (load_only) {
       // Wedged past the limit (bone drives the tool into the tissue): the
       // tissue gets the limited forces and no geometric constraint, which
-      // would push it as far as the bone says whatever the force.
+      // would push it as far as the bone says whatever the force. A tool
+      // held by kHoldLoad is held the same way: by its load alone.
       c.kind = fem::ContactKind::kForceOnly;
       c.state = c.force_n > 0.0 ? fem::ContactState::kActive : fem::ContactState::kCandidate;
     } else if (hold != nullptr) {
@@ -254,7 +292,7 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
     }
     push_contact(c);
   }
-  if (frozen && !report_.tissue_force_clamped) {
+  if (frozen && !load_only) {
     // Held spheres the collision stage no longer reports stay held.
     for (std::size_t h = 0; h < hold_count_; ++h) {
       bool listed = false;
@@ -323,16 +361,23 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   // forces scaled down to the limit and sent as force only. Within the band
   // the force-aware decision already keeps the reaction at the limit (to
   // its yield tolerance and the one-tick lag), and the constraints stay.
+  const HeldProxy held = settings_.force_aware.held_proxy;
   const double solved_reaction = solver_.resultant(RowKind::kTissue).norm();
   tissue_force_scale_ = 1.0;
-  const HeldProxy held = settings_.force_aware.held_proxy;
-  if (settings_.mode != ResponseMode::kNaive && held == HeldProxy::kStay && state_ == TrackingState::kLostTrack) {
-    // Held where it froze: the spheres stay frozen (the FEM holds them
-    // where it finds them) and their forces are scaled to the limit.
+  const bool holds_proxy = (held == HeldProxy::kStay && state_ == TrackingState::kLostTrack) ||
+                           (held == HeldProxy::kHoldLoad && pinned);
+  if (settings_.mode != ResponseMode::kNaive && holds_proxy) {
+    // Held where it froze: the tissue forces are scaled to the limit; the
+    // spheres stay frozen (kStay) or carry that load alone (kHoldLoad,
+    // force only: write_contacts).
     if (solved_reaction > device.renderable_force_n) {
       tissue_force_scale_ = device.renderable_force_n / solved_reaction;
       report_.tissue_force_scaled_held = true;
     }
+    // kHoldLoad: held, the tissue carries the load alone; catching up, it
+    // does once the load had to be scaled.
+    report_.tissue_held_by_load = held == HeldProxy::kHoldLoad &&
+                                  (state_ == TrackingState::kLostTrack || report_.tissue_force_scaled_held);
   } else if (settings_.mode != ResponseMode::kNaive && held != HeldProxy::kUnclamped &&
              solved_reaction > kWedgeBand * device.renderable_force_n) {
     tissue_force_scale_ = device.renderable_force_n / solved_reaction;

@@ -83,6 +83,9 @@ struct TickReport {
   // HeldProxy::kStay: the held spheres' forces were scaled down to the
   // limit; they stay frozen (not force-only, unlike tissue_force_clamped).
   bool tissue_force_scaled_held = false;
+  // HeldProxy::kHoldLoad: the tool's entries are force only, the tissue held
+  // by its load (while held, or catching up with the load scaled).
+  bool tissue_held_by_load = false;
   bool force_limited = false;      // the commanded force was scaled to the renderable force
   double obstacle_reaction_n = 0.0;  // |force of rigid obstacles on the tool|, N
 };
@@ -115,6 +118,7 @@ class ContactResponse {
   };
 
   Eigen::Vector3d move_proxy(const TickInput& input, const EffectiveCoupling& coupling);
+  Eigen::Vector3d catch_up_step(const Eigen::Vector3d& toward, double max_step, double dt_s) const;
   Eigen::Vector3d yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n);
   bool plausible_step(const Eigen::Vector3d& step_m, const Eigen::Vector3d& target_offset_m) const;
   void capture_holds(const TissueCompliance& compliance);
@@ -127,6 +131,10 @@ class ContactResponse {
   ToolProxy proxy_;
   TrackingState state_ = TrackingState::kTracking;
   double previous_reaction_n_ = 0.0;
+  // Unit direction in which the held tool pushed the tissue when it froze
+  // (the tissue reaction's resultant on the tissue): kHoldLoad releases when
+  // the hand's pull along it falls below the band.
+  Eigen::Vector3d held_push_direction_ = Eigen::Vector3d::Zero();
   double tissue_force_scale_ = 1.0;  // applied to the ContactSet's tissue forces this tick
   std::vector<Hold> holds_;
   std::size_t hold_count_ = 0;

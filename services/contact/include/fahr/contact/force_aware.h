@@ -25,6 +25,18 @@ enum class HeldProxy : std::uint8_t {
   // the spheres stay frozen (the FEM holds them where each step finds
   // them). The published gap is then the hand's pull past the limit.
   kStay,
+  // The default. Stays where it froze (the published gap is then exactly
+  // the hand's pull past the proxy), and the tissue is held by a load, not
+  // by position constraints: each tick's pinned solve at the held pose,
+  // scaled so that its resultant is at most the limit, sent as force only
+  // (never projected). At equilibrium a position hold's force is that load,
+  // so the tissue settles where c' = c would hold it; but a load cannot
+  // fight the forces it is sent, as kStay's frozen spheres do (the strain
+  // grew under them). It releases, and holds again while catching up, on
+  // the hand's pull along the push it froze with, never backs off, and
+  // keeps the load scaled and force only while catching up past the limit
+  // (tools/overshoot_bench/README.md, "A proxy held by its load").
+  kHoldLoad,
   // A diagnostic, not a response: stays, and the tissue gets whatever the
   // pinned solve asks, unclamped, so a bench can see whether the frozen
   // hold is steady by itself.
@@ -42,10 +54,17 @@ struct ForceAwareSettings {
   // motion causes: 0.05 m/s x 400 N/m x 1 ms = 0.02 N per tick, 20 N/s,
   // below the ~ 50 N/s at which a force step is felt as a click.
   double catch_up_speed_mps = 0.05;
+  // Fastest change of that motion, m/s^2, > 0: the coupling's damping then
+  // changes the stylus force by at most B x this x dt per tick (1 N s/m x
+  // 10 m/s^2 x 1 ms = 0.01 N) when the equilibrium the proxy heads for
+  // turns (it moves with every FEM state); without it a turn reversed the
+  // proxy's velocity in one tick, a 2 B v_c = 0.1 N step. 10 m/s^2 reaches
+  // the full catch-up speed in 5 ms.
+  double catch_up_acceleration_mps2 = 10.0;
   // What a proxy held while the device has lost track does when the pinned
   // solve's tissue reaction exceeds the limit (the tissue's state changed
   // under it, or the gateway lowered the limit).
-  HeldProxy held_proxy = HeldProxy::kBackOff;
+  HeldProxy held_proxy = HeldProxy::kHoldLoad;
 };
 
 // Tissue reaction past the limit: freeze.

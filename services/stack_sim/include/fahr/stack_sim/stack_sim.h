@@ -56,7 +56,7 @@ struct StackOptions {
   std::optional<fem::FrozenTarget> frozen_target;
   // What the proxy held while the device has lost track does past the limit
   // (contact ForceAwareSettings::held_proxy).
-  contact::HeldProxy held_proxy = contact::HeldProxy::kBackOff;
+  contact::HeldProxy held_proxy = contact::HeldProxy::kHoldLoad;
   // Experimental: the FEM keeps the whole tongue out of the tool at the
   // ContactSet's tool pose (FemBodySetup::tool), not only the set's spheres;
   // the FEM service's --tool-obstacle.

@@ -46,9 +46,14 @@ struct TickRecord {
   std::uint32_t active = 0;
   bool fem_stepped = false;      // the FEM stepped at this tick (after the haptic tick)
   FemStepReport fem;             // valid when fem_stepped
-  // Largest penetration of an active tool contact after the FEM's
+  // Largest penetration of an active tool constraint after the FEM's
   // projection of this step, m (valid when fem_stepped).
   double active_penetration_m = 0.0;
+  // Largest penetration of a tool contact sent as force only (a held load,
+  // or a wedge's clamped forces), which the FEM does not project, m (valid
+  // when fem_stepped): the tissue may flow into a tool held still past the
+  // limit, since holding it out would take more force than the device has.
+  double force_only_penetration_m = 0.0;
   TickReport response;
   // Deepest row penetration at the tool pose the FEM will see (penalty:
   // the device pose; rows of this tick), m.

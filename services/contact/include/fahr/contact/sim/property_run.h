@@ -41,6 +41,9 @@ struct PropertyRunResult {
   // persistent_steps consecutive FEM steps (the smallest depth over such a
   // window), m; 0 when none lasted.
   double max_persistent_penetration_m = 0.0;
+  // Largest penetration of a force-only tool contact (TickRecord), m:
+  // reported, not a property (no constraint keeps it out).
+  double max_force_only_penetration_m = 0.0;
   std::string failure;             // the first property broken; empty when all held
   bool ok() const { return failure.empty(); }
 };
