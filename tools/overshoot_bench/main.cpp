@@ -262,6 +262,7 @@ struct RunChoices {
   std::string spread = "service";
   std::string frozen_target = "service";
   bool fem_anatomy_slide = false;
+  int fem_anatomy_rounds = 0;  // 0: the FEM's
   std::string held_proxy = "load";
   bool fem_tool_obstacle = false;
   double candidate_margin_mm = -1.0;
@@ -326,6 +327,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   if (choices.frozen_target == "step-start") options.frozen_target = fem::FrozenTarget::kStepStart;
   if (choices.frozen_target == "hold-centre") options.frozen_target = fem::FrozenTarget::kHoldCentre;
   options.fem_anatomy_slide = choices.fem_anatomy_slide;
+  options.fem_anatomy_rounds = choices.fem_anatomy_rounds;
   stack_sim::StackSim sim(variant, options);
   Result r;
   r.name = penalty ? "penalty" : "force-aware";
@@ -498,6 +500,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 0.9));
   app.add_flag("--fem-anatomy-slide", choices.fem_anatomy_slide,
                "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
+  app.add_option("--fem-anatomy-rounds", choices.fem_anatomy_rounds,
+                 "the FEM's tool/anatomy alternation rounds per step (services/fem obstacle_projection.h "
+                 "max_rounds); default the FEM's")
+      ->check(CLI::Range(1, 1000));
   app.add_option("--response", response, "which response to run")
       ->check(CLI::IsMember({"both", "force-aware", "penalty"}));
   app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")

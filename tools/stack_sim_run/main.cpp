@@ -58,6 +58,11 @@ int main(int argc, char** argv) {
   bool fem_anatomy_slide = false;
   app.add_flag("--fem-anatomy-slide", fem_anatomy_slide,
                "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
+  int fem_anatomy_rounds = 0;
+  app.add_option("--fem-anatomy-rounds", fem_anatomy_rounds,
+                 "the FEM's tool/anatomy alternation rounds per step (services/fem obstacle_projection.h "
+                 "max_rounds); default the FEM's")
+      ->check(CLI::Range(1, 1000));
   bool fem_tool_obstacle = false;
   app.add_flag("--fem-tool-obstacle", fem_tool_obstacle,
                "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose");
@@ -85,6 +90,7 @@ int main(int argc, char** argv) {
     if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
     options.fem_tool_obstacle = fem_tool_obstacle;
     options.fem_anatomy_slide = fem_anatomy_slide;
+    options.fem_anatomy_rounds = fem_anatomy_rounds;
     if (candidate_margin_mm >= 0.0) options.candidate_margin_m = 1e-3 * candidate_margin_mm;
     if (row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(row_compliance);
     options.collision =

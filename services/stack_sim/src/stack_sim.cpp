@@ -48,6 +48,7 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   fem_setup_.enforce_anatomy = options.fem_anatomy;
   if (options.fem_support_ratio) fem_setup_.anatomy_settings.support_stiffness_ratio = *options.fem_support_ratio;
   fem_setup_.anatomy_settings.slide_after_entry = options.fem_anatomy_slide;
+  if (options.fem_anatomy_rounds > 0) fem_setup_.anatomy_settings.max_rounds = options.fem_anatomy_rounds;
   if (options.sphere_spread) fem_setup_.sphere_spread = *options.sphere_spread;
   if (options.frozen_target) fem_setup_.frozen_target = *options.frozen_target;
   if (options.fem_tool_obstacle) fem_setup_.tool = fem_service::load_tool_field(*scene_);

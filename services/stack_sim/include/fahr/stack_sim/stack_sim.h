@@ -50,6 +50,9 @@ struct StackOptions {
   // The FEM's anatomy pass slides a node along the bone after its path
   // enters the margin (ObstacleProjectionSettings::slide_after_entry).
   bool fem_anatomy_slide = false;
+  // Overrides the FEM's tool/anatomy alternation rounds per step
+  // (ObstacleProjectionSettings::max_rounds) when > 0.
+  int fem_anatomy_rounds = 0;
   // Overrides the FEM service's sphere spread (projection.h) when set.
   std::optional<fem::SphereSpread> sphere_spread;
   // Overrides the FEM service's frozen target (projection.h) when set.
