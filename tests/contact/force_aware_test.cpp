@@ -207,7 +207,10 @@ TEST(ForceAware, ATickNeverThrowsAHeldToolFartherThanAFastHandMoves) {
   ASSERT_NEAR(rows[0].penetration_m(), 0.020, 1e-12);
   ASSERT_NEAR(rows[1].penetration_m(), 0.022, 1e-12);
 
-  ContactResponse response{ResponseSettings{}};
+  // The back-off is what could throw it (kHoldLoad never backs off).
+  ResponseSettings settings;
+  settings.force_aware.held_proxy = HeldProxy::kBackOff;
+  ContactResponse response(settings);
   response.reset(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity());
   TickInput in;
   in.device.renderable_force_n = 0.2;
