@@ -230,7 +230,8 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
   const double reaction = solver_.resultant(RowKind::kTissue).norm();
   // While catching up the tissue may still push at the frozen level (up to
   // the limit and a little over); freeze again only if it grows, i.e. the
-  // hand pushes back in, so the two states cannot chatter.
+  // hand pushes back in, so the two states cannot chatter (kHoldLoad: only
+  // if the hand's pull passes the limit again).
   const bool catching_up = state_ == TrackingState::kCatchingUp;
   const bool growing = !catching_up || reaction > previous_reaction_n_;
   const bool freeze = hold_load && catching_up ? should_freeze(settings_.force_aware, pull, limit)
@@ -245,7 +246,7 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     const HeldProxy held = settings_.force_aware.held_proxy;
     const Eigen::Vector3d back =
         held == HeldProxy::kStay || held == HeldProxy::kHoldLoad ? zero : yield_to_limit(zero, limit);
-    capture_holds(input.compliance);
+    if (!hold_load) capture_holds(input.compliance);  // kHoldLoad holds no sphere
     return back;
   }
   return step;
@@ -274,7 +275,7 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
     c.penetration_m = solver_.penetration(i) + row.normal.dot(plane_shift_m);
     c.force_n = tissue_force_scale_ * solver_.lambda(i);
     c.hold_centre_m = row.other_point_m;
-    const Hold* hold = frozen ? find_hold(row.id) : nullptr;
+    const Hold* hold = frozen && !load_only ? find_hold(row.id) : nullptr;
     if (load_only) {
       // Wedged past the limit (bone drives the tool into the tissue): the
       // tissue gets the limited forces and no geometric constraint, which

@@ -80,8 +80,9 @@ struct TickReport {
   bool yielded = false;            // a held proxy backed off to keep the reaction at the limit
   bool implausible_step = false;   // the coupled solve's step was refused; the proxy held
   bool tissue_force_clamped = false;  // the tissue forces were scaled down to the limit
-  // HeldProxy::kStay: the held spheres' forces were scaled down to the
-  // limit; they stay frozen (not force-only, unlike tissue_force_clamped).
+  // HeldProxy::kStay or kHoldLoad: the held tool's tissue forces were
+  // scaled down to the limit (kStay's spheres stay frozen, kHoldLoad's
+  // entries are force only: tissue_held_by_load).
   bool tissue_force_scaled_held = false;
   // HeldProxy::kHoldLoad: the tool's entries are force only, the tissue held
   // by its load (while held, or catching up with the load scaled).
