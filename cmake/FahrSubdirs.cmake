@@ -2,7 +2,8 @@
 # CMakeLists.txt, in name order, so adding a library, test group or tool is
 # one new folder and no edit to a shared list.
 # -DFAHR_ONLY="common;geometry" restricts the build to folders of those
-# names (in services/, tests/ and tools/), for working on one part alone.
+# names (in libs/, services/, sim/, bench/, tests/ and tools/), for working
+# on one part alone.
 set(FAHR_ONLY "" CACHE STRING "Only add subfolders with these names (empty: all)")
 function(fahr_add_subdirectories)
   file(GLOB children LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}/*)

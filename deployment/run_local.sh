@@ -83,15 +83,15 @@ if [ "$(id -u)" -eq 0 ] && [ -z "${FAHR_RUN_LOCAL_IN_NETNS:-}" ]; then
 fi
 
 gateway="$build/services/device_gateway/fahr_device_gateway"
-fem="$build/services/fem/main/fahr_fem_service"
-haptic="$build/services/haptic/main/fahr_haptic_service"
+fem="$build/services/fem/fahr_fem_service"
+haptic="$build/services/haptic/fahr_haptic_service"
 summary="$build/tools/run_summary/fahr_run_summary"
-clock="$build/tools/lockstep_clock/fahr_lockstep_clock"
+clock="$build/services/lockstep_clock/fahr_lockstep_clock"
 needed=("$gateway" "$fem" "$haptic" "$summary")
 [ "$mode" = lockstep ] && needed+=("$clock")
 for exe in "${needed[@]}"; do
   if [ ! -x "$exe" ]; then
-    echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway_service fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock" >&2
+    echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock" >&2
     exit 2
   fi
 done

@@ -15,14 +15,14 @@ build="${FAHR_BUILD_DIR:-$root/build}"
 
 bash "$root/tools/setup.sh"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
-cmake --build "$build" -j2 --target fahr_device_gateway_service fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock
+cmake --build "$build" -j2 --target fahr_device_gateway fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock
 
 echo "fahr demo: simulated neonatal intubation, gateway + FEM + haptic over DDS"
 bash "$root/deployment/run_local.sh" "$build" --duration-s "${FAHR_DEMO_SECONDS:-20}"
 
 if [ "${FAHR_DEMO_TRANSPORT:-0}" = 1 ]; then
   cmake --build "$build" -j2 --target fahr_transport_latency
-  demo=("$build/tools/transport_latency/fahr_transport_latency" --round-trips 2000 --large-round-trips 100
+  demo=("$build/bench/transport_latency/fahr_transport_latency" --round-trips 2000 --large-round-trips 100
         --sizes small,100k)
   echo "fahr transport demo: round trips between two processes (microseconds)"
   if [ "$(id -u)" -eq 0 ]; then

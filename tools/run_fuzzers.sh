@@ -17,7 +17,7 @@ targets=(fuzz_tetgen fuzz_gmsh fuzz_vtk)
 # tools stay ON because some test folders link tool libraries; only the fuzz
 # targets are built, never the test suite or the tools.
 CC=clang CXX=clang++ cmake -S "${root}" -B "${build}" -G Ninja \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFAHR_FUZZ=ON -DFAHR_BUILD_TESTS=ON -DFAHR_BUILD_TOOLS=ON >/dev/null
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFAHR_FUZZ=ON -DFAHR_BUILD_TESTS=ON -DFAHR_BUILD_BENCHES=OFF >/dev/null
 cmake --build "${build}" --target "${targets[@]}"
 
 mkdir -p "${build}/fuzz-artifacts"

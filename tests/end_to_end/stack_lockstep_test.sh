@@ -44,7 +44,7 @@ if ! diff "$tmp/cyclonedds.hashes" "$tmp/fastdds.hashes"; then
   echo "FAIL: the two vendors' lockstep runs differ"
   exit 1
 fi
-"$build/tools/stack_sim_run/fahr_stack_sim_run" --seconds 4 | tee "$tmp/inprocess.txt"
+"$build/sim/stack_sim_run/fahr_stack_sim_run" --seconds 4 | tee "$tmp/inprocess.txt"
 grep "^lockstep_clock: hash" "$tmp/inprocess.txt" | sort >"$tmp/inprocess.hashes"
 if ! diff "$tmp/cyclonedds.hashes" "$tmp/inprocess.hashes"; then
   echo "FAIL: the in-process run differs from the DDS runs"
@@ -61,7 +61,7 @@ sed -e "s|\.\./\.\./meshes/|$repo/meshes/|" \
 grep -q "^  compliance_columns: normals" "$tmp/normals.yaml" || { echo "FAIL: could not write the normals scene"; exit 1; }
 cp "$tmp/cyclonedds.hashes" "$tmp/blocks.hashes"
 run cyclonedds 63 "$tmp/normals.yaml"
-"$build/tools/stack_sim_run/fahr_stack_sim_run" --seconds 4 --scene "$tmp/normals.yaml" | tee "$tmp/normals_inprocess.txt"
+"$build/sim/stack_sim_run/fahr_stack_sim_run" --seconds 4 --scene "$tmp/normals.yaml" | tee "$tmp/normals_inprocess.txt"
 grep "^lockstep_clock: hash" "$tmp/normals_inprocess.txt" | sort >"$tmp/normals_inprocess.hashes"
 if ! diff "$tmp/cyclonedds.hashes" "$tmp/normals_inprocess.hashes"; then
   echo "FAIL: with W along the normals the in-process run differs from the DDS run"

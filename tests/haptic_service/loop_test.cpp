@@ -9,11 +9,11 @@
 
 #include "contact_set.h"
 #include "fahr/device/trajectory.h"
-#include "fahr/haptic/surface_samples.h"
+#include "fahr/collision/surface_samples.h"
 #include "force_command.h"
-#include "haptic_loop.h"
+#include "fahr/haptic_service/haptic_loop.h"
 #include "scene_fixture.h"
-#include "tissue_snapshot.h"
+#include "fahr/haptic_service/tissue_snapshot.h"
 
 #ifndef FAHR_SANITIZE_BUILD
 #include "allocation_counter.h"
@@ -40,9 +40,9 @@ double script_pitch_deg(const Eigen::Quaterniond& q) {
 double tool_depth(const HapticSetup& setup, const RigidField& field, const Eigen::Vector3d& tip_m, double pitch_deg) {
   const double half = 0.5 * pitch_deg * std::numbers::pi / 180.0;
   const Eigen::Quaterniond q(std::cos(half), 0.0, 0.0, std::sin(half));
-  std::vector<haptic::SurfaceContact> contacts(256);
+  std::vector<collision::SurfaceContact> contacts(256);
   std::size_t n = 0;
-  haptic::query_surface_samples(setup.tool_samples, Eigen::Translation3d(tip_m) * q, rigid_body(field), 2e-3,
+  collision::query_surface_samples(setup.tool_samples, Eigen::Translation3d(tip_m) * q, rigid_body(field), 2e-3,
                                 contacts, n);
   double deepest = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) deepest = std::max(deepest, contacts[i].depth_m);

@@ -42,8 +42,8 @@ msg::DevicePose device_pose(std::uint64_t tick, const Eigen::Vector3d& position_
   return pose;
 }
 
-haptic::RigidBody rigid_body(const RigidField& field) {
-  haptic::RigidBody body;
+collision::RigidBody rigid_body(const RigidField& field) {
+  collision::RigidBody body;
   body.id = field.scene_body->id;
   body.sdf = field.sdf.get();
   body.world_from_body = Eigen::Translation3d(field.scene_body->pose.position_m) * field.scene_body->pose.orientation;

@@ -7,7 +7,7 @@
 
 #include "device_pose.h"
 #include "fahr/scene/load_scene.h"
-#include "haptic_setup.h"
+#include "fahr/haptic_service/haptic_setup.h"
 
 namespace fahr::haptic_service::test {
 
@@ -25,6 +25,6 @@ msg::DevicePose device_pose(std::uint64_t tick, const Eigen::Vector3d& position_
                             double renderable_force_n = 7.9);
 
 // The rigid body of one anatomy field, posed as in the scene.
-haptic::RigidBody rigid_body(const RigidField& field);
+collision::RigidBody rigid_body(const RigidField& field);
 
 }  // namespace fahr::haptic_service::test

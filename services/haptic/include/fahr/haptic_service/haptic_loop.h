@@ -1,0 +1,126 @@
+// One haptic tick per DevicePose: the tool's contacts with the tongue
+// through the AIST of the newest digested FEM state (TissueSnapshot), its
+// contacts with the rigid anatomy through its surface samples, the contact
+// response on the FEM's compliance, and the ForceCommand and ContactSet that
+// answer it. Every buffer is sized in the constructor; tick() allocates
+// nothing once the wire samples hold their reserved capacity.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "contact_set.h"
+#include "device_pose.h"
+#include "fahr/contact/contact_response.h"
+#include "fahr/contact/penalty_response.h"
+#include "fahr/collision/contact_buffer.h"
+#include "fahr/collision/deepest_contacts.h"
+#include "fahr/collision/rigid_body.h"
+#include "fahr/collision/sphere_query.h"
+#include "fahr/collision/surface_samples.h"
+#include "force_command.h"
+#include "fahr/haptic_service/haptic_setup.h"
+#include "fahr/haptic_service/tissue_snapshot.h"
+
+namespace fahr::haptic_service {
+
+// Figures the reporter thread reads while the loop runs (relaxed atomics:
+// each is a single value, no invariant ties them together).
+struct LoopMetrics {
+  std::atomic<std::uint64_t> ticks{0};
+  std::atomic<std::uint64_t> snapshots{0};          // distinct FEM states the ticks used
+  std::atomic<std::uint32_t> tool_rows{0};          // tissue rows of the last tick (touching and candidates)
+  std::atomic<std::uint32_t> anatomy_rows{0};       // tool vs rigid anatomy rows of the last tick
+  std::atomic<std::uint32_t> active_contacts{0};    // rows with lambda > 0, last tick
+  std::atomic<std::uint64_t> rows_dropped{0};       // tool contacts beyond the row budget, total
+  std::atomic<std::uint64_t> query_overflows{0};    // contact buffer full, total
+  std::atomic<std::uint32_t> missing_compliance{0}; // rows on the fallback compliance, last tick
+  std::atomic<std::uint64_t> lost_track_ticks{0};
+  std::atomic<std::uint64_t> lost_track_episodes{0};
+  std::atomic<double> reaction_n{0.0};              // last tissue reaction, N
+  std::atomic<double> obstacle_reaction_n{0.0};     // last reaction of the rigid anatomy on the tool, N
+  std::atomic<double> peak_force_n{0.0};            // largest |F_k| commanded, N
+  // Work time of a tick (query, solve, messages): largest since the last
+  // report (the reporter resets it) and over the whole run, us.
+  std::atomic<double> tick_us_max{0.0};
+  std::atomic<double> tick_us_peak{0.0};
+};
+
+// Where the last tick's time went (steady clock, us): finding the tool's
+// contacts with the tissue (AIST query or triangle baseline, and the row
+// selection), with the rigid anatomy, and the contact response (solve,
+// decision, ContactSet). Read in the loop's thread (benchmarks, stack_sim).
+struct TickPhases {
+  double tissue_query_us = 0.0;
+  double anatomy_query_us = 0.0;
+  double response_us = 0.0;
+  collision::QueryStats tissue_query;  // the AIST query's work (zero with the triangle baseline)
+};
+
+// Rows the tool may have against rigid anatomy per tick: one per sample
+// leaf touching (~5 mm of blade each), the deepest kept.
+inline constexpr std::size_t kMaxAnatomyRows = 16;
+
+class HapticLoop {
+ public:
+  explicit HapticLoop(const HapticSetup& setup);
+
+  // Answers `pose` on the tissue of `tissue` (the newest snapshot).
+  void tick(const msg::DevicePose& pose, const TissueSnapshot& tissue, msg::ForceCommand& command,
+            msg::ContactSet& contacts);
+
+  const contact::ContactResponse& response() const { return response_; }
+  const LoopMetrics& metrics() const { return metrics_; }
+  const TickPhases& last_phases() const { return phases_; }
+  // Also resets the per-report maxima (reporter thread).
+  void append_metrics(std::vector<std::pair<std::string, double>>& out);
+
+ private:
+  contact::DeviceSample device_sample(const msg::DevicePose& pose);
+  void collect_tissue_rows(const TissueSnapshot& tissue);
+  std::size_t select_rows(const TissueSnapshot& tissue);
+  void collect_triangle_rows(const TissueSnapshot& tissue);
+  void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
+  const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device, const TissueSnapshot& tissue);
+
+  const HapticSetup& setup_;
+  double nominal_period_s_;
+  contact::ContactResponse response_;
+  // The penalty baseline (setup.penalty) and its ContactSet entries.
+  contact::PenaltyResponse penalty_;
+  std::vector<fem::Contact> penalty_contacts_;
+  std::size_t penalty_count_ = 0;
+
+  // Tool against the tongue (AIST).
+  collision::RigidBody tool_body_;
+  collision::QuerySettings tool_query_;
+  collision::PrePenetrationMemory tool_memory_;
+  collision::ContactBuffer tool_contacts_;
+  std::vector<std::uint32_t> order_;  // indices into tool_contacts_, deepest first when over capacity
+  std::vector<double> row_key_;       // per contact: select_rows' key (RowCompliance other than kDeepest)
+  // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
+  std::vector<collision::TriangleContact> triangle_contacts_;
+  std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1
+  std::vector<std::uint32_t> sphere_contact_;  // per slot: the deepest triangle contact of a sphere
+  std::vector<std::uint32_t> slot_sphere_;     // per slot: the sphere (to clear row_of_sphere_)
+  // Tool against the rigid anatomy (surface samples).
+  std::vector<collision::RigidBody> anatomy_bodies_;
+  std::vector<collision::SurfaceContact> anatomy_contacts_;
+  std::vector<std::uint32_t> anatomy_order_;
+  std::size_t tissue_row_budget_ = 0;
+  std::vector<contact::ContactRow> rows_;
+  std::size_t row_count_ = 0;
+
+  std::uint64_t last_fem_step_ = 0;
+  bool started_ = false;
+  bool was_lost_ = false;
+  std::uint64_t last_servo_tick_ = 0;
+  std::uint64_t tick_ = 0;
+  LoopMetrics metrics_;
+  TickPhases phases_;
+};
+
+}  // namespace fahr::haptic_service

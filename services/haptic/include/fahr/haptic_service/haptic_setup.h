@@ -1,0 +1,109 @@
+// Builds what the haptic service's loop needs from a scene, once, before
+// the first tick: the deformable body's AIST (the same deterministic filling
+// as fahr_fem_service, so sphere ids agree without a handshake), the tool's
+// signed distance field in its own frame, the obstacles' fields in theirs,
+// and the contact response settings.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "fahr/contact/contact_response.h"
+#include "fahr/contact/penalty_response.h"
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/geometry/surface_mesh.h"
+#include "fahr/geometry/tet_mesh.h"
+#include "fahr/collision/field_grid.h"
+#include "fahr/sphere_layout/fill_settings.h"
+#include "fahr/sphere_layout/sphere_layout.h"
+#include "fahr/collision/surface_samples.h"
+#include "fahr/runtime/rigid_field.h"
+#include "fahr/scene/scene.h"
+
+namespace fahr::haptic_service {
+
+// A rigid body's surface and its field, built as the FEM service builds the
+// same anatomy's (services/runtime).
+using RigidField = runtime::RigidField;
+
+// How the tool's contacts with the deformable body are found.
+enum class CollisionMethod {
+  kAist,      // the adaptive inner sphere tree (the paper's method)
+  kTriangle,  // the triangle-level baseline (Bullet box trees, vertex-face)
+};
+
+// What the triangle baseline needs beyond the AIST: the body's boundary and,
+// per boundary vertex, the sphere whose compliance and ContactSet entry its
+// contacts use (the nearest sphere at rest), so both methods feed the same
+// response and the same FEM.
+struct TriangleCollisionSetup {
+  geometry::SurfaceMesh boundary;                // world frame, rest, m
+  std::vector<geometry::Index> surface_to_node;  // FEM node of each boundary vertex
+  std::vector<std::uint32_t> vertex_sphere;      // sphere id of each boundary vertex
+};
+
+// A pressed blade touches ~600 spheres; the solve takes 64 rows and the
+// neonatal scene's FEM sends W (and free centres) for 16 of them. kDeepest:
+// the 64 deepest rows; the others are on the response's fallback compliance
+// and their projected centres, and most rows change each FEM state (after
+// its projection the W spheres are the shallowest). kKeep: the spheres the
+// newest state has W for come first, then the deepest of the rest, so the
+// FEM computes W for the same spheres again. kFreeDepth: the deepest, a W
+// sphere's depth taken on its free-motion centre (the published one reads
+// about zero after the FEM's projection; the others were not projected, so
+// theirs is already free): the depths the solve then uses.
+enum class RowCompliance { kDeepest, kKeep, kFreeDepth };
+// "deepest", "keep" or "free" (the benches' --row-compliance); kDeepest otherwise.
+inline RowCompliance row_compliance_named(std::string_view name) {
+  if (name == "keep") return RowCompliance::kKeep;
+  if (name == "free") return RowCompliance::kFreeDepth;
+  return RowCompliance::kDeepest;
+}
+
+struct HapticSetup {
+  const scene::Scene* scene = nullptr;
+  const scene::Body* deformable = nullptr;
+  geometry::TetMesh mesh;  // world frame, m (the FEM service's frame too)
+  sphere_layout::SphereLayout layout;
+  std::unique_ptr<RigidField> tool;
+  // The tool field's grid in the compact form the tick's AIST query reads
+  // (one cell per sphere, single precision: haptic/field_grid.h).
+  std::unique_ptr<collision::FieldGrid> tool_grid;
+  // Points on the tool's surface (tool frame) tested against the anatomy.
+  collision::SurfaceSamples tool_samples;
+  // Every rigid body either side touches, loaded once.
+  std::vector<std::unique_ptr<RigidField>> anatomy;
+  // Indices into anatomy: what the deformable body is tested against (the
+  // plan's hard pairs), and what the tool is (its tool-obstacle pairs).
+  std::vector<std::size_t> tissue_obstacles;
+  std::vector<std::size_t> tool_obstacles;
+  contact::ResponseSettings response;
+  // contact.response: penalty: the baseline of the paper's Figure 7a (the
+  // tool follows the device rigidly; forces k_p d on the FEM, no projection).
+  bool penalty = false;
+  contact::PenaltySettings penalty_settings;
+  CollisionMethod collision = CollisionMethod::kAist;
+  std::unique_ptr<TriangleCollisionSetup> triangles;  // set for kTriangle only
+  // How rows are picked when the tool touches more spheres than the solve
+  // takes (see RowCompliance): kFreeDepth where the scene has W along the
+  // normals (solver.compliance_columns), else kDeepest.
+  RowCompliance row_compliance = RowCompliance::kDeepest;
+  // Spheres within this gap of the tool are rows too (candidates, lambda = 0
+  // until the proxy moves into them), m, >= 0: the solve then stops the
+  // proxy within the tick instead of one tick late. The walk also visits
+  // spheres 1 mm beyond it, to remember their centres outside.
+  double candidate_margin_m = 1e-3;
+};
+
+// Throws std::runtime_error naming the body and what is wrong.
+// fem_keeps_anatomy: the FEM keeps the tongue out of the anatomy itself
+// (fem/obstacle_projection.h; the FEM service always does), so the tongue
+// is not tested against the anatomy here and the ContactSet carries no
+// obstacle entries, which that FEM ignores. false: the haptic side finds
+// them, for a FEM without its own anatomy (stack_sim's --fem-anatomy off).
+HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision = CollisionMethod::kAist,
+                   bool fem_keeps_anatomy = true);
+
+}  // namespace fahr::haptic_service

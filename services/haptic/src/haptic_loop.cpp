@@ -1,0 +1,397 @@
+// The haptic tick (see haptic_loop.h).
+#include "fahr/haptic_service/haptic_loop.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "fahr/haptic_service/msg_conversion.h"
+
+namespace fahr::haptic_service {
+namespace {
+
+// Tool contacts the query may report per tick. The blade pressing the
+// tongue touches a few dozen of its finest spheres; candidates within the
+// margin add as many again. 1024 leaves headroom, and a full buffer is
+// counted, not fatal.
+constexpr std::size_t kToolContactCapacity = 1024;
+// Leaves of the tool's surface samples near the anatomy in one tick: the
+// blade lying along the palate touches a few dozen.
+constexpr std::size_t kAnatomyContactCapacity = 128;
+// Tool samples within this distance of the anatomy become rows (separated,
+// lambda = 0 unless the proxy moves into them): the solve then stops the
+// proxy within the tick instead of one tick late, m. 1 mm: a hand at 1 m/s.
+constexpr double kAnatomyMarginM = 1e-3;
+
+template <class T>
+void relaxed_store(std::atomic<T>& a, T v) {
+  a.store(v, std::memory_order_relaxed);
+}
+
+double elapsed_us(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since).count();
+}
+
+void store_max(std::atomic<double>& a, double v) {
+  if (v > a.load(std::memory_order_relaxed)) a.store(v, std::memory_order_relaxed);
+}
+
+template <class T>
+void relaxed_add(std::atomic<T>& a, T v) {
+  a.fetch_add(v, std::memory_order_relaxed);
+}
+
+// Puts the `keep` deepest of indices[0, n) first (indices into `contacts`,
+// each with a depth_m) when there are more than that; returns how many were
+// dropped. In place, allocation-free.
+template <class Contact>
+std::size_t keep_deepest(std::vector<std::uint32_t>& indices, std::size_t n, std::size_t keep,
+                         const Contact& contacts) {
+  if (n <= keep) return 0;
+  std::partial_sort(indices.begin(), indices.begin() + static_cast<std::ptrdiff_t>(keep),
+                    indices.begin() + static_cast<std::ptrdiff_t>(n),
+                    [&](std::uint32_t a, std::uint32_t b) { return contacts[a].depth_m > contacts[b].depth_m; });
+  return n - keep;
+}
+
+}  // namespace
+
+HapticLoop::HapticLoop(const HapticSetup& setup)
+    : setup_(setup),
+      nominal_period_s_(1.0 / setup.scene->rates.haptic_hz),
+      response_(setup.response),
+      penalty_(setup.penalty_settings),
+      penalty_contacts_(setup.response.max_contacts),
+      tool_memory_(setup.layout.size()),
+      tool_contacts_(kToolContactCapacity),
+      order_(kToolContactCapacity, 0),
+      row_key_(kToolContactCapacity, 0.0),
+      anatomy_contacts_(kAnatomyContactCapacity),
+      anatomy_order_(kAnatomyContactCapacity, 0),
+      tissue_row_budget_(std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES, setup.response.max_rows)),
+      rows_(setup.response.max_rows) {
+  if (setup.collision == CollisionMethod::kTriangle) {
+    triangle_contacts_.reserve(kToolContactCapacity);
+    row_of_sphere_.assign(setup.layout.size(), -1);
+    sphere_contact_.assign(kToolContactCapacity, 0);
+    slot_sphere_.assign(kToolContactCapacity, 0);
+  }
+  tool_body_.id = setup.tool->scene_body->id;
+  tool_body_.sdf = setup.tool->sdf.get();
+  tool_body_.grid = setup.tool_grid.get();
+  // Spheres near the blade are sent as candidates, so the FEM computes
+  // their compliance before they touch.
+  tool_query_.candidate_margin_m = setup.candidate_margin_m;
+  // The grid's distance (~0.1 us a sphere) rather than the triangles' (1-3
+  // us on the 19k-triangle blade): with a few hundred spheres near the blade
+  // the exact query alone can take the whole 1 ms period on a shared core.
+  // It is exact on the blade's flat underside, off by a fraction of a cell
+  // (0.5 mm) at its edges.
+  tool_query_.exact_narrow_phase = false;
+  // The rows take the contact point, normal and depth only: no surface point
+  // (a face read and a closest point per reported sphere, ~500 a pressed tick).
+  tool_query_.surface_probe = collision::QuerySettings::SurfaceProbe::kNone;
+  // Of ~540 contacts a pressed tick ~64 become rows: the others' normals
+  // (a gradient, a square root, two transforms each) are not worked out.
+  tool_query_.defer_outside_contacts = true;
+  for (const std::size_t a : setup.tool_obstacles) {
+    const RigidField& field = *setup.anatomy[a];
+    collision::RigidBody body;
+    body.id = field.scene_body->id;
+    body.sdf = field.sdf.get();
+    body.world_from_body = Eigen::Translation3d(field.scene_body->pose.position_m) * field.scene_body->pose.orientation;
+    anatomy_bodies_.push_back(body);
+  }
+}
+
+contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
+  contact::DeviceSample d;
+  d.pose_seq = pose.header().seq();
+  d.position_m = to_eigen(pose.world_from_stylus().position_m());
+  d.orientation = to_eigen(pose.world_from_stylus().orientation());
+  d.velocity_mps = to_eigen(pose.linear_velocity_mps());
+  d.renderable_force_n = std::max(0.0, pose.renderable_force_n());
+  if (pose.max_stiffness_npm() > 0.0) d.max_stiffness_npm = pose.max_stiffness_npm();
+  // The servo count gives the time since the last answered pose, whatever
+  // DDS dropped in between; bounded so a stall does not make the damper vanish.
+  const std::uint64_t ticks = started_ && pose.servo_tick() > last_servo_tick_ ? pose.servo_tick() - last_servo_tick_ : 1;
+  d.dt_s = nominal_period_s_ * static_cast<double>(std::min<std::uint64_t>(ticks, 10));
+  last_servo_tick_ = pose.servo_tick();
+  return d;
+}
+
+// The rows' order of choice (haptic_setup.h RowCompliance): the k deepest,
+// the deepest with a W sphere's depth taken on its free centre, or the W
+// spheres first. Keys are worked out once per contact, then partially
+// sorted, as select_deepest does for the depth alone.
+std::size_t HapticLoop::select_rows(const TissueSnapshot& tissue) {
+  if (setup_.row_compliance == RowCompliance::kDeepest) {
+    return collision::select_deepest(tool_contacts_, tissue_row_budget_, order_);
+  }
+  const std::size_t n = std::min(tool_contacts_.size(), order_.size());
+  std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
+  if (n <= tissue_row_budget_) return n;
+  const bool free_depth = setup_.row_compliance == RowCompliance::kFreeDepth;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t w = tissue.compliance_index[tool_contacts_[i].sphere_id];
+    double key = tool_contacts_[i].depth_m;
+    // kFreeDepth: |c - c_free| stands for (c - c_free) . n, the FEM's shift
+    // being along the pushing normals. kKeep: a metre ahead of any depth.
+    if (w >= 0) key += free_depth ? double{tissue.free_shift_m[static_cast<std::size_t>(w)]} : 1.0;
+    row_key_[i] = key;
+  }
+  std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
+                    order_.begin() + static_cast<std::ptrdiff_t>(n),
+                    [&](std::uint32_t a, std::uint32_t b) { return row_key_[a] > row_key_[b]; });
+  return tissue_row_budget_;
+}
+
+void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
+  // More than W can cover: keep the deepest (touching before candidates),
+  // and only those get their point and normal (defer_outside_contacts).
+  const std::size_t keep = select_rows(tissue);
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, tool_contacts_.size() - keep);
+  collision::complete_deferred(tissue.tree, tool_body_, tool_query_, tool_contacts_, order_.data(), keep);
+  // (The penalty baseline's forces are part of the FEM's step, so it reads
+  // the published centres.)
+  const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
+  for (std::size_t r = 0; r < keep; ++r) {
+    const collision::SphereContact& s = tool_contacts_[order_[r]];
+    contact::ContactRow& row = rows_[row_count_++];
+    row.kind = contact::RowKind::kTissue;
+    row.id = s.sphere_id;
+    row.normal = s.normal;
+    row.tool_point_m = s.point_m;
+    row.radius_m = tissue.spheres.radii_m()[s.sphere_id];
+    row.compliance_index = tissue.compliance_index[s.sphere_id];
+    row.other_point_m = tissue.spheres.centres_m()[s.sphere_id];
+    if (free_centres && row.compliance_index >= 0) {
+      // Penetration on the free-motion centre (services/contact README,
+      // "Which centre"): the projected one reads zero at a steady contact.
+      const float* c = tissue.free_centres_m.data() + 3 * row.compliance_index;
+      row.other_point_m = Eigen::Vector3d(c[0], c[1], c[2]);
+    }
+  }
+}
+
+// The baseline's vertex-face contacts as rows of the same response: each
+// tongue vertex behind a blade face (or within the candidate margin in front
+// of it: a candidate row, as the AIST's) speaks for the sphere nearest it at
+// rest (its compliance, its ContactSet entry); the deepest contact per sphere
+// is kept. The vertex comes from the published (projected) positions; it is
+// moved by its sphere's free-motion offset, as the AIST rows use the free
+// centres. Blade vertices behind a tongue face (the tip's edge) are found,
+// and timed, but give no row: as rows on the face's nearest corner sphere
+// they drove the intubation's tongue to thousands of inverted tets within
+// 20 s (fahr_stack_sim_run --collision triangle), since the FEM projects that
+// sphere, radius included, onto the plane through a blade vertex.
+void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
+  // The AIST rows' candidate margin: both methods hand the solve the same kind of rows.
+  tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_, tool_query_.candidate_margin_m);
+  const auto& vertex_sphere = setup_.triangles->vertex_sphere;
+  std::size_t slots = 0;
+  for (std::size_t i = 0; i < triangle_contacts_.size() && slots < sphere_contact_.size(); ++i) {
+    const collision::TriangleContact& c = triangle_contacts_[i];
+    if (c.tissue_vertex < 0) continue;
+    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.tissue_vertex)];
+    const std::int32_t slot = row_of_sphere_[sphere];
+    if (slot < 0) {
+      row_of_sphere_[sphere] = static_cast<std::int32_t>(slots);
+      slot_sphere_[slots] = sphere;
+      sphere_contact_[slots++] = static_cast<std::uint32_t>(i);
+    } else if (c.depth_m > triangle_contacts_[sphere_contact_[static_cast<std::size_t>(slot)]].depth_m) {
+      sphere_contact_[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(i);
+    }
+  }
+  for (std::size_t k = 0; k < slots; ++k) row_of_sphere_[slot_sphere_[k]] = -1;
+  const std::size_t keep = std::min(slots, tissue_row_budget_);
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, keep_deepest(sphere_contact_, slots, keep, triangle_contacts_));
+  // (The penalty baseline's forces are part of the FEM's step, so it reads
+  // the published centres.)
+  const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
+  for (std::size_t r = 0; r < keep; ++r) {
+    const collision::TriangleContact& c = triangle_contacts_[sphere_contact_[r]];
+    const std::uint32_t sphere = vertex_sphere[static_cast<std::size_t>(c.tissue_vertex)];
+    contact::ContactRow& row = rows_[row_count_++];
+    row.kind = contact::RowKind::kTissue;
+    row.id = sphere;
+    row.normal = c.normal;
+    row.tool_point_m = c.point_m;
+    row.other_point_m = c.point_m - c.depth_m * c.normal;  // the vertex: depth = -(v - q) . n
+    row.radius_m = 0.0;
+    row.compliance_index = tissue.compliance_index[sphere];
+    if (free_centres && row.compliance_index >= 0) {
+      const float* f = tissue.free_centres_m.data() + 3 * row.compliance_index;
+      row.other_point_m += Eigen::Vector3d(f[0], f[1], f[2]) - tissue.spheres.centres_m()[sphere];
+    }
+  }
+}
+
+void HapticLoop::collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool) {
+  std::size_t n = 0;
+  for (const collision::RigidBody& body : anatomy_bodies_) {
+    const auto stats =
+        collision::query_surface_samples(setup_.tool_samples, world_from_tool, body, kAnatomyMarginM, anatomy_contacts_, n);
+    if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
+  }
+  const std::size_t keep = std::min({n, kMaxAnatomyRows, rows_.size() - row_count_});
+  std::iota(anatomy_order_.begin(), anatomy_order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, keep_deepest(anatomy_order_, n, keep, anatomy_contacts_));
+  for (std::size_t r = 0; r < keep; ++r) {
+    const collision::SurfaceContact& c = anatomy_contacts_[anatomy_order_[r]];
+    contact::ContactRow& row = rows_[row_count_++];
+    row.kind = contact::RowKind::kObstacle;
+    // (body, leaf) keys the warm start: body ids are small scene indices,
+    // leaves fewer than 2^20.
+    row.id = (c.body_id << 20) | c.leaf;
+    // From the tool toward the anatomy: moving the tool into it deepens the row.
+    row.normal = -c.normal;
+    row.tool_point_m = c.tool_point_m;
+    row.other_point_m = c.surface_point_m;
+    row.radius_m = 0.0;
+    row.compliance_index = contact::kNoCompliance;
+  }
+  relaxed_store(metrics_.anatomy_rows, static_cast<std::uint32_t>(keep));
+}
+
+void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue, msg::ForceCommand& command,
+                      msg::ContactSet& contacts) {
+  const auto start = std::chrono::steady_clock::now();
+  const contact::DeviceSample device = device_sample(pose);
+  if (!started_) {
+    response_.reset(device.position_m, device.orientation);
+    started_ = true;
+  }
+  if (tissue.from_fem && tissue.fem_step != last_fem_step_) {
+    last_fem_step_ = tissue.fem_step;
+    relaxed_add<std::uint64_t>(metrics_.snapshots, 1);
+  }
+  // Rows are measured with the tool at the proxy, in the device's
+  // orientation: the reference pose p0 of the solve. The penalty baseline
+  // has no proxy: its tool is the device.
+  const Eigen::Vector3d tool_at = setup_.penalty ? device.position_m : response_.proxy().position_m;
+  tool_body_.world_from_body = Eigen::Translation3d(tool_at) * device.orientation;
+  row_count_ = 0;
+  const auto query_start = std::chrono::steady_clock::now();
+  phases_.tissue_query = {};
+  if (setup_.collision == CollisionMethod::kTriangle && tissue.triangles) {
+    collect_triangle_rows(tissue);
+  } else {
+    tool_contacts_.clear();
+    const auto stats =
+        collision::query_spheres(tissue.tree, tissue.spheres, tool_body_, tool_query_, tool_memory_, tool_contacts_);
+    if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
+    phases_.tissue_query = stats;
+    collect_tissue_rows(tissue);
+  }
+  const std::size_t tissue_rows = row_count_;
+  const auto anatomy_start = std::chrono::steady_clock::now();
+  collect_anatomy_rows(tool_body_.world_from_body);
+  const auto response_start = std::chrono::steady_clock::now();
+
+  const contact::ForceOutput* output = nullptr;
+  if (setup_.penalty) {
+    output = &penalty_tick(device, tissue);
+  } else {
+    contact::TickInput input;
+    input.device = device;
+    input.rows = {rows_.data(), row_count_};
+    if (tissue.from_fem) input.compliance = tissue.compliance();
+    input.tissue_obstacle_contacts = tissue.tissue_obstacle_contacts();
+    output = &response_.tick(input);
+  }
+  const contact::ForceOutput& out = *output;
+  const auto response_end = std::chrono::steady_clock::now();
+  using Micro = std::chrono::duration<double, std::micro>;
+  phases_.tissue_query_us = Micro(anatomy_start - query_start).count();
+  phases_.anatomy_query_us = Micro(response_start - anatomy_start).count();
+  phases_.response_us = Micro(response_end - response_start).count();
+
+  fill_command(out, pose.device_id(), command);
+  command.header().sim_step(pose.servo_tick());
+  command.header().sim_time_ns(pose.header().sim_time_ns());
+  contacts.body_id(setup_.deformable->id);
+  contacts.haptic_tick(tick_);
+  contacts.fem_step(tissue.fem_step);
+  if (setup_.penalty) {
+    contacts.tool_frozen(false);
+    fill_contacts({penalty_contacts_.data(), penalty_count_}, tool_body_.id, tissue.tissue_obstacle_body_ids(),
+                  contacts);
+  } else {
+    contacts.tool_frozen(response_.tool_frozen());
+    fill_contacts(response_.contacts(), tool_body_.id, tissue.tissue_obstacle_body_ids(), contacts);
+  }
+  // Where the FEM finds the tool: the proxy after this tick (the penalty
+  // baseline's tool is the device).
+  put(setup_.penalty ? device.position_m : response_.proxy().position_m, contacts.world_from_tool().position_m());
+  put(device.orientation, contacts.world_from_tool().orientation());
+  contacts.header().sim_step(pose.servo_tick());
+  contacts.header().sim_time_ns(pose.header().sim_time_ns());
+  ++tick_;
+
+  relaxed_add<std::uint64_t>(metrics_.ticks, 1);
+  relaxed_store(metrics_.tool_rows, static_cast<std::uint32_t>(tissue_rows));
+  relaxed_store(metrics_.active_contacts, out.active_contacts);
+  relaxed_store(metrics_.missing_compliance,
+                static_cast<std::uint32_t>(std::max(0, response_.report().load.missing_compliance)));
+  relaxed_store(metrics_.reaction_n, out.tissue_reaction_n);
+  relaxed_store(metrics_.obstacle_reaction_n, response_.report().obstacle_reaction_n);
+  const double force_n = out.force_n.norm();
+  if (force_n > metrics_.peak_force_n.load(std::memory_order_relaxed)) relaxed_store(metrics_.peak_force_n, force_n);
+  if (out.lost_track) {
+    relaxed_add<std::uint64_t>(metrics_.lost_track_ticks, 1);
+    if (!was_lost_) relaxed_add<std::uint64_t>(metrics_.lost_track_episodes, 1);
+  }
+  was_lost_ = out.lost_track;
+  const double tick_us = elapsed_us(start);
+  store_max(metrics_.tick_us_max, tick_us);
+  store_max(metrics_.tick_us_peak, tick_us);
+}
+
+// The penalty baseline: each penetrating tissue row pushes its sphere with
+// k_p d along n, as a force-only ContactSet entry (the FEM applies it and
+// projects nothing); bone rows push the tool but not the tissue.
+const contact::ForceOutput& HapticLoop::penalty_tick(const contact::DeviceSample& device,
+                                                     const TissueSnapshot& tissue) {
+  const contact::ForceOutput& out = penalty_.tick(device, {rows_.data(), row_count_}, tissue.fem_step);
+  penalty_count_ = 0;
+  for (const contact::SphereForce& f : penalty_.sphere_forces()) {
+    const double magnitude = f.force_n.norm();
+    if (!(magnitude > 0.0) || penalty_count_ == penalty_contacts_.size()) continue;
+    fem::Contact& c = penalty_contacts_[penalty_count_++];
+    c.sphere_id = f.sphere_id;
+    c.kind = fem::ContactKind::kForceOnly;
+    c.state = fem::ContactState::kActive;
+    c.normal = f.force_n / magnitude;
+    c.force_n = magnitude;
+    c.hold_centre_m = tissue.spheres.centres_m()[f.sphere_id];
+    c.plane_point_m = c.hold_centre_m;
+    c.penetration_m = magnitude / setup_.penalty_settings.stiffness_npm;
+  }
+  for (const fem::Contact& c : tissue.tissue_obstacle_contacts()) {
+    if (penalty_count_ == penalty_contacts_.size()) break;
+    penalty_contacts_[penalty_count_++] = c;
+  }
+  return out;
+}
+
+void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out) {
+  const auto get = [](const auto& a) { return static_cast<double>(a.load(std::memory_order_relaxed)); };
+  out.emplace_back("fem_states_used", get(metrics_.snapshots));
+  out.emplace_back("tool_rows", get(metrics_.tool_rows));
+  out.emplace_back("anatomy_rows", get(metrics_.anatomy_rows));
+  out.emplace_back("active_contacts", get(metrics_.active_contacts));
+  out.emplace_back("rows_dropped", get(metrics_.rows_dropped));
+  out.emplace_back("query_overflows", get(metrics_.query_overflows));
+  out.emplace_back("missing_compliance", get(metrics_.missing_compliance));
+  out.emplace_back("lost_track_ticks", get(metrics_.lost_track_ticks));
+  out.emplace_back("lost_track_episodes", get(metrics_.lost_track_episodes));
+  out.emplace_back("tissue_reaction_n", get(metrics_.reaction_n));
+  out.emplace_back("anatomy_reaction_n", get(metrics_.obstacle_reaction_n));
+  out.emplace_back("peak_force_n", get(metrics_.peak_force_n));
+  out.emplace_back("spheres", static_cast<double>(setup_.layout.size()));
+  out.emplace_back("tick_us_max", metrics_.tick_us_max.exchange(0.0, std::memory_order_relaxed));
+}
+
+}  // namespace fahr::haptic_service

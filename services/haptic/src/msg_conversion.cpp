@@ -1,0 +1,86 @@
+// Wire conversions of the haptic service.
+#include "fahr/haptic_service/msg_conversion.h"
+
+#include <cmath>
+
+namespace fahr::haptic_service {
+
+Eigen::Quaterniond to_eigen(const msg::Quat& q) {
+  Eigen::Quaterniond out(q.w(), q.x(), q.y(), q.z());
+  const double norm = out.norm();
+  // A gateway that sent a zero or non-finite quaternion gets no rotation
+  // rather than a NaN pose in the collision query.
+  if (!(norm > 1e-9) || !std::isfinite(norm)) return Eigen::Quaterniond::Identity();
+  out.coeffs() /= norm;
+  return out;
+}
+
+void put(const Eigen::Quaterniond& q, msg::Quat& out) {
+  out.w(q.w());
+  out.x(q.x());
+  out.y(q.y());
+  out.z(q.z());
+}
+
+void fill_command(const contact::ForceOutput& output, std::uint32_t device_id, msg::ForceCommand& out) {
+  out.device_id(device_id);
+  out.answered_pose_seq(output.answered_pose_seq);
+  put(output.answered_position_m, out.answered_position_m());
+  put(output.force_n, out.force_n());
+  auto& k = out.stiffness_npm().m();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) k[static_cast<std::size_t>(3 * r + c)] = output.stiffness_npm(r, c);
+  }
+  put(Eigen::Vector3d::Zero(), out.torque_nm());  // the rigid blade's torque is not computed yet
+  put(output.proxy_position_m, out.world_from_proxy().position_m());
+  put(output.proxy_orientation, out.world_from_proxy().orientation());
+  out.lost_track(output.lost_track);
+  put(output.device_minus_proxy_m, out.device_minus_proxy_m());
+  out.tissue_reaction_n(output.tissue_reaction_n);
+  out.active_contacts(output.active_contacts);
+  out.fem_step(output.fem_step);
+}
+
+namespace {
+
+msg::ConstraintState wire_state(fem::ContactState s) {
+  switch (s) {
+    case fem::ContactState::kActive:
+      return msg::CONSTRAINT_ACTIVE;
+    case fem::ContactState::kFrozen:
+      return msg::CONSTRAINT_FROZEN;
+    case fem::ContactState::kCandidate:
+      break;
+  }
+  return msg::CONSTRAINT_CANDIDATE;
+}
+
+}  // namespace
+
+void fill_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_body_id,
+                   std::span<const std::uint32_t> obstacle_body_ids, msg::ContactSet& out) {
+  const std::size_t n = std::min<std::size_t>(contacts.size(), msg::MAX_CONTACTS);
+  out.contacts().resize(n);
+  std::size_t obstacle = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const fem::Contact& c = contacts[i];
+    msg::Contact& w = out.contacts()[i];
+    w.sphere_id(c.sphere_id);
+    if (c.kind == fem::ContactKind::kObstacle) {
+      w.kind(msg::CONTACT_OBSTACLE);
+      w.other_body_id(obstacle < obstacle_body_ids.size() ? obstacle_body_ids[obstacle] : 0u);
+      ++obstacle;
+    } else {
+      w.kind(c.kind == fem::ContactKind::kForceOnly ? msg::CONTACT_FORCE_ONLY : msg::CONTACT_TOOL);
+      w.other_body_id(tool_body_id);
+    }
+    w.state(wire_state(c.state));
+    put(c.plane_point_m, w.point_m());
+    put(c.normal, w.normal());
+    put(c.hold_centre_m, w.hold_centre_m());
+    w.penetration_m(c.penetration_m);
+    w.force_n(c.force_n);
+  }
+}
+
+}  // namespace fahr::haptic_service

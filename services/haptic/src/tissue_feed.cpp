@@ -1,0 +1,55 @@
+// The state thread of the real-time haptic service (see tissue_feed.h).
+#include "fahr/haptic_service/tissue_feed.h"
+
+#include <chrono>
+
+namespace fahr::haptic_service {
+
+TissueFeed::TissueFeed(common::Participant& participant, const HapticSetup& setup)
+    : digest_(setup),
+      buffer_([this] { return digest_.make_snapshot(); }),
+      states_(participant),
+      thread_([this] { run(); }) {}
+
+TissueFeed::~TissueFeed() {
+  stop_.store(true, std::memory_order_relaxed);
+  thread_.join();
+}
+
+void TissueFeed::run() {
+  using namespace std::chrono_literals;
+  std::uint64_t seen = 0;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    // 50 ms: short enough to notice the stop, long enough not to spin.
+    seen = states_.wait_for_samples(seen, 50ms);
+    if (!states_.fetch_newest()) continue;
+    TissueSnapshot& next = buffer_.back();
+    if (!digest_.digest(states_.newest(), next)) {
+      metrics_.bad_states.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    buffer_.publish();
+    metrics_.fem_states.fetch_add(1, std::memory_order_relaxed);
+    metrics_.obstacle_contacts.store(static_cast<std::uint32_t>(next.obstacle_count), std::memory_order_relaxed);
+    if (next.obstacle_overflow) metrics_.obstacle_overflows.fetch_add(1, std::memory_order_relaxed);
+    metrics_.free_centres.store(next.have_free_centres, std::memory_order_relaxed);
+    if (next.digest_us > metrics_.digest_us_max.load(std::memory_order_relaxed)) {
+      metrics_.digest_us_max.store(next.digest_us, std::memory_order_relaxed);
+    }
+    if (next.digest_us > metrics_.digest_us_peak.load(std::memory_order_relaxed)) {
+      metrics_.digest_us_peak.store(next.digest_us, std::memory_order_relaxed);
+    }
+  }
+}
+
+void TissueFeed::append_metrics(std::vector<std::pair<std::string, double>>& out) {
+  const auto get = [](const auto& a) { return static_cast<double>(a.load(std::memory_order_relaxed)); };
+  out.emplace_back("fem_states", get(metrics_.fem_states));
+  out.emplace_back("bad_states", get(metrics_.bad_states));
+  out.emplace_back("obstacle_contacts", get(metrics_.obstacle_contacts));
+  out.emplace_back("obstacle_overflows", get(metrics_.obstacle_overflows));
+  out.emplace_back("free_centres", metrics_.free_centres.load(std::memory_order_relaxed) ? 1.0 : 0.0);
+  out.emplace_back("digest_us_max", metrics_.digest_us_max.exchange(0.0, std::memory_order_relaxed));
+}
+
+}  // namespace fahr::haptic_service
