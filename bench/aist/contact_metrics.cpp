@@ -32,9 +32,11 @@ double winding_number(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3
 
 }  // namespace
 
-void ContactMetrics::add_tick(const collision::ContactBuffer& aist, const collision::SphereState& state,
+void ContactMetrics::add_tick(const collision::ContactBuffer& aist,
+                              const collision::SphereState& state,
                               const std::vector<collision::TriangleContact>& base,
-                              const Eigen::Isometry3d& world_from_blade, std::span<const double> positions_m) {
+                              const Eigen::Isometry3d& world_from_blade,
+                              std::span<const double> positions_m) {
   std::vector<Eigen::Vector3d> deformed;
   bool have_deformed = false;
   auto inside_tongue = [&](const Eigen::Vector3d& p) {
@@ -58,7 +60,8 @@ void ContactMetrics::add_tick(const collision::ContactBuffer& aist, const collis
   for (const auto& b : base) {
     // The tissue-side point: the penetrating tongue vertex, or the blade
     // vertex that is inside the tongue.
-    const Eigen::Vector3d p = b.tissue_vertex >= 0 ? Eigen::Vector3d(b.point_m - b.depth_m * b.normal) : b.point_m;
+    const Eigen::Vector3d p =
+        b.tissue_vertex >= 0 ? Eigen::Vector3d(b.point_m - b.depth_m * b.normal) : b.point_m;
     // Verified against exact geometry: a tongue vertex must be inside the
     // blade (its exact field), a blade vertex inside the deformed tongue (its
     // winding number); a vertex merely behind a face is a false contact.
@@ -75,12 +78,14 @@ void ContactMetrics::add_tick(const collision::ContactBuffer& aist, const collis
     }
     ++base_total_;
     bool recalled = false, near = false, by_surface = false;
-    double aist_depth = 0.0, nearest_depth = 0.0, nearest_gap = std::numeric_limits<double>::infinity();
+    double aist_depth = 0.0, nearest_depth = 0.0,
+           nearest_gap = std::numeric_limits<double>::infinity();
     double nearest_surface = 0.0;
     // The surface point measuring at p: the reporting sphere's anchor nearest
     // p (a sphere without one stands for the surface by its own; its
     // distance is that of its surface); [1]: candidates' anchors too.
-    double anchor_gap[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    double anchor_gap[2] = {std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::infinity()};
     double anchor_depth[2] = {0.0, 0.0}, anchor_field = 0.0;
     std::size_t aist_index = 0;
     for (const auto& a : aist) {
@@ -92,12 +97,15 @@ void ContactMetrics::add_tick(const collision::ContactBuffer& aist, const collis
       const double gap = (p - centres[a.sphere_id]).norm() - radii[a.sphere_id];
       const double to_anchor = a.has_surface ? (p - a.surface_point_m).norm() : gap;
       for (int with_candidates = 0; with_candidates < 2; ++with_candidates) {
-        if ((a.candidate && with_candidates == 0) || !(to_anchor < anchor_gap[with_candidates])) continue;
+        if ((a.candidate && with_candidates == 0) || !(to_anchor < anchor_gap[with_candidates]))
+          continue;
         anchor_gap[with_candidates] = to_anchor;
         anchor_depth[with_candidates] = surface;
         if (with_candidates == 0) {
-          anchor_field = a.has_surface ? -scene_.blade_sdf.query_exact(blade_from_world * a.surface_point_m).distance_m
-                                       : a.depth_m;
+          anchor_field =
+              a.has_surface
+                  ? -scene_.blade_sdf.query_exact(blade_from_world * a.surface_point_m).distance_m
+                  : a.depth_m;
         }
       }
       if (a.candidate) continue;
@@ -129,7 +137,8 @@ void ContactMetrics::add_tick(const collision::ContactBuffer& aist, const collis
     if (!recalled) {
       // Why it was missed: the distance from p to the (deformed) sphere union.
       double gap = std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < centres.size(); ++i) gap = std::min(gap, (p - centres[i]).norm() - radii[i]);
+      for (std::size_t i = 0; i < centres.size(); ++i)
+        gap = std::min(gap, (p - centres[i]).norm() - radii[i]);
       if (near) {
         ++miss_candidate_;
       } else if (gap <= kRegionSlackM) {
@@ -169,7 +178,8 @@ void ContactMetrics::add_tick(const collision::ContactBuffer& aist, const collis
     ++aist_total_;
     bool matched = false;
     for (const auto& b : base) {
-      const Eigen::Vector3d p = b.tissue_vertex >= 0 ? Eigen::Vector3d(b.point_m - b.depth_m * b.normal) : b.point_m;
+      const Eigen::Vector3d p =
+          b.tissue_vertex >= 0 ? Eigen::Vector3d(b.point_m - b.depth_m * b.normal) : b.point_m;
       matched = matched || in_region(a, p);
     }
     aist_unmatched_ += matched ? 0 : 1;
@@ -179,98 +189,160 @@ void ContactMetrics::add_tick(const collision::ContactBuffer& aist, const collis
 }
 
 double ContactMetrics::recall() const {
-  return base_total_ > 0 ? static_cast<double>(base_recalled_) / static_cast<double>(base_total_) : 1.0;
+  return base_total_ > 0 ? static_cast<double>(base_recalled_) / static_cast<double>(base_total_)
+                         : 1.0;
 }
 
 double ContactMetrics::recall_near() const {
-  return base_total_ > 0 ? static_cast<double>(base_recalled_near_) / static_cast<double>(base_total_) : 1.0;
+  return base_total_ > 0
+             ? static_cast<double>(base_recalled_near_) / static_cast<double>(base_total_)
+             : 1.0;
 }
 
 double ContactMetrics::recall_deeper() const {
-  return deeper_total_ > 0 ? static_cast<double>(deeper_recalled_) / static_cast<double>(deeper_total_) : 1.0;
+  return deeper_total_ > 0
+             ? static_cast<double>(deeper_recalled_) / static_cast<double>(deeper_total_)
+             : 1.0;
 }
 
-double ContactMetrics::depth_error_p99_m() const { return percentile(aist_depth_error_m_, 99); }
+double ContactMetrics::depth_error_p99_m() const {
+  return percentile(aist_depth_error_m_, 99);
+}
 
 void ContactMetrics::print() const {
-  auto ratio = [](std::size_t a, std::size_t b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 100.0; };
-  std::printf("\nRecall: a baseline contact's tissue-side point (the tongue vertex inside the blade, or the blade vertex "
-              "inside the tongue) is recalled when it lies in the region of an AIST sphere that reports contact: within "
-              "its radius + %.1f mm (the coverage target). \"with candidates\": an AIST sphere within the candidate margin (not touching) counts as well. Baseline tongue-vertex contacts that the exact blade field puts "
-              "outside the blade are the baseline's false contacts and are left out. Ticks with contacts: %zu (both: %zu).\n\n",
-              kRegionSlackM * 1e3, contact_ticks_, ticks_both_);
-  std::printf("| baseline contacts (verified) | recall | with candidates | deeper than %.2f mm | recall | deeper than %.2f mm | recall | with candidates | baseline false contacts | AIST contacts | AIST with no baseline contact in region |\n",
-              kDeepM * 1e3, kDeeperM * 1e3);
+  auto ratio = [](std::size_t a, std::size_t b) {
+    return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 100.0;
+  };
+  std::printf(
+      "\nRecall: a baseline contact's tissue-side point (the tongue vertex inside the blade, or "
+      "the blade vertex "
+      "inside the tongue) is recalled when it lies in the region of an AIST sphere that reports "
+      "contact: within "
+      "its radius + %.1f mm (the coverage target). \"with candidates\": an AIST sphere within the "
+      "candidate margin (not touching) counts as well. Baseline tongue-vertex contacts that the "
+      "exact blade field puts "
+      "outside the blade are the baseline's false contacts and are left out. Ticks with contacts: "
+      "%zu (both: %zu).\n\n",
+      kRegionSlackM * 1e3, contact_ticks_, ticks_both_);
+  std::printf(
+      "| baseline contacts (verified) | recall | with candidates | deeper than %.2f mm | recall | "
+      "deeper than %.2f mm | recall | with candidates | baseline false contacts | AIST contacts | "
+      "AIST with no baseline contact in region |\n",
+      kDeepM * 1e3, kDeeperM * 1e3);
   std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
-  std::printf("| %zu | %.2f%% | %.2f%% | %zu | %.2f%% | %zu | %.2f%% | %.2f%% | %zu | %zu | %zu (%.1f%%) |\n", base_total_,
-              ratio(base_recalled_, base_total_), ratio(base_recalled_near_, base_total_), deep_total_,
-              ratio(deep_recalled_, deep_total_), deeper_total_, ratio(deeper_recalled_, deeper_total_),
-              ratio(deeper_recalled_near_, deeper_total_), base_false_, aist_total_, aist_unmatched_,
-              ratio(aist_unmatched_, aist_total_));
+  std::printf(
+      "| %zu | %.2f%% | %.2f%% | %zu | %.2f%% | %zu | %.2f%% | %.2f%% | %zu | %zu | %zu (%.1f%%) "
+      "|\n",
+      base_total_, ratio(base_recalled_, base_total_), ratio(base_recalled_near_, base_total_),
+      deep_total_, ratio(deep_recalled_, deep_total_), deeper_total_,
+      ratio(deeper_recalled_, deeper_total_), ratio(deeper_recalled_near_, deeper_total_),
+      base_false_, aist_total_, aist_unmatched_, ratio(aist_unmatched_, aist_total_));
   const std::size_t missed = base_total_ - base_recalled_;
-  std::printf("\nMissed baseline contacts (%zu), by cause: an AIST sphere covering the point is reported as a "
-              "candidate (within %.2f mm of the blade, resting where the FEM's projection put it): %zu (%.1f%%); the "
-              "sphere union lies within %.1f mm of the point but no covering sphere reaches the blade (the union stands "
-              "inside the deformed surface): %zu (%.1f%%); the union lies farther than that from the point (coverage lost "
-              "under the deformation): %zu (%.1f%%).\n",
-              missed, kCandidateMarginM * 1e3, miss_candidate_, ratio(miss_candidate_, missed), kRegionSlackM * 1e3,
-              miss_standoff_, ratio(miss_standoff_, missed), miss_detached_, ratio(miss_detached_, missed));
-  std::printf("\nDepth error at each baseline tongue-vertex contact (%zu): the exact penetration of that vertex into the "
-              "blade (-sdf, exact query; median %.3f mm, max %.3f mm) against the deepest AIST contact whose region holds "
-              "the vertex, and against the baseline's own face depth.\n\n",
-              exact_depth_m_.size(), percentile(exact_depth_m_, 50) * 1e3, percentile(exact_depth_m_, 100) * 1e3);
-  std::printf("| method | median (mm) | p95 (mm) | p99 (mm) | max (mm) |\n| --- | --- | --- | --- | --- |\n");
+  std::printf(
+      "\nMissed baseline contacts (%zu), by cause: an AIST sphere covering the point is reported "
+      "as a "
+      "candidate (within %.2f mm of the blade, resting where the FEM's projection put it): %zu "
+      "(%.1f%%); the "
+      "sphere union lies within %.1f mm of the point but no covering sphere reaches the blade (the "
+      "union stands "
+      "inside the deformed surface): %zu (%.1f%%); the union lies farther than that from the point "
+      "(coverage lost "
+      "under the deformation): %zu (%.1f%%).\n",
+      missed, kCandidateMarginM * 1e3, miss_candidate_, ratio(miss_candidate_, missed),
+      kRegionSlackM * 1e3, miss_standoff_, ratio(miss_standoff_, missed), miss_detached_,
+      ratio(miss_detached_, missed));
+  std::printf(
+      "\nDepth error at each baseline tongue-vertex contact (%zu): the exact penetration of that "
+      "vertex into the "
+      "blade (-sdf, exact query; median %.3f mm, max %.3f mm) against the deepest AIST contact "
+      "whose region holds "
+      "the vertex, and against the baseline's own face depth.\n\n",
+      exact_depth_m_.size(), percentile(exact_depth_m_, 50) * 1e3,
+      percentile(exact_depth_m_, 100) * 1e3);
+  std::printf(
+      "| method | median (mm) | p95 (mm) | p99 (mm) | max (mm) |\n| --- | --- | --- | --- | --- "
+      "|\n");
   std::printf("| AIST | %.3f | %.3f | %.3f | %.3f |\n", percentile(aist_depth_error_m_, 50) * 1e3,
               percentile(aist_depth_error_m_, 95) * 1e3, percentile(aist_depth_error_m_, 99) * 1e3,
               percentile(aist_depth_error_m_, 100) * 1e3);
-  std::printf("| baseline | %.3f | %.3f | %.3f | %.3f |\n", percentile(base_depth_error_m_, 50) * 1e3,
-              percentile(base_depth_error_m_, 95) * 1e3, percentile(base_depth_error_m_, 99) * 1e3,
+  std::printf("| baseline | %.3f | %.3f | %.3f | %.3f |\n",
+              percentile(base_depth_error_m_, 50) * 1e3, percentile(base_depth_error_m_, 95) * 1e3,
+              percentile(base_depth_error_m_, 99) * 1e3,
               percentile(base_depth_error_m_, 100) * 1e3);
-  std::printf("\nDepth error at every verified baseline contact (%zu; exact depth median %.3f mm, p95 %.3f mm, max %.3f mm): "
-              "a tongue vertex's exact penetration as above, a blade vertex's depth behind the deformed tissue face the "
-              "baseline found it under (inside the tongue by its winding number). AIST depth at the point: the deepest "
-              "reporting sphere whose region holds it, or the reporting sphere whose surface is nearest the point "
-              "(0 when none).\n\n",
-              all_exact_depth_m_.size(), percentile(all_exact_depth_m_, 50) * 1e3, percentile(all_exact_depth_m_, 95) * 1e3,
-              percentile(all_exact_depth_m_, 100) * 1e3);
-  std::printf("| AIST depth at the point | median (mm) | p95 (mm) | p99 (mm) | max (mm) |\n| --- | --- | --- | --- | --- |\n");
+  std::printf(
+      "\nDepth error at every verified baseline contact (%zu; exact depth median %.3f mm, p95 %.3f "
+      "mm, max %.3f mm): "
+      "a tongue vertex's exact penetration as above, a blade vertex's depth behind the deformed "
+      "tissue face the "
+      "baseline found it under (inside the tongue by its winding number). AIST depth at the point: "
+      "the deepest "
+      "reporting sphere whose region holds it, or the reporting sphere whose surface is nearest "
+      "the point "
+      "(0 when none).\n\n",
+      all_exact_depth_m_.size(), percentile(all_exact_depth_m_, 50) * 1e3,
+      percentile(all_exact_depth_m_, 95) * 1e3, percentile(all_exact_depth_m_, 100) * 1e3);
+  std::printf(
+      "| AIST depth at the point | median (mm) | p95 (mm) | p99 (mm) | max (mm) |\n| --- | --- | "
+      "--- | --- | --- |\n");
   for (const auto* e : {&all_deepest_error_m_, &all_nearest_error_m_}) {
-    std::printf("| %s | %.3f | %.3f | %.3f | %.3f |\n", e == &all_deepest_error_m_ ? "deepest sphere" : "nearest sphere",
-                percentile(*e, 50) * 1e3, percentile(*e, 95) * 1e3, percentile(*e, 99) * 1e3, percentile(*e, 100) * 1e3);
+    std::printf("| %s | %.3f | %.3f | %.3f | %.3f |\n",
+                e == &all_deepest_error_m_ ? "deepest sphere" : "nearest sphere",
+                percentile(*e, 50) * 1e3, percentile(*e, 95) * 1e3, percentile(*e, 99) * 1e3,
+                percentile(*e, 100) * 1e3);
   }
-  std::printf("\nSurface depth (SphereContact::surface_depth_m: the depth of the sphere's surface point, on its "
-              "anchor face of the deformed tissue, behind the blade's tangent plane at the contact) against the sphere "
-              "depth, at the same verified contacts, by kind: %zu tongue vertices inside the blade, %zu blade vertices "
-              "inside the tongue. \"nearest surface point\": of the reporting spheres whose region holds the point, the "
-              "one whose surface point is nearest it (median distance %.3f mm, p95 %.3f mm over recalled points); "
-              "\"the field at it\": the blade's exact field at that surface point instead (not what the query reports: "
-              "a diagnostic). A depth <= 0 (that surface point clear of the blade) counts as 0. Recall counting a "
-              "candidate sphere whose surface point is inside the blade as reporting: %.2f%%.\n\n",
-              anchor_error_m_[0].size(), anchor_error_m_[1].size(), percentile(anchor_distance_m_, 50) * 1e3,
-              percentile(anchor_distance_m_, 95) * 1e3, ratio(base_recalled_surface_, base_total_));
-  std::printf("| AIST depth at the point | all: median / p95 / p99 / max (mm) | tongue vertices: median / p95 (mm) | blade vertices: median / p95 (mm) |\n| --- | --- | --- | --- |\n");
+  std::printf(
+      "\nSurface depth (SphereContact::surface_depth_m: the depth of the sphere's surface point, "
+      "on its "
+      "anchor face of the deformed tissue, behind the blade's tangent plane at the contact) "
+      "against the sphere "
+      "depth, at the same verified contacts, by kind: %zu tongue vertices inside the blade, %zu "
+      "blade vertices "
+      "inside the tongue. \"nearest surface point\": of the reporting spheres whose region holds "
+      "the point, the "
+      "one whose surface point is nearest it (median distance %.3f mm, p95 %.3f mm over recalled "
+      "points); "
+      "\"the field at it\": the blade's exact field at that surface point instead (not what the "
+      "query reports: "
+      "a diagnostic). A depth <= 0 (that surface point clear of the blade) counts as 0. Recall "
+      "counting a "
+      "candidate sphere whose surface point is inside the blade as reporting: %.2f%%.\n\n",
+      anchor_error_m_[0].size(), anchor_error_m_[1].size(),
+      percentile(anchor_distance_m_, 50) * 1e3, percentile(anchor_distance_m_, 95) * 1e3,
+      ratio(base_recalled_surface_, base_total_));
+  std::printf(
+      "| AIST depth at the point | all: median / p95 / p99 / max (mm) | tongue vertices: median / "
+      "p95 (mm) | blade vertices: median / p95 (mm) |\n| --- | --- | --- | --- |\n");
   auto row = [](const char* name, const std::vector<double>* e) {
-    std::printf("| %s | %.3f / %.3f / %.3f / %.3f | %.3f / %.3f | %.3f / %.3f |\n", name, percentile(e[2], 50) * 1e3,
-                percentile(e[2], 95) * 1e3, percentile(e[2], 99) * 1e3, percentile(e[2], 100) * 1e3,
-                percentile(e[0], 50) * 1e3, percentile(e[0], 95) * 1e3, percentile(e[1], 50) * 1e3,
-                percentile(e[1], 95) * 1e3);
+    std::printf("| %s | %.3f / %.3f / %.3f / %.3f | %.3f / %.3f | %.3f / %.3f |\n", name,
+                percentile(e[2], 50) * 1e3, percentile(e[2], 95) * 1e3, percentile(e[2], 99) * 1e3,
+                percentile(e[2], 100) * 1e3, percentile(e[0], 50) * 1e3, percentile(e[0], 95) * 1e3,
+                percentile(e[1], 50) * 1e3, percentile(e[1], 95) * 1e3);
   };
   row("nearest sphere, sphere depth (before)", sphere_nearest_error_m_);
   row("nearest sphere, surface depth", nearest_surface_error_m_);
   row("nearest surface point, surface depth", anchor_error_m_);
   row("nearest surface point, candidates' too", anchor_candidates_error_m_);
   row("nearest surface point, the field at it", anchor_field_error_m_);
-  std::printf("\nPer AIST contact (%zu reporting spheres with a verified baseline contact in their region): the "
-              "sphere's depth against the deepest exact penetration among those baseline contacts (median %.3f mm, "
-              "p95 %.3f mm), the penetration depth of the contact the sphere stands for. A sphere reports one depth; "
-              "the baseline reports one per vertex, and on the blade's rounded rim the vertices under one tissue face "
-              "range from its deepest point to 0, which the per-point tables above compare with that one depth.\n\n",
-              contact_deepest_m_.size(), percentile(contact_deepest_m_, 50) * 1e3,
-              percentile(contact_deepest_m_, 95) * 1e3);
-  std::printf("| AIST depth | median (mm) | p95 (mm) | p99 (mm) | max (mm) |\n| --- | --- | --- | --- | --- |\n");
+  std::printf(
+      "\nPer AIST contact (%zu reporting spheres with a verified baseline contact in their "
+      "region): the "
+      "sphere's depth against the deepest exact penetration among those baseline contacts (median "
+      "%.3f mm, "
+      "p95 %.3f mm), the penetration depth of the contact the sphere stands for. A sphere reports "
+      "one depth; "
+      "the baseline reports one per vertex, and on the blade's rounded rim the vertices under one "
+      "tissue face "
+      "range from its deepest point to 0, which the per-point tables above compare with that one "
+      "depth.\n\n",
+      contact_deepest_m_.size(), percentile(contact_deepest_m_, 50) * 1e3,
+      percentile(contact_deepest_m_, 95) * 1e3);
+  std::printf(
+      "| AIST depth | median (mm) | p95 (mm) | p99 (mm) | max (mm) |\n| --- | --- | --- | --- | "
+      "--- |\n");
   for (const auto* e : {&contact_sphere_error_m_, &contact_surface_error_m_}) {
     std::printf("| %s | %.3f | %.3f | %.3f | %.3f |\n",
-                e == &contact_sphere_error_m_ ? "sphere depth" : "surface depth (SphereContact::surface_depth_m)",
+                e == &contact_sphere_error_m_ ? "sphere depth"
+                                              : "surface depth (SphereContact::surface_depth_m)",
                 percentile(*e, 50) * 1e3, percentile(*e, 95) * 1e3, percentile(*e, 99) * 1e3,
                 percentile(*e, 100) * 1e3);
   }

@@ -19,12 +19,13 @@ class ContactMetrics {
   // One tick's contacts; with_reference computes the exact depth reference
   // (dense samples of the deformed boundary against the blade's field).
   void add_tick(const collision::ContactBuffer& aist, const collision::SphereState& state,
-                const std::vector<collision::TriangleContact>& base, const Eigen::Isometry3d& world_from_blade,
-                std::span<const double> positions_m);
+                const std::vector<collision::TriangleContact>& base,
+                const Eigen::Isometry3d& world_from_blade, std::span<const double> positions_m);
   void print() const;
   double recall() const;
   double recall_deeper() const;
-  double recall_near() const;  // counting candidate spheres too  // over verified contacts deeper than kDeeperM
+  double recall_near()
+      const;  // counting candidate spheres too  // over verified contacts deeper than kDeeperM
   double depth_error_p99_m() const;
 
   // Baseline contacts shallower than this are also counted apart: the sphere
@@ -58,15 +59,17 @@ class ContactMetrics {
   // the blade's exact field at that surface point (a diagnostic); the
   // distance of that surface point from the point.
   static constexpr int kKinds = 3;
-  std::vector<double> nearest_surface_error_m_[kKinds], anchor_error_m_[kKinds], anchor_field_error_m_[kKinds];
+  std::vector<double> nearest_surface_error_m_[kKinds], anchor_error_m_[kKinds],
+      anchor_field_error_m_[kKinds];
   std::vector<double> anchor_candidates_error_m_[kKinds];  // candidates' anchors too
-  std::vector<double> sphere_nearest_error_m_[kKinds];  // the old figure, split by kind
+  std::vector<double> sphere_nearest_error_m_[kKinds];     // the old figure, split by kind
   std::vector<double> anchor_distance_m_;
   std::size_t base_recalled_surface_ = 0;
   // Per reporting sphere with a verified baseline contact in its region: the
   // deepest exact penetration there, and the errors of its sphere and
   // surface depths against it.
-  std::vector<double> contact_deepest_m_, contact_sphere_error_m_, contact_surface_error_m_;  // a reporting sphere, or a candidate whose anchor is inside
+  std::vector<double> contact_deepest_m_, contact_sphere_error_m_,
+      contact_surface_error_m_;  // a reporting sphere, or a candidate whose anchor is inside
 };
 
 }  // namespace fahr::aist_bench

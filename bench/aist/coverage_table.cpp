@@ -3,10 +3,10 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "fahr/collision/sphere_state.h"
 #include "fahr/geometry/tetgen_loader.h"
 #include "fahr/sphere_layout/coverage.h"
 #include "fahr/sphere_layout/fill_spheres.h"
-#include "fahr/collision/sphere_state.h"
 #include "sections.h"
 #include "stats.h"
 
@@ -20,8 +20,8 @@ void row(const char* name, const geometry::TetMesh& mesh, const geometry::Surfac
   try {
     layout = sphere_layout::fill_spheres(mesh, settings);
   } catch (const std::invalid_argument& e) {
-    std::printf("| %s | %.0f | %d | %s | refused: %s |\n", name, settings.volume_ratio, settings.refinement_levels,
-                settings.surface_hugging ? "yes" : "no", e.what());
+    std::printf("| %s | %.0f | %d | %s | refused: %s |\n", name, settings.volume_ratio,
+                settings.refinement_levels, settings.surface_hugging ? "yes" : "no", e.what());
     return;
   }
   const double fill_ms = elapsed_us(start) / 1e3;
@@ -29,21 +29,29 @@ void row(const char* name, const geometry::TetMesh& mesh, const geometry::Surfac
   sphere_layout::CoverageSettings coverage;
   coverage.sample_spacing_m = 0.2e-3;
   coverage.voxel_size_m = 0.2e-3;
-  const auto report = sphere_layout::measure_coverage(rest.centres_m(), rest.radii_m(), boundary, sdf, coverage);
-  std::printf("| %s | %.0f | %d | %s | %zu | %zu / %zu / %zu | %zu | %.3f | %.3f | %.3f | %.3f | %.3f | %.0f |\n", name,
-              settings.volume_ratio, settings.refinement_levels, settings.surface_hugging ? "yes" : "no",
-              layout.size(), layout.count_at_level(0), layout.count_at_level(1), layout.count_at_level(2),
-              layout.count(sphere_layout::SphereOrigin::kHugging), report.boundary_to_union_max_m * 1e3,
-              report.boundary_to_union_p999_m * 1e3, report.boundary_to_union_mean_m * 1e3, report.union_to_boundary_max_m * 1e3,
-              report.hausdorff_m() * 1e3, fill_ms);
+  const auto report =
+      sphere_layout::measure_coverage(rest.centres_m(), rest.radii_m(), boundary, sdf, coverage);
+  std::printf(
+      "| %s | %.0f | %d | %s | %zu | %zu / %zu / %zu | %zu | %.3f | %.3f | %.3f | %.3f | %.3f | "
+      "%.0f |\n",
+      name, settings.volume_ratio, settings.refinement_levels,
+      settings.surface_hugging ? "yes" : "no", layout.size(), layout.count_at_level(0),
+      layout.count_at_level(1), layout.count_at_level(2),
+      layout.count(sphere_layout::SphereOrigin::kHugging), report.boundary_to_union_max_m * 1e3,
+      report.boundary_to_union_p999_m * 1e3, report.boundary_to_union_mean_m * 1e3,
+      report.union_to_boundary_max_m * 1e3, report.hausdorff_m() * 1e3, fill_ms);
   std::fflush(stdout);
 }
 
 }  // namespace
 
 void coverage_table(const Scene& scene) {
-  std::printf("\n## Coverage (symmetric Hausdorff, boundary vs sphere-union outer surface, samples 0.2 mm)\n\n");
-  std::printf("| mesh | ratio | levels | hugging | spheres | level 0 / 1 / 2 | hugging | b->u max (mm) | b->u p99.9 (mm) | b->u mean (mm) | u->b max (mm) | Hausdorff (mm) | fill (ms) |\n");
+  std::printf(
+      "\n## Coverage (symmetric Hausdorff, boundary vs sphere-union outer surface, samples 0.2 "
+      "mm)\n\n");
+  std::printf(
+      "| mesh | ratio | levels | hugging | spheres | level 0 / 1 / 2 | hugging | b->u max (mm) | "
+      "b->u p99.9 (mm) | b->u mean (mm) | u->b max (mm) | Hausdorff (mm) | fill (ms) |\n");
   std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const bool hugging : {false, true}) {
     for (const int levels : {0, 1, 2}) {

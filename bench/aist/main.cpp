@@ -2,7 +2,10 @@
 // (default: all), record / replay FILE (replay.cpp: the query alone on
 // recorded states, contact hashes), detection (the trajectory with the FEM driven by its boundary
 // points' contacts, both detectors judged on the same states). Usage: aist_bench
-// [coverage|trajectory|detection|sweep|all] [--scene-dir DIR] [--max-spheres N] [--ticks N] [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe anchor|face] [--spread W] [--driver-subdivision N] [--sweep-steps N] [--file PATH] [--evict-kb K] [--replay-only K] [--replay-passes P]
+// [coverage|trajectory|detection|sweep|all] [--scene-dir DIR] [--max-spheres N] [--ticks N]
+// [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe
+// anchor|face] [--spread W] [--driver-subdivision N] [--sweep-steps N] [--file PATH] [--evict-kb K]
+// [--replay-only K] [--replay-passes P]
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -28,11 +31,13 @@ int main(int argc, char** argv) {
     } else if (std::strcmp(argv[i], "--surface-probe") == 0 && i + 1 < argc) {
       const std::string probe = argv[++i];
       if (probe != "anchor" && probe != "face") {
-        std::fprintf(stderr, "aist_bench: --surface-probe takes anchor or face, not %s\n", probe.c_str());
+        std::fprintf(stderr, "aist_bench: --surface-probe takes anchor or face, not %s\n",
+                     probe.c_str());
         return 2;
       }
-      options.surface_probe = probe == "anchor" ? fahr::collision::QuerySettings::SurfaceProbe::kAnchor
-                                                : fahr::collision::QuerySettings::SurfaceProbe::kFacePoint;
+      options.surface_probe = probe == "anchor"
+                                  ? fahr::collision::QuerySettings::SurfaceProbe::kAnchor
+                                  : fahr::collision::QuerySettings::SurfaceProbe::kFacePoint;
     } else if (std::strcmp(argv[i], "--anchor-gap-mm") == 0 && i + 1 < argc) {
       options.anchor_gap_m = 1e-3 * std::stod(argv[++i]);
     } else if (std::strcmp(argv[i], "--skin-mm") == 0 && i + 1 < argc) {
@@ -73,9 +78,11 @@ int main(int argc, char** argv) {
     const auto scene = load_scene(0.5e-3, scene_dir);
     std::printf("# AIST benchmark (neonatal scene, Miller 1 blade)\n\n");
     if (scene_dir != FAHR_NEONATAL_DIR) std::printf("scene: %s\n\n", scene_dir.c_str());
-    std::printf("tongue: %zu nodes, %zu tets, %zu boundary triangles (mean edge %.2f mm); blade: %zu triangles\n",
-                scene->tongue.node_count(), scene->tongue.tet_count(), scene->boundary.triangle_count(),
-                scene->mean_boundary_edge_m * 1e3, scene->blade.triangle_count());
+    std::printf(
+        "tongue: %zu nodes, %zu tets, %zu boundary triangles (mean edge %.2f mm); blade: %zu "
+        "triangles\n",
+        scene->tongue.node_count(), scene->tongue.tet_count(), scene->boundary.triangle_count(),
+        scene->mean_boundary_edge_m * 1e3, scene->blade.triangle_count());
     if (section == "coverage" || section == "all") coverage_table(*scene);
     if (section == "trajectory" || section == "all") trajectory_table(*scene, options);
     if (section == "sweep" || section == "all") sweep_table(*scene, options);

@@ -23,8 +23,8 @@ class NodeMetrics {
  public:
   explicit NodeMetrics(const Scene& scene);
   void add_tick(const collision::ContactBuffer& aist, const collision::SphereState& state,
-                const std::vector<collision::TriangleContact>& base, const Eigen::Isometry3d& world_from_blade,
-                std::span<const double> positions_m);
+                const std::vector<collision::TriangleContact>& base,
+                const Eigen::Isometry3d& world_from_blade, std::span<const double> positions_m);
   void print() const;
 
  private:
@@ -33,12 +33,13 @@ class NodeMetrics {
   static constexpr double kClassDepthM[kClasses] = {0.0, 0.1e-3, 0.25e-3};
 
   const Scene& scene_;
-  std::vector<std::uint32_t> nodes_;         // boundary nodes, unique
+  std::vector<std::uint32_t> nodes_;          // boundary nodes, unique
   std::vector<std::int32_t> node_to_vertex_;  // per node: a boundary vertex or -1
-  std::vector<std::uint32_t> base_stamp_;    // per boundary vertex: tick it was reported
-  std::vector<double> base_depth_m_;         // per boundary vertex, valid when stamped
+  std::vector<std::uint32_t> base_stamp_;     // per boundary vertex: tick it was reported
+  std::vector<double> base_depth_m_;          // per boundary vertex, valid when stamped
   std::uint32_t tick_ = 0;
-  std::size_t total_[kClasses] = {}, aist_[kClasses] = {}, aist_near_[kClasses] = {}, base_[kClasses] = {};
+  std::size_t total_[kClasses] = {}, aist_[kClasses] = {}, aist_near_[kClasses] = {},
+              base_[kClasses] = {};
   std::size_t miss_candidate_ = 0, miss_standoff_ = 0, miss_detached_ = 0;
   std::vector<double> exact_m_, aist_error_m_, aist_signed_error_m_, base_error_m_;
   std::vector<double> recalled_error_m_;  // AIST error over recalled nodes only

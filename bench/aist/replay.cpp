@@ -20,9 +20,9 @@
 
 #include "fahr/collision/deepest_contacts.h"
 #include "fahr/collision/field_grid.h"
-#include "fahr/sphere_layout/fill_spheres.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
+#include "fahr/sphere_layout/fill_spheres.h"
 #include "sections.h"
 #include "sphere_contact_set.h"
 #include "stats.h"
@@ -34,9 +34,9 @@ constexpr std::uint64_t kMagic = 0x31594150455241ULL;  // "ARPEAY1": the file's 
 
 struct Recording {
   std::uint64_t nodes = 0;
-  std::vector<Eigen::Matrix4d> poses;            // world_from_body of the blade, per tick
-  std::vector<std::int64_t> state_of_tick;       // index into states, or -1: the previous state stands
-  std::vector<std::vector<double>> states;       // FEM positions, m, 3 per node
+  std::vector<Eigen::Matrix4d> poses;       // world_from_body of the blade, per tick
+  std::vector<std::int64_t> state_of_tick;  // index into states, or -1: the previous state stands
+  std::vector<std::vector<double>> states;  // FEM positions, m, 3 per node
 };
 
 template <typename T>
@@ -55,7 +55,8 @@ Recording load(const std::string& path) {
   if (!in) throw std::runtime_error("replay: cannot open " + path);
   std::uint64_t magic = 0, ticks = 0;
   read_pod(in, magic);
-  if (magic != kMagic) throw std::runtime_error("replay: " + path + " is not an aist_bench recording");
+  if (magic != kMagic)
+    throw std::runtime_error("replay: " + path + " is not an aist_bench recording");
   Recording r;
   read_pod(in, r.nodes);
   read_pod(in, ticks);
@@ -70,7 +71,8 @@ Recording load(const std::string& path) {
     r.poses.push_back(pose);
     if (fresh != 0) {
       std::vector<double> x(3 * r.nodes);
-      in.read(reinterpret_cast<char*>(x.data()), static_cast<std::streamsize>(x.size() * sizeof(double)));
+      in.read(reinterpret_cast<char*>(x.data()),
+              static_cast<std::streamsize>(x.size() * sizeof(double)));
       if (!in) throw std::runtime_error("replay: the recording ends early");
       r.states.push_back(std::move(x));
       r.state_of_tick.push_back(static_cast<std::int64_t>(r.states.size()) - 1);
@@ -94,8 +96,8 @@ struct ContactHash {
     bytes(c.point_m.data(), 3 * sizeof(double));
     bytes(c.normal.data(), 3 * sizeof(double));
     bytes(&c.depth_m, sizeof(double));
-    const std::uint8_t flags = static_cast<std::uint8_t>((c.candidate ? 1 : 0) | (c.normal_without_history ? 2 : 0) |
-                                                         (c.has_surface ? 4 : 0));
+    const std::uint8_t flags = static_cast<std::uint8_t>(
+        (c.candidate ? 1 : 0) | (c.normal_without_history ? 2 : 0) | (c.has_surface ? 4 : 0));
     bytes(&flags, 1);
     if (c.has_surface) {
       bytes(c.surface_point_m.data(), 3 * sizeof(double));
@@ -127,7 +129,8 @@ struct ReplayVariant {
 
 // The haptic tick's row selection (services/haptic/main/haptic_loop.cpp)
 // for a variant that keeps rows; returns how many.
-std::size_t select_rows(const collision::SphereTree& tree, const collision::RigidBody& blade, ReplayVariant& v) {
+std::size_t select_rows(const collision::SphereTree& tree, const collision::RigidBody& blade,
+                        ReplayVariant& v) {
   if (v.keep == 0) return 0;
   const std::size_t kept = collision::select_deepest(v.buffer, v.keep, v.rows);
   collision::complete_deferred(tree, blade, v.settings, v.buffer, v.rows.data(), kept);
@@ -137,7 +140,8 @@ std::size_t select_rows(const collision::SphereTree& tree, const collision::Rigi
 }  // namespace
 
 void record_states(const Scene& scene, const Options& options, const std::string& path) {
-  const sphere_layout::SphereLayout layout = sphere_layout::fill_spheres(scene.tongue, trajectory_fill(options));
+  const sphere_layout::SphereLayout layout =
+      sphere_layout::fill_spheres(scene.tongue, trajectory_fill(options));
   const fem::SphereLinks links = to_fem_links(layout, options.skin_m);
   auto body = make_tongue_body(scene);
   collision::SphereState state(layout);
@@ -172,17 +176,19 @@ void record_states(const Scene& scene, const Options& options, const std::string
     write_pod(out, static_cast<std::uint8_t>(fresh ? 1 : 0));
     if (fresh) {
       const auto x = body->positions_m();
-      out.write(reinterpret_cast<const char*>(x.data()), static_cast<std::streamsize>(x.size() * sizeof(double)));
+      out.write(reinterpret_cast<const char*>(x.data()),
+                static_cast<std::streamsize>(x.size() * sizeof(double)));
     }
   }
   if (!out) throw std::runtime_error("record: writing " + path + " failed");
-  std::printf("Recorded %d ticks (FEM every %d, %llu nodes) to %s.\n", options.ticks, options.fem_every,
-              static_cast<unsigned long long>(nodes), path.c_str());
+  std::printf("Recorded %d ticks (FEM every %d, %llu nodes) to %s.\n", options.ticks,
+              options.fem_every, static_cast<unsigned long long>(nodes), path.c_str());
 }
 
 void replay_states(const Scene& scene, const Options& options, const std::string& path) {
   const Recording rec = load(path);
-  const sphere_layout::SphereLayout layout = sphere_layout::fill_spheres(scene.tongue, trajectory_fill(options));
+  const sphere_layout::SphereLayout layout =
+      sphere_layout::fill_spheres(scene.tongue, trajectory_fill(options));
   collision::SphereState state(layout);
   collision::SphereTree tree(layout);
   const collision::FieldGrid grid(scene.blade_sdf);
@@ -210,17 +216,27 @@ void replay_states(const Scene& scene, const Options& options, const std::string
   auto add = [&](const char* name, const collision::QuerySettings& s, std::size_t keep) {
     const int index = added++;
     if (options.replay_only >= 0 && index != options.replay_only) return;
-    variants.push_back({name, s, keep, collision::PrePenetrationMemory(layout.size()), collision::ContactBuffer(4096),
-                        std::vector<std::uint32_t>(4096), {}, {}, {}, {}, {}});
+    variants.push_back({name,
+                        s,
+                        keep,
+                        collision::PrePenetrationMemory(layout.size()),
+                        collision::ContactBuffer(4096),
+                        std::vector<std::uint32_t>(4096),
+                        {},
+                        {},
+                        {},
+                        {},
+                        {}});
   };
   add("grid narrow phase (trajectory's settings)", bench_grid, 0);
   add("exact narrow phase (trajectory's settings)", bench, 0);
   add("grid, 1 mm candidates (the service's settings)", service, 0);
   add("grid, 1 mm candidates, deepest_only 64", service_deepest, 0);
   add("grid, 1 mm candidates, no surface probe", service_plain, 0);
-  add("the same, then the 64 deepest kept (the service's tick before)", service_plain, kServiceRows);
-  add("the same, outside contacts deferred, the 64 deepest completed (the service's tick now)", service_deferred,
+  add("the same, then the 64 deepest kept (the service's tick before)", service_plain,
       kServiceRows);
+  add("the same, outside contacts deferred, the 64 deepest completed (the service's tick now)",
+      service_deferred, kServiceRows);
   if (variants.empty()) throw std::runtime_error("replay: --replay-only names no variant");
   // Evicting the core's L2 (2 MB here) between queries stands for the rest
   // of a haptic tick (and other processes) running in between.
@@ -255,7 +271,8 @@ void replay_states(const Scene& scene, const Options& options, const std::string
         for (auto& e : evict) sink += (e += 1);
         v.buffer.clear();
         const double start = thread_cpu_us();
-        const collision::QueryStats stats = collision::query_spheres(tree, state, blade, v.settings, v.memory, v.buffer);
+        const collision::QueryStats stats =
+            collision::query_spheres(tree, state, blade, v.settings, v.memory, v.buffer);
         const std::size_t kept = select_rows(tree, blade, v);
         v.first_us[tick] = std::min(v.first_us[tick], thread_cpu_us() - start);
         if (pass == 0) {
@@ -285,24 +302,33 @@ void replay_states(const Scene& scene, const Options& options, const std::string
     }
   }
   const double n = static_cast<double>(rec.poses.size());
-  std::printf("\n## Replay of %s: %zu ticks, %zu FEM states, %zu spheres, %zu kB written before each first run (evicts L2), per tick the least of %d passes (checksum %llu)\n\n",
-              path.c_str(), rec.poses.size(), rec.states.size(), layout.size(), options.evict_bytes / 1024, options.replay_passes,
-              static_cast<unsigned long long>(sink % 10));
-  std::printf("| query | first run thread CPU: median / p99 / p99.9 / max (us) | warm rerun: median / p99 / p99.9 / max (us) | nodes visited (mean) | spheres tested: mean / max | contacts: mean / max | centre inside: mean / max | contact hash: in order / as sets | row hash |\n");
+  std::printf(
+      "\n## Replay of %s: %zu ticks, %zu FEM states, %zu spheres, %zu kB written before each first "
+      "run (evicts L2), per tick the least of %d passes (checksum %llu)\n\n",
+      path.c_str(), rec.poses.size(), rec.states.size(), layout.size(), options.evict_bytes / 1024,
+      options.replay_passes, static_cast<unsigned long long>(sink % 10));
+  std::printf(
+      "| query | first run thread CPU: median / p99 / p99.9 / max (us) | warm rerun: median / p99 "
+      "/ p99.9 / max (us) | nodes visited (mean) | spheres tested: mean / max | contacts: mean / "
+      "max | centre inside: mean / max | contact hash: in order / as sets | row hash |\n");
   std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const auto& v : variants) {
     char rows[32] = "";
-    if (v.keep > 0) std::snprintf(rows, sizeof(rows), "%016llx", static_cast<unsigned long long>(v.row_hash.value));
-    std::printf("| %s | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f | %.0f | %.0f / %u | %.0f / %u | %.0f / %u | %016llx / %016llx | %s |\n", v.name,
-                percentile(v.first_us, 50), percentile(v.first_us, 99), percentile(v.first_us, 99.9),
-                percentile(v.first_us, 100), percentile(v.warm_us, 50), percentile(v.warm_us, 99),
-                percentile(v.warm_us, 99.9), percentile(v.warm_us, 100), v.nodes_sum / n, v.tested_sum / n,
-                v.tested_max, v.contacts_sum / n, v.contacts_max, v.inside_sum / n, v.inside_max,
-                static_cast<unsigned long long>(v.hash.value),
-                static_cast<unsigned long long>(v.set_hash.value), rows);
+    if (v.keep > 0)
+      std::snprintf(rows, sizeof(rows), "%016llx",
+                    static_cast<unsigned long long>(v.row_hash.value));
+    std::printf(
+        "| %s | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f | %.0f | %.0f / %u | %.0f / "
+        "%u | %.0f / %u | %016llx / %016llx | %s |\n",
+        v.name, percentile(v.first_us, 50), percentile(v.first_us, 99),
+        percentile(v.first_us, 99.9), percentile(v.first_us, 100), percentile(v.warm_us, 50),
+        percentile(v.warm_us, 99), percentile(v.warm_us, 99.9), percentile(v.warm_us, 100),
+        v.nodes_sum / n, v.tested_sum / n, v.tested_max, v.contacts_sum / n, v.contacts_max,
+        v.inside_sum / n, v.inside_max, static_cast<unsigned long long>(v.hash.value),
+        static_cast<unsigned long long>(v.set_hash.value), rows);
   }
-  std::printf("\nupdate+refit thread CPU: median %.1f us, p99.9 %.1f us.\n", percentile(refit_us, 50),
-              percentile(refit_us, 99.9));
+  std::printf("\nupdate+refit thread CPU: median %.1f us, p99.9 %.1f us.\n",
+              percentile(refit_us, 50), percentile(refit_us, 99.9));
 }
 
 }  // namespace fahr::aist_bench

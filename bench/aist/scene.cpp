@@ -3,8 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -48,12 +48,20 @@ std::unique_ptr<Scene> load_scene(double blade_cell_m, const std::string& dir) {
   auto boundary_sdf = make_field(boundary, 1e-3);
   auto blade = geometry::load_surface(dir + "/miller1.obj", kMillimetre);
   auto blade_sdf = make_field(blade, blade_cell_m);
-  auto scene = std::make_unique<Scene>(Scene{std::move(tongue), read_fixed_nodes(dir + "/tongue_fixed_nodes.txt"),
-                                             std::move(boundary), std::move(s2n), std::move(boundary_sdf),
-                                             std::move(blade), std::move(blade_sdf), 0.0, {}, 0.0});
+  auto scene = std::make_unique<Scene>(Scene{std::move(tongue),
+                                             read_fixed_nodes(dir + "/tongue_fixed_nodes.txt"),
+                                             std::move(boundary),
+                                             std::move(s2n),
+                                             std::move(boundary_sdf),
+                                             std::move(blade),
+                                             std::move(blade_sdf),
+                                             0.0,
+                                             {},
+                                             0.0});
   double sum = 0.0;
   for (const auto& t : scene->boundary.triangles()) {
-    for (int k = 0; k < 3; ++k) sum += (scene->boundary.vertices()[t[k]] - scene->boundary.vertices()[t[(k + 1) % 3]]).norm();
+    for (int k = 0; k < 3; ++k)
+      sum += (scene->boundary.vertices()[t[k]] - scene->boundary.vertices()[t[(k + 1) % 3]]).norm();
   }
   scene->mean_boundary_edge_m = sum / (3.0 * static_cast<double>(scene->boundary.triangle_count()));
   // Dorsum profile: boundary vertices within 5 mm of the mid-line (the blade is ~10 mm wide).
@@ -65,7 +73,8 @@ std::unique_ptr<Scene> load_scene(double blade_cell_m, const std::string& dir) {
     x1 = std::max(x1, p.x());
   }
   scene->dorsum_x0_m = x0;
-  scene->dorsum_y_m.assign(static_cast<std::size_t>((x1 - x0) / kMillimetre) + 1, -std::numeric_limits<double>::infinity());
+  scene->dorsum_y_m.assign(static_cast<std::size_t>((x1 - x0) / kMillimetre) + 1,
+                           -std::numeric_limits<double>::infinity());
   for (const auto& p : v) {
     if (std::abs(p.z()) > kHalfWidth) continue;
     auto& y = scene->dorsum_y_m[static_cast<std::size_t>((p.x() - x0) / kMillimetre)];
@@ -104,7 +113,9 @@ Eigen::Isometry3d blade_pose(const Scene& scene, double s, double lever_depth_m)
   const double tip_x = x_start + w_slide * (x_end - x_start);
   double pitch = 8.0 * degree * w_slide;
   double tip_y = std::max(0.5 * kMillimetre - w_slide, clear_tip_height(scene, tip_x, pitch));
-  if (s > 0.5) tip_y = clear_tip_height(scene, x_end, 8.0 * degree) - lever_depth_m * smoothstep((s - 0.5) / 0.3);
+  if (s > 0.5)
+    tip_y =
+        clear_tip_height(scene, x_end, 8.0 * degree) - lever_depth_m * smoothstep((s - 0.5) / 0.3);
   if (s > 0.8) {
     const double w = smoothstep((s - 0.8) / 0.2);
     pitch += 4.0 * degree * w;
@@ -135,7 +146,8 @@ std::unique_ptr<fem::Body> make_tongue_body(const Scene& scene) {
 fem::SphereLinks to_fem_links(const sphere_layout::SphereLayout& layout, double skin_m) {
   fem::SphereLinks links;
   for (std::size_t i = 0; i < layout.size(); ++i) {
-    const std::string error = links.add_sphere(layout.nodes(i), layout.weights(i), layout.sphere(i).rest_radius_m + skin_m);
+    const std::string error = links.add_sphere(layout.nodes(i), layout.weights(i),
+                                               layout.sphere(i).rest_radius_m + skin_m);
     if (!error.empty()) throw std::runtime_error("sphere links: " + error);
   }
   return links;

@@ -18,12 +18,12 @@
 namespace fahr::aist_bench {
 
 struct Scene {
-  geometry::TetMesh tongue;                  // m
+  geometry::TetMesh tongue;  // m
   std::vector<std::uint32_t> fixed_nodes;
-  geometry::SurfaceMesh boundary;            // tongue boundary, m
+  geometry::SurfaceMesh boundary;  // tongue boundary, m
   std::vector<geometry::Index> surface_to_node;
   geometry::SignedDistanceField boundary_sdf;
-  geometry::SurfaceMesh blade;               // Miller 1, tool frame, m
+  geometry::SurfaceMesh blade;  // Miller 1, tool frame, m
   geometry::SignedDistanceField blade_sdf;
   double mean_boundary_edge_m = 0.0;
   // Height (y, m) of the rest dorsum near the mid-line per 1 mm bin of x,

@@ -1,30 +1,36 @@
 // The benchmark's sections; each prints its Markdown table(s).
 #pragma once
 
-#include "fahr/sphere_layout/fill_settings.h"
-#include "fahr/collision/sphere_query.h"
-#include "scene.h"
-
 #include <cstddef>
 #include <string>
+
+#include "fahr/collision/sphere_query.h"
+#include "fahr/sphere_layout/fill_settings.h"
+#include "scene.h"
 
 namespace fahr::aist_bench {
 
 struct Options {
-  int ticks = 3000;            // haptic ticks of the trajectory (1 kHz)
-  int fem_every = 2;           // haptic ticks per FEM step (FEM at 500 Hz with h = 2 ms)
-  double lever_depth_m = 3e-3; // how far the levering sinks the tip
-  int sweep_steps = 200;       // FEM steps per sweep configuration
-  double skin_m = 0.0;         // AIST contact skin (QuerySettings::contact_skin_m)
-  double weight_spread = sphere_layout::FillSettings{}.weight_spread;  // FillSettings::weight_spread of the trajectory layout
+  int ticks = 3000;             // haptic ticks of the trajectory (1 kHz)
+  int fem_every = 2;            // haptic ticks per FEM step (FEM at 500 Hz with h = 2 ms)
+  double lever_depth_m = 3e-3;  // how far the levering sinks the tip
+  int sweep_steps = 200;        // FEM steps per sweep configuration
+  double skin_m = 0.0;          // AIST contact skin (QuerySettings::contact_skin_m)
+  double weight_spread =
+      sphere_layout::FillSettings{}
+          .weight_spread;  // FillSettings::weight_spread of the trajectory layout
   // FillSettings of the trajectory layout (defaults: the library's).
   double hugging_tolerance_m = sphere_layout::FillSettings{}.hugging_tolerance_m;
   double hugging_radius_fraction = sphere_layout::FillSettings{}.hugging_radius_fraction;
-  double approach_margin_m = collision::QuerySettings{}.approach_margin_m;  // QuerySettings of the trajectory
+  double approach_margin_m =
+      collision::QuerySettings{}.approach_margin_m;  // QuerySettings of the trajectory
   double anchor_depth_factor = sphere_layout::FillSettings{}.hugging_anchor_depth_factor;
   double anchor_gap_m = sphere_layout::FillSettings{}.anchor_gap_m;  // FillSettings::anchor_gap_m
-  std::size_t max_spheres = sphere_layout::FillSettings{}.max_spheres;  // FillSettings::max_spheres (a finer tongue needs more)
-  collision::QuerySettings::SurfaceProbe surface_probe = collision::QuerySettings{}.surface_probe;  // --surface-probe anchor|face
+  std::size_t max_spheres =
+      sphere_layout::FillSettings{}
+          .max_spheres;  // FillSettings::max_spheres (a finer tongue needs more)
+  collision::QuerySettings::SurfaceProbe surface_probe =
+      collision::QuerySettings{}.surface_probe;  // --surface-probe anchor|face
   // true (section "detection"): the trajectory's FEM is driven by contacts
   // of its own boundary points (surface_contacts.h) instead of the AIST's,
   // so both detectors are judged on states neither of them made.
@@ -40,7 +46,7 @@ struct Options {
   std::string file;
   std::size_t evict_bytes = std::size_t{4} << 20;
   int replay_passes = 1;  // --replay-passes P: per tick the least of P passes
-  int replay_only = -1;  // --replay-only K: replay only the K-th query variant (for perf), -1 all
+  int replay_only = -1;   // --replay-only K: replay only the K-th query variant (for perf), -1 all
 };
 
 // Candidate margin of the benchmark's queries, m: the closure's tolerance,

@@ -5,8 +5,8 @@
 
 #include <cstdint>
 
-#include "fahr/fem/contact_set.h"
 #include "fahr/collision/contact_buffer.h"
+#include "fahr/fem/contact_set.h"
 
 namespace fahr::aist_bench {
 

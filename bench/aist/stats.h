@@ -11,7 +11,8 @@ namespace fahr::aist_bench {
 double percentile(std::vector<double> values, double p);
 
 inline double elapsed_us(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 // CPU time of the calling thread, us: unlike wall time it does not count

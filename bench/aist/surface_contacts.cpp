@@ -19,7 +19,8 @@ constexpr double kBoxMarginM = 1e-3;
 
 // Adds a point; the weights are built to sum to 1, so a refusal is a bug
 // that would shift every later point's id.
-void add_point(fem::SphereLinks& links, std::span<const std::uint32_t> nodes, std::span<const double> weights) {
+void add_point(fem::SphereLinks& links, std::span<const std::uint32_t> nodes,
+               std::span<const double> weights) {
   const std::string error = links.add_sphere(nodes, weights, 0.0);
   if (!error.empty()) throw std::logic_error("surface contacts: " + error);
 }
@@ -33,10 +34,13 @@ SurfaceContacts::SurfaceContacts(const Scene& scene, int subdivision) : scene_(s
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   const double one = 1.0;
-  for (const auto n : nodes) add_point(links_, std::span<const std::uint32_t>(&n, 1), std::span<const double>(&one, 1));
+  for (const auto n : nodes)
+    add_point(links_, std::span<const std::uint32_t>(&n, 1), std::span<const double>(&one, 1));
 
   const double n_inv = 1.0 / subdivision;
-  const auto node_of = [&](geometry::Index v) { return static_cast<std::uint32_t>(scene.surface_to_node[v]); };
+  const auto node_of = [&](geometry::Index v) {
+    return static_cast<std::uint32_t>(scene.surface_to_node[v]);
+  };
   std::set<std::pair<std::uint32_t, std::uint32_t>> edges_done;
   for (const auto& t : scene.boundary.triangles()) {
     const std::array<std::uint32_t, 3> face{node_of(t[0]), node_of(t[1]), node_of(t[2])};
@@ -67,7 +71,8 @@ SurfaceContacts::SurfaceContacts(const Scene& scene, int subdivision) : scene_(s
   remembered_.assign(links_.size(), false);
 }
 
-void SurfaceContacts::fill(const fem::Body& body, const Eigen::Isometry3d& world_from_blade, fem::ContactSet& set) {
+void SurfaceContacts::fill(const fem::Body& body, const Eigen::Isometry3d& world_from_blade,
+                           fem::ContactSet& set) {
   set.state_step = body.step_index();
   set.contacts.clear();
   const Eigen::Isometry3d blade_from_world = world_from_blade.inverse();

@@ -1,26 +1,26 @@
 // The scripted laryngoscope trajectory: the FEM tongue pressed by the Miller
 // 1 blade, AIST and the triangle baseline interleaved in one process.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <memory>
 #include <numeric>
 #include <random>
 #include <string>
-#include <chrono>
-#include <cstdio>
 
 #include "contact_metrics.h"
-#include "surface_contacts.h"
-#include "node_metrics.h"
 #include "fahr/collision/field_grid.h"
-#include "fahr/sphere_layout/fill_spheres.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
 #include "fahr/collision/triangle_baseline.h"
+#include "fahr/sphere_layout/fill_spheres.h"
+#include "node_metrics.h"
 #include "sections.h"
 #include "sphere_contact_set.h"
 #include "stats.h"
+#include "surface_contacts.h"
 
 namespace fahr::aist_bench {
 namespace {
@@ -58,8 +58,8 @@ struct Variant {
 // The contacts two variants disagree on in one tick: a sphere touching in
 // one and not the other, or a depth differing by more than tolerance_m.
 // largest_m: the largest depth difference of a sphere touching in both.
-std::size_t disagreements(const collision::ContactBuffer& a, const collision::ContactBuffer& b, double tolerance_m,
-                          double& largest_m) {
+std::size_t disagreements(const collision::ContactBuffer& a, const collision::ContactBuffer& b,
+                          double tolerance_m, double& largest_m) {
   std::size_t count = 0;
   for (const auto& x : a) {
     if (x.candidate) continue;
@@ -81,13 +81,16 @@ std::size_t disagreements(const collision::ContactBuffer& a, const collision::Co
 }
 
 void print_timing_row(const char* name, const Timings& t) {
-  std::printf("| %s | %.1f | %.1f | %.1f | %.1f / %.1f / %.1f | %.1f / %.1f / %.1f | %.1f / %.1f / %.1f | %.1f | %.1f | %.1f | %.1f | %.1f |\n", name,
-              percentile(t.query_us, 50), percentile(t.query_us, 99), percentile(t.query_us, 99.9),
-              percentile(t.cpu_query_us, 50), percentile(t.cpu_query_us, 99), percentile(t.cpu_query_us, 99.9),
-              percentile(t.best_query_us, 50), percentile(t.best_query_us, 99), percentile(t.best_query_us, 99.9),
-              percentile(t.warm_cpu_us, 50), percentile(t.warm_cpu_us, 99), percentile(t.warm_cpu_us, 99.9),
-              percentile(t.update_us, 50), percentile(t.update_us, 99.9), percentile(t.tick_us, 50),
-              percentile(t.tick_us, 99), percentile(t.tick_us, 99.9));
+  std::printf(
+      "| %s | %.1f | %.1f | %.1f | %.1f / %.1f / %.1f | %.1f / %.1f / %.1f | %.1f / %.1f / %.1f | "
+      "%.1f | %.1f | %.1f | %.1f | %.1f |\n",
+      name, percentile(t.query_us, 50), percentile(t.query_us, 99), percentile(t.query_us, 99.9),
+      percentile(t.cpu_query_us, 50), percentile(t.cpu_query_us, 99),
+      percentile(t.cpu_query_us, 99.9), percentile(t.best_query_us, 50),
+      percentile(t.best_query_us, 99), percentile(t.best_query_us, 99.9),
+      percentile(t.warm_cpu_us, 50), percentile(t.warm_cpu_us, 99), percentile(t.warm_cpu_us, 99.9),
+      percentile(t.update_us, 50), percentile(t.update_us, 99.9), percentile(t.tick_us, 50),
+      percentile(t.tick_us, 99), percentile(t.tick_us, 99.9));
 }
 
 }  // namespace
@@ -119,8 +122,10 @@ void trajectory_table(const Scene& scene, const Options& options) {
   const fem::SphereLinks links = to_fem_links(layout, options.skin_m);
   auto body = make_tongue_body(scene);
   std::vector<double> rest;
-  for (const auto& p : scene.tongue.rest_positions()) rest.insert(rest.end(), {p.x(), p.y(), p.z()});
-  collision::SphereState state = options.stretch_radius ? collision::SphereState(layout, rest) : collision::SphereState(layout);
+  for (const auto& p : scene.tongue.rest_positions())
+    rest.insert(rest.end(), {p.x(), p.y(), p.z()});
+  collision::SphereState state = options.stretch_radius ? collision::SphereState(layout, rest)
+                                                        : collision::SphereState(layout);
   collision::SphereTree tree(layout);
   const collision::FieldGrid blade_grid(scene.blade_sdf);
   const collision::QuerySettings exact_settings = trajectory_query(options);
@@ -131,14 +136,30 @@ void trajectory_table(const Scene& scene, const Options& options) {
   // without a FieldGrid, to measure what the copy changes in one run.
   // A deque: a Variant holds buffers and is neither copied nor moved.
   std::deque<Variant> variants;
-  variants.push_back({"AIST, exact narrow phase", exact_settings, &blade_grid, collision::PrePenetrationMemory(layout.size()),
-                      collision::ContactBuffer(4096), {}});
-  variants.push_back({"AIST, grid narrow phase", grid_settings, &blade_grid, collision::PrePenetrationMemory(layout.size()),
-                      collision::ContactBuffer(4096), {}});
-  variants.push_back({"AIST, exact, field's own grid", exact_settings, nullptr, collision::PrePenetrationMemory(layout.size()),
-                      collision::ContactBuffer(4096), {}});
-  variants.push_back({"AIST, grid, field's own grid", grid_settings, nullptr, collision::PrePenetrationMemory(layout.size()),
-                      collision::ContactBuffer(4096), {}});
+  variants.push_back({"AIST, exact narrow phase",
+                      exact_settings,
+                      &blade_grid,
+                      collision::PrePenetrationMemory(layout.size()),
+                      collision::ContactBuffer(4096),
+                      {}});
+  variants.push_back({"AIST, grid narrow phase",
+                      grid_settings,
+                      &blade_grid,
+                      collision::PrePenetrationMemory(layout.size()),
+                      collision::ContactBuffer(4096),
+                      {}});
+  variants.push_back({"AIST, exact, field's own grid",
+                      exact_settings,
+                      nullptr,
+                      collision::PrePenetrationMemory(layout.size()),
+                      collision::ContactBuffer(4096),
+                      {}});
+  variants.push_back({"AIST, grid, field's own grid",
+                      grid_settings,
+                      nullptr,
+                      collision::PrePenetrationMemory(layout.size()),
+                      collision::ContactBuffer(4096),
+                      {}});
   const int methods = static_cast<int>(variants.size()) + 1;  // the baseline last
   // Contacts the FieldGrid changes: the same sphere touching in both, depth
   // within 10 nm (its single-precision values are within a few nm).
@@ -156,7 +177,8 @@ void trajectory_table(const Scene& scene, const Options& options) {
   // The reference driver, built only when it drives (its face points cost
   // set-up at a high subdivision).
   std::unique_ptr<SurfaceContacts> reference_driver;
-  if (options.reference_driven) reference_driver = std::make_unique<SurfaceContacts>(scene, options.driver_subdivision);
+  if (options.reference_driven)
+    reference_driver = std::make_unique<SurfaceContacts>(scene, options.driver_subdivision);
   const collision::ContactBuffer& buffer = variants[0].buffer;  // drives the FEM in the closed loop
 
   Timings base;
@@ -214,7 +236,8 @@ void trajectory_table(const Scene& scene, const Options& options) {
           Variant& v = variants[static_cast<std::size_t>(who)];
           blade.grid = v.grid;
           v.buffer.clear();
-          const auto stats = collision::query_spheres(tree, state, blade, v.settings, v.memory, v.buffer);
+          const auto stats =
+              collision::query_spheres(tree, state, blade, v.settings, v.memory, v.buffer);
           const double t = elapsed_us(start);
           best[who] = std::min(best[who], t);
           if (repeat == kRepeats - 1) {
@@ -250,18 +273,25 @@ void trajectory_table(const Scene& scene, const Options& options) {
       }
     }
     for (int who = 0; who < methods; ++who) {
-      Timings& t = who < static_cast<int>(variants.size()) ? variants[static_cast<std::size_t>(who)].timings : base;
+      Timings& t = who < static_cast<int>(variants.size())
+                       ? variants[static_cast<std::size_t>(who)].timings
+                       : base;
       t.best_query_us.push_back(best[who]);
       t.query_us.push_back(query[who]);
-      t.tick_us.push_back(query[who] + (who < static_cast<int>(variants.size()) ? aist_update : base_update));
+      t.tick_us.push_back(query[who] +
+                          (who < static_cast<int>(variants.size()) ? aist_update : base_update));
     }
-    exact_changed += disagreements(variants[0].buffer, variants[2].buffer, kSameDepthM, exact_largest_m);
-    grid_changed += disagreements(variants[1].buffer, variants[3].buffer, kSameDepthM, grid_largest_m);
+    exact_changed +=
+        disagreements(variants[0].buffer, variants[2].buffer, kSameDepthM, exact_largest_m);
+    grid_changed +=
+        disagreements(variants[1].buffer, variants[3].buffer, kSameDepthM, grid_largest_m);
     for (auto& v : variants) {
       for (const auto& c : v.buffer) v.contacts += c.candidate ? 0 : 1;
     }
-    grid_metrics.add_tick(variants[1].buffer, state, base_contacts, blade.world_from_body, body->positions_m());
-    grid_node_metrics.add_tick(variants[1].buffer, state, base_contacts, blade.world_from_body, body->positions_m());
+    grid_metrics.add_tick(variants[1].buffer, state, base_contacts, blade.world_from_body,
+                          body->positions_m());
+    grid_node_metrics.add_tick(variants[1].buffer, state, base_contacts, blade.world_from_body,
+                               body->positions_m());
     std::size_t touching = 0;
     for (const auto& c : buffer) touching += c.candidate ? 0 : 1;
     max_aist_contacts = std::max(max_aist_contacts, touching);
@@ -274,53 +304,79 @@ void trajectory_table(const Scene& scene, const Options& options) {
       !reference_driver ? std::string()
       : options.driver_subdivision == 1
           ? std::string("every boundary node (surface_contacts.h), neither detector")
-          : std::to_string(reference_driver->point_count()) + " boundary points, the nodes and each face at subdivision " +
-                std::to_string(options.driver_subdivision) + " (surface_contacts.h), neither detector";
-  std::printf("\n## %s: Miller 1 pressing and levering the FEM tongue (%d ticks at 1 kHz, FEM every %d ticks, contact skin %.2f mm, candidate margin %.2f mm)\n\n",
-              options.reference_driven ? "Detection only (the FEM driven by its boundary points' contacts)" : "Trajectory", options.ticks,
-              options.fem_every, options.skin_m * 1e3, kCandidateMarginM * 1e3);
-  std::printf("Layout: %zu spheres (%zu grid level 0, %zu level 1, %zu hugging; %zu with a surface anchor, anchor gap %.2f mm, surface probe: %s), ratio %.0f, levels %d, weight spread %.2f (hugging %.2f), radius rule: %s. "
-              "FEM (fahr::fem, corotational, implicit Euler, Algorithm 1 projection of %s): "
-              "%zu steps, %.2f ms per step. Contacts per tick at most: AIST %zu, baseline %zu; buffer overflows: %zu. "
-              "Rebuilds after construction: AIST tree %llu, baseline tree %llu.\n\n",
-              layout.size(), layout.count_at_level(0), layout.count_at_level(1), layout.count(sphere_layout::SphereOrigin::kHugging),
-              layout.anchor_count(), fill.anchor_gap_m * 1e3,
-              options.surface_probe == collision::QuerySettings::SurfaceProbe::kAnchor ? "fixed anchor" : "face point under the contact",
-              fill.volume_ratio, fill.refinement_levels, fill.weight_spread, fill.hugging_weight_spread,
-              options.stretch_radius ? "smallest stretch" : "volume", options.reference_driven ? driver_text.c_str() : "the AIST contacts", fem_steps,
-              fem_ms / static_cast<double>(fem_steps), max_aist_contacts, max_base_contacts, overflows,
-              static_cast<unsigned long long>(tree.rebuild_count()), static_cast<unsigned long long>(baseline.rebuild_count()));
-  std::printf("| method | query median (us) | query p99 | query p99.9 | query thread CPU: median / p99 / p99.9 (us) | best of %d: median / p99 / p99.9 (us) | warm rerun thread CPU: median / p99 / p99.9 (us) | update+refit median (us) | update+refit p99.9 | tick median (us) | tick p99 | tick p99.9 |\n",
-              kRepeats);
+          : std::to_string(reference_driver->point_count()) +
+                " boundary points, the nodes and each face at subdivision " +
+                std::to_string(options.driver_subdivision) +
+                " (surface_contacts.h), neither detector";
+  std::printf(
+      "\n## %s: Miller 1 pressing and levering the FEM tongue (%d ticks at 1 kHz, FEM every %d "
+      "ticks, contact skin %.2f mm, candidate margin %.2f mm)\n\n",
+      options.reference_driven ? "Detection only (the FEM driven by its boundary points' contacts)"
+                               : "Trajectory",
+      options.ticks, options.fem_every, options.skin_m * 1e3, kCandidateMarginM * 1e3);
+  std::printf(
+      "Layout: %zu spheres (%zu grid level 0, %zu level 1, %zu hugging; %zu with a surface anchor, "
+      "anchor gap %.2f mm, surface probe: %s), ratio %.0f, levels %d, weight spread %.2f (hugging "
+      "%.2f), radius rule: %s. "
+      "FEM (fahr::fem, corotational, implicit Euler, Algorithm 1 projection of %s): "
+      "%zu steps, %.2f ms per step. Contacts per tick at most: AIST %zu, baseline %zu; buffer "
+      "overflows: %zu. "
+      "Rebuilds after construction: AIST tree %llu, baseline tree %llu.\n\n",
+      layout.size(), layout.count_at_level(0), layout.count_at_level(1),
+      layout.count(sphere_layout::SphereOrigin::kHugging), layout.anchor_count(),
+      fill.anchor_gap_m * 1e3,
+      options.surface_probe == collision::QuerySettings::SurfaceProbe::kAnchor
+          ? "fixed anchor"
+          : "face point under the contact",
+      fill.volume_ratio, fill.refinement_levels, fill.weight_spread, fill.hugging_weight_spread,
+      options.stretch_radius ? "smallest stretch" : "volume",
+      options.reference_driven ? driver_text.c_str() : "the AIST contacts", fem_steps,
+      fem_ms / static_cast<double>(fem_steps), max_aist_contacts, max_base_contacts, overflows,
+      static_cast<unsigned long long>(tree.rebuild_count()),
+      static_cast<unsigned long long>(baseline.rebuild_count()));
+  std::printf(
+      "| method | query median (us) | query p99 | query p99.9 | query thread CPU: median / p99 / "
+      "p99.9 (us) | best of %d: median / p99 / p99.9 (us) | warm rerun thread CPU: median / p99 / "
+      "p99.9 (us) | update+refit median (us) | update+refit p99.9 | tick median (us) | tick p99 | "
+      "tick p99.9 |\n",
+      kRepeats);
   std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   for (const auto& v : variants) print_timing_row(v.name, v.timings);
   print_timing_row("baseline (Bullet GImpact trees + vertex-face)", base);
   const double n = static_cast<double>(options.ticks);
-  std::printf("\nPer AIST query on average (exact, grid): %.0f / %.0f tree nodes visited, %.0f / %.0f spheres tested, "
-              "%.0f / %.0f narrow-phase spheres (at most %u nodes, %u spheres tested, %u narrow-phase). The blade's FieldGrid: %.1f MB, storage rounding %.2g mm. Touching "
-              "contacts that differ with and without it (sphere touching in one only, or depth apart by more than "
-              "10 nm), over %zu / %zu: exact %zu, grid %zu; largest depth difference of a sphere touching in both: exact "
-              "%.2g mm, grid %.2g mm.\n",
-              variants[0].nodes_sum / n, variants[1].nodes_sum / n, variants[0].tested_sum / n, variants[1].tested_sum / n,
-              variants[0].narrow_sum / n, variants[1].narrow_sum / n, variants[1].nodes_max, variants[1].tested_max,
-              variants[1].narrow_max,
-              4.0 * static_cast<double>(scene.blade_sdf.grid_dimensions().prod()) / 1e6, blade_grid.storage_error_m() * 1e3,
-              variants[2].contacts, variants[3].contacts, exact_changed, grid_changed, exact_largest_m * 1e3,
-              grid_largest_m * 1e3);
+  std::printf(
+      "\nPer AIST query on average (exact, grid): %.0f / %.0f tree nodes visited, %.0f / %.0f "
+      "spheres tested, "
+      "%.0f / %.0f narrow-phase spheres (at most %u nodes, %u spheres tested, %u narrow-phase). "
+      "The blade's FieldGrid: %.1f MB, storage rounding %.2g mm. Touching "
+      "contacts that differ with and without it (sphere touching in one only, or depth apart by "
+      "more than "
+      "10 nm), over %zu / %zu: exact %zu, grid %zu; largest depth difference of a sphere touching "
+      "in both: exact "
+      "%.2g mm, grid %.2g mm.\n",
+      variants[0].nodes_sum / n, variants[1].nodes_sum / n, variants[0].tested_sum / n,
+      variants[1].tested_sum / n, variants[0].narrow_sum / n, variants[1].narrow_sum / n,
+      variants[1].nodes_max, variants[1].tested_max, variants[1].narrow_max,
+      4.0 * static_cast<double>(scene.blade_sdf.grid_dimensions().prod()) / 1e6,
+      blade_grid.storage_error_m() * 1e3, variants[2].contacts, variants[3].contacts, exact_changed,
+      grid_changed, exact_largest_m * 1e3, grid_largest_m * 1e3);
   for (const auto& v : variants) {
     const Timings& t = v.timings;
-    std::printf("Speed-up (baseline / %s): thread CPU median %.1fx, p99.9 %.1fx; warm rerun median %.1fx, p99.9 %.1fx; tick median %.1fx, p99.9 %.1fx; "
-                "best-of-%d query: median %.1fx, p99.9 %.1fx.\n",
-                v.name, percentile(base.cpu_query_us, 50) / percentile(t.cpu_query_us, 50),
-                percentile(base.cpu_query_us, 99.9) / percentile(t.cpu_query_us, 99.9),
-                percentile(base.warm_cpu_us, 50) / percentile(t.warm_cpu_us, 50),
-                percentile(base.warm_cpu_us, 99.9) / percentile(t.warm_cpu_us, 99.9),
-                percentile(base.tick_us, 50) / percentile(t.tick_us, 50),
-                percentile(base.tick_us, 99.9) / percentile(t.tick_us, 99.9), kRepeats,
-                percentile(base.best_query_us, 50) / percentile(t.best_query_us, 50),
-                percentile(base.best_query_us, 99.9) / percentile(t.best_query_us, 99.9));
+    std::printf(
+        "Speed-up (baseline / %s): thread CPU median %.1fx, p99.9 %.1fx; warm rerun median %.1fx, "
+        "p99.9 %.1fx; tick median %.1fx, p99.9 %.1fx; "
+        "best-of-%d query: median %.1fx, p99.9 %.1fx.\n",
+        v.name, percentile(base.cpu_query_us, 50) / percentile(t.cpu_query_us, 50),
+        percentile(base.cpu_query_us, 99.9) / percentile(t.cpu_query_us, 99.9),
+        percentile(base.warm_cpu_us, 50) / percentile(t.warm_cpu_us, 50),
+        percentile(base.warm_cpu_us, 99.9) / percentile(t.warm_cpu_us, 99.9),
+        percentile(base.tick_us, 50) / percentile(t.tick_us, 50),
+        percentile(base.tick_us, 99.9) / percentile(t.tick_us, 99.9), kRepeats,
+        percentile(base.best_query_us, 50) / percentile(t.best_query_us, 50),
+        percentile(base.best_query_us, 99.9) / percentile(t.best_query_us, 99.9));
   }
-  std::printf("\n### AIST, exact narrow phase%s\n", options.reference_driven ? "" : " (its contacts drive the FEM)");
+  std::printf("\n### AIST, exact narrow phase%s\n",
+              options.reference_driven ? "" : " (its contacts drive the FEM)");
   metrics.print();
   node_metrics.print();
   std::printf("\n### AIST, grid narrow phase\n");

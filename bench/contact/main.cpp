@@ -27,8 +27,10 @@ int main(int argc, char** argv) {
   const bool all = std::strcmp(which, "all") == 0;
   int failures = 0;
   if (all || std::strcmp(which, "punch") == 0) failures += fahr::contact::bench::run_punch();
-  if (all || std::strcmp(which, "overshoot") == 0) failures += fahr::contact::bench::run_overshoot();
-  if (all || std::strcmp(which, "smoothness") == 0) failures += fahr::contact::bench::run_smoothness();
+  if (all || std::strcmp(which, "overshoot") == 0)
+    failures += fahr::contact::bench::run_overshoot();
+  if (all || std::strcmp(which, "smoothness") == 0)
+    failures += fahr::contact::bench::run_smoothness();
   std::printf("%s\n", failures == 0 ? "all targets met" : "some targets missed");
   return failures == 0 ? 0 : 1;
 }

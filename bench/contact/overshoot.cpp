@@ -9,10 +9,14 @@ namespace fahr::contact::bench {
 
 int run_overshoot() {
   constexpr double kLimitN = 1.0;  // renderable force now, N (a derated Touch X)
-  const sim::OvershootResult fa = sim::run_overshoot_experiment(sim::Method::kForceAware, kLimitN, 0.0);
-  const sim::OvershootResult pe = sim::run_overshoot_experiment(sim::Method::kPenalty, kLimitN, fa.deepest_device_y_m);
-  std::printf("\n== overshoot (Figure 7): 10 mm punch on a tissue block, FEM 100 Hz, limit %.2f N, 3x, hold 5 s ==\n",
-              kLimitN);
+  const sim::OvershootResult fa =
+      sim::run_overshoot_experiment(sim::Method::kForceAware, kLimitN, 0.0);
+  const sim::OvershootResult pe =
+      sim::run_overshoot_experiment(sim::Method::kPenalty, kLimitN, fa.deepest_device_y_m);
+  std::printf(
+      "\n== overshoot (Figure 7): 10 mm punch on a tissue block, FEM 100 Hz, limit %.2f N, 3x, "
+      "hold 5 s ==\n",
+      kLimitN);
   std::printf("%-42s %14s %14s\n", "", "force-aware", "penalty");
   auto row = [](const char* name, double a, double b, const char* unit) {
     std::printf("%-42s %14.4g %14.4g %s\n", name, a, b, unit);
@@ -28,10 +32,12 @@ int run_overshoot() {
   row("largest force step of the run", fa.max_tick_step_n, pe.max_tick_step_n, "N/tick");
   row("max displacement 1 s after release", 1e3 * fa.displacement_1s_after_release_m,
       1e3 * pe.displacement_1s_after_release_m, "mm");
-  row("deepest penetration of a contact", 1e3 * fa.max_penetration_m, 1e3 * pe.max_penetration_m, "mm");
+  row("deepest penetration of a contact", 1e3 * fa.max_penetration_m, 1e3 * pe.max_penetration_m,
+      "mm");
   row("inverted tets (worst step)", fa.max_inverted, pe.max_inverted, "");
   row("largest elastic energy", 1e3 * fa.max_elastic_energy_j, 1e3 * pe.max_elastic_energy_j, "mJ");
-  row("final elastic energy", 1e3 * fa.final_elastic_energy_j, 1e3 * pe.final_elastic_energy_j, "mJ");
+  row("final elastic energy", 1e3 * fa.final_elastic_energy_j, 1e3 * pe.final_elastic_energy_j,
+      "mJ");
   row("finite throughout (1 = yes)", fa.finite, pe.finite, "");
   // Re-engagement bound (README): per tick |dF| <= K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c).
   const double bound = fa.coupling_npm * (0.02 * 0.001 + 0.05 * 0.001) + 1.0 * (0.02 + 0.05);

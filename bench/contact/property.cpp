@@ -40,7 +40,9 @@ bool parse(int argc, char** argv, Options& o) {
     }
   }
   if (o.runs < 1 || o.first < 0 || !(o.seconds > 0.0) || o.threads < 1) {
-    std::fprintf(stderr, "contact_bench property: --runs >= 1, --first >= 0, --seconds > 0, --threads >= 1\n");
+    std::fprintf(
+        stderr,
+        "contact_bench property: --runs >= 1, --first >= 0, --seconds > 0, --threads >= 1\n");
     return false;
   }
   return true;
@@ -51,8 +53,9 @@ bool parse(int argc, char** argv, Options& o) {
 int run_property(int argc, char** argv) {
   Options o;
   if (!parse(argc, argv, o)) return 1;
-  std::printf("\n== property runs: %d lockstep runs of %.1f s (runs %d-%d), 432-tet block, %d threads ==\n", o.runs,
-              o.seconds, o.first, o.first + o.runs - 1, o.threads);
+  std::printf(
+      "\n== property runs: %d lockstep runs of %.1f s (runs %d-%d), 432-tet block, %d threads ==\n",
+      o.runs, o.seconds, o.first, o.first + o.runs - 1, o.threads);
   std::vector<sim::PropertyRunResult> results(static_cast<std::size_t>(o.runs));
   std::atomic<int> next{0};
   std::atomic<bool> setup_failed{false};
@@ -74,7 +77,8 @@ int run_property(int argc, char** argv) {
   std::vector<std::thread> threads;
   for (int t = 0; t < o.threads; ++t) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (setup_failed) return 1;
 
   int froze = 0, not_finite = 0, failed = 0;
@@ -86,14 +90,18 @@ int run_property(int argc, char** argv) {
     command = std::max(command, r.max_command_n / r.limit_n);
     penetration_m = std::max(penetration_m, r.max_persistent_penetration_m);
     force_only_m = std::max(force_only_m, r.max_force_only_penetration_m);
-    if (!r.ok() && ++failed <= 10) std::printf("run %d (seed %llu): %s\n", r.run, static_cast<unsigned long long>(r.seed), r.failure.c_str());
+    if (!r.ok() && ++failed <= 10)
+      std::printf("run %d (seed %llu): %s\n", r.run, static_cast<unsigned long long>(r.seed),
+                  r.failure.c_str());
   }
-  std::printf("%7s %7s %16s %15s %18s %19s %5s %7s %8s\n", "runs", "froze", "max reaction/L", "max command/L",
-              "max persist. um", "max force-only um", "NaN", "failed", "wall s");
-  std::printf("%7d %7d %16.4f %15.4f %18.2f %19.2f %5d %7d %8.1f\n", o.runs, froze, reaction, command,
-              1e6 * penetration_m, 1e6 * force_only_m, not_finite, failed, wall_s);
-  std::printf("target: no NaN, command <= L, reaction <= 1.05 L, no active penetration > 10 um kept 3 FEM steps: %s\n",
-              failed == 0 ? "met" : "MISSED");
+  std::printf("%7s %7s %16s %15s %18s %19s %5s %7s %8s\n", "runs", "froze", "max reaction/L",
+              "max command/L", "max persist. um", "max force-only um", "NaN", "failed", "wall s");
+  std::printf("%7d %7d %16.4f %15.4f %18.2f %19.2f %5d %7d %8.1f\n", o.runs, froze, reaction,
+              command, 1e6 * penetration_m, 1e6 * force_only_m, not_finite, failed, wall_s);
+  std::printf(
+      "target: no NaN, command <= L, reaction <= 1.05 L, no active penetration > 10 um kept 3 FEM "
+      "steps: %s\n",
+      failed == 0 ? "met" : "MISSED");
   return failed == 0 ? 0 : 1;
 }
 

@@ -88,8 +88,8 @@ SolverCase cg_jacobi(double tolerance, int max_iterations) {
 
 SolverCase cg_lagged(int period, double tolerance, int max_iterations) {
   char name[96];
-  std::snprintf(name, sizeof(name), "cg lagged-chol %s, tol %.0e max %d", lag_label(period).c_str(), tolerance,
-                max_iterations);
+  std::snprintf(name, sizeof(name), "cg lagged-chol %s, tol %.0e max %d", lag_label(period).c_str(),
+                tolerance, max_iterations);
   SolverCase c{name, {}};
   c.solver.kind = LinearSolver::kConjugateGradient;
   c.solver.preconditioner = CgPreconditioner::kLaggedCholesky;

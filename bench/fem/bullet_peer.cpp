@@ -39,9 +39,11 @@ Material peer_material() {
   return m;
 }
 
-double max_displacement(const std::vector<Eigen::Vector3d>& rest, const std::vector<Eigen::Vector3d>& now) {
+double max_displacement(const std::vector<Eigen::Vector3d>& rest,
+                        const std::vector<Eigen::Vector3d>& now) {
   double largest = 0.0;
-  for (std::size_t i = 0; i < rest.size(); ++i) largest = std::max(largest, (now[i] - rest[i]).norm());
+  for (std::size_t i = 0; i < rest.size(); ++i)
+    largest = std::max(largest, (now[i] - rest[i]).norm());
   return largest;
 }
 
@@ -53,8 +55,9 @@ struct PeerResult {
   std::string trace;  // max displacement, mm, every 25 steps
 };
 
-PeerResult run_fahr(const std::string& name, const TetMesh& mesh, const std::vector<std::uint32_t>& fixed,
-                    const SolverSettings& solver, int steps) {
+PeerResult run_fahr(const std::string& name, const TetMesh& mesh,
+                    const std::vector<std::uint32_t>& fixed, const SolverSettings& solver,
+                    int steps) {
   BodySettings settings;
   settings.material = peer_material();
   settings.time_step = std::chrono::duration<double>(kStep_s);
@@ -104,23 +107,27 @@ PeerResult run_bullet(const TetMesh& mesh, const std::vector<std::uint32_t>& fix
   btDeformableBodySolver solver;
   btDeformableMultiBodyConstraintSolver constraints;
   constraints.setDeformableSolver(&solver);
-  btDeformableMultiBodyDynamicsWorld world(&dispatcher, &broadphase, &constraints, &config, &solver);
+  btDeformableMultiBodyDynamicsWorld world(&dispatcher, &broadphase, &constraints, &config,
+                                           &solver);
   const btVector3 gravity(0, -9.81, 0);
   world.setGravity(gravity);
   world.getWorldInfo().m_gravity = gravity;  // setGravity does not reach it
   world.setUseProjection(true);
   ElementRest rest;
   build_element_rest(mesh.nodes_m, mesh.tets, rest);
-  const std::vector<double> mass = lumped_mass(rest, mesh.nodes_m.size(), material.density_kg_per_m3);
+  const std::vector<double> mass =
+      lumped_mass(rest, mesh.nodes_m.size(), material.density_kg_per_m3);
   std::vector<btVector3> x(mesh.nodes_m.size());
   std::vector<btScalar> m(mesh.nodes_m.size());
   for (std::size_t i = 0; i < x.size(); ++i) {
     x[i] = btVector3(mesh.nodes_m[i].x(), mesh.nodes_m[i].y(), mesh.nodes_m[i].z());
     m[i] = mass[i];
   }
-  auto* body = new btSoftBody(&world.getWorldInfo(), static_cast<int>(x.size()), x.data(), m.data());
+  auto* body =
+      new btSoftBody(&world.getWorldInfo(), static_cast<int>(x.size()), x.data(), m.data());
   for (const Tet& t : mesh.tets) {
-    body->appendTetra(static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2]), static_cast<int>(t[3]));
+    body->appendTetra(static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2]),
+                      static_cast<int>(t[3]));
   }
   body->initializeDmInverse();
   body->m_tetraScratches.resize(body->m_tetras.size());
@@ -129,8 +136,8 @@ PeerResult run_bullet(const TetMesh& mesh, const std::vector<std::uint32_t>& fix
   body->m_sleepingThreshold = 0;
   for (const std::uint32_t node : fixed) body->setMass(static_cast<int>(node), 0);
   world.addSoftBody(body);
-  btDeformableLinearElasticityForce elasticity(lame.mu_pa, lame.lambda_pa, material.rayleigh_mass_per_s,
-                                               material.rayleigh_stiffness_s);
+  btDeformableLinearElasticityForce elasticity(
+      lame.mu_pa, lame.lambda_pa, material.rayleigh_mass_per_s, material.rayleigh_stiffness_s);
   world.addForce(body, &elasticity);
   // No btDeformableGravityForce: the world already applies the world-info
   // gravity to deformable nodes, and adding the force as well doubled the
@@ -146,13 +153,16 @@ PeerResult run_bullet(const TetMesh& mesh, const std::vector<std::uint32_t>& fix
     cpu_in_steps += thread_cpu_ms() - before;
     if ((k + 1) % 25 == 0) {
       double largest = 0.0;
-      for (std::size_t i = 0; i < x.size(); ++i) largest = std::max(largest, (body->m_nodes[static_cast<int>(i)].m_x - x[i]).length());
+      for (std::size_t i = 0; i < x.size(); ++i)
+        largest = std::max(largest, (body->m_nodes[static_cast<int>(i)].m_x - x[i]).length());
       double fixed_moved = 0.0;
       for (const std::uint32_t node : fixed) {
-        fixed_moved = std::max(fixed_moved, (body->m_nodes[static_cast<int>(node)].m_x - x[node]).length());
+        fixed_moved =
+            std::max(fixed_moved, (body->m_nodes[static_cast<int>(node)].m_x - x[node]).length());
       }
       char entry[64];
-      std::snprintf(entry, sizeof(entry), " %.1f (fixed nodes %.2g)", 1e3 * largest, 1e3 * fixed_moved);
+      std::snprintf(entry, sizeof(entry), " %.1f (fixed nodes %.2g)", 1e3 * largest,
+                    1e3 * fixed_moved);
       result.trace += entry;
     }
   }
@@ -204,27 +214,36 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < mesh.nodes_m.size(); ++i) {
     if (mesh.nodes_m[i].y() < lowest + 0.010) fixed.push_back(static_cast<std::uint32_t>(i));
   }
-  std::printf("# fem_bullet_peer: ArtiSynth tongue, %zu tets, %zu nodes (%zu fixed), E 10 kPa, nu 0.45, "
-              "h 10 ms, %d steps (%.2f s), gravity -y\n\n",
-              mesh.tets.size(), mesh.nodes_m.size(), fixed.size(), steps, steps * kStep_s);
+  std::printf(
+      "# fem_bullet_peer: ArtiSynth tongue, %zu tets, %zu nodes (%zu fixed), E 10 kPa, nu 0.45, "
+      "h 10 ms, %d steps (%.2f s), gravity -y\n\n",
+      mesh.tets.size(), mesh.nodes_m.size(), fixed.size(), steps, steps * kStep_s);
   std::vector<PeerResult> results;
   // Converged fahr reference: exact step, run four times as long.
-  const PeerResult reference = run_fahr("fahr reference (cholmod every step, 4x longer)", mesh, fixed,
-                                        cholmod_exact().solver, 4 * steps);
+  const PeerResult reference = run_fahr("fahr reference (cholmod every step, 4x longer)", mesh,
+                                        fixed, cholmod_exact().solver, 4 * steps);
   results.push_back(reference);
-  results.push_back(run_fahr("fahr cholmod every step", mesh, fixed, cholmod_exact().solver, steps));
+  results.push_back(
+      run_fahr("fahr cholmod every step", mesh, fixed, cholmod_exact().solver, steps));
   SolverSettings lagged = cholmod_lagged(0).solver;
-  results.push_back(run_fahr("fahr cholmod lagged, refactor on 0.1 rad rotation", mesh, fixed, lagged, steps));
-  results.push_back(run_fahr("fahr cg lagged-chol rest factor tol 1e-6", mesh, fixed, cg_lagged(0, 1e-6, 20).solver, steps));
+  results.push_back(
+      run_fahr("fahr cholmod lagged, refactor on 0.1 rad rotation", mesh, fixed, lagged, steps));
+  results.push_back(run_fahr("fahr cg lagged-chol rest factor tol 1e-6", mesh, fixed,
+                             cg_lagged(0, 1e-6, 20).solver, steps));
   results.push_back(run_bullet(mesh, fixed, steps));
-  std::printf("Linear static sag (fahr, one K u = f solve): %.3f mm\n\n", linear_static_sag_mm(mesh, fixed));
-  std::printf("| solver | CPU ms/step | max displacement mm | vs converged fahr %% | finite |\n|---|---|---|---|---|\n");
+  std::printf("Linear static sag (fahr, one K u = f solve): %.3f mm\n\n",
+              linear_static_sag_mm(mesh, fixed));
+  std::printf(
+      "| solver | CPU ms/step | max displacement mm | vs converged fahr %% | finite "
+      "|\n|---|---|---|---|---|\n");
   for (const PeerResult& r : results) {
     std::printf("| %s | %.2f | %.3f | %+.2f | %s |\n", r.name.c_str(), r.cpu_ms, r.sag_mm,
                 100.0 * (r.sag_mm - reference.sag_mm) / reference.sag_mm, r.finite ? "yes" : "NO");
   }
   for (const PeerResult& r : results) {
-    if (!r.trace.empty()) std::printf("\n%s: max displacement every 25 steps (mm):%s\n", r.name.c_str(), r.trace.c_str());
+    if (!r.trace.empty())
+      std::printf("\n%s: max displacement every 25 steps (mm):%s\n", r.name.c_str(),
+                  r.trace.c_str());
   }
   return 0;
 }

@@ -19,8 +19,12 @@ constexpr double kDensity = 1000.0;
 // stays below 1e-5 relative.
 constexpr double kTargetDeflection_m = 1e-4;
 
-double second_moment() { return kSide_m * kSide_m * kSide_m * kSide_m / 12.0; }
-double tip_load_n() { return 3.0 * kYoungs_pa * second_moment() * kTargetDeflection_m / std::pow(kLength_m, 3); }
+double second_moment() {
+  return kSide_m * kSide_m * kSide_m * kSide_m / 12.0;
+}
+double tip_load_n() {
+  return 3.0 * kYoungs_pa * second_moment() * kTargetDeflection_m / std::pow(kLength_m, 3);
+}
 
 struct Row {
   int n = 0;
@@ -36,7 +40,9 @@ struct Row {
   bool pareto = false;
 };
 
-TetMesh beam(int n) { return make_box_mesh({10 * n, n, n}, Eigen::Vector3d(kLength_m, kSide_m, kSide_m)); }
+TetMesh beam(int n) {
+  return make_box_mesh({10 * n, n, n}, Eigen::Vector3d(kLength_m, kSide_m, kSide_m));
+}
 
 Material beam_material(double rayleigh_mass) {
   Material m;
@@ -48,7 +54,8 @@ Material beam_material(double rayleigh_mass) {
   return m;
 }
 
-std::unique_ptr<Body> loaded_beam(const TetMesh& mesh, const BodySettings& settings, std::vector<std::uint32_t>& tip) {
+std::unique_ptr<Body> loaded_beam(const TetMesh& mesh, const BodySettings& settings,
+                                  std::vector<std::uint32_t>& tip) {
   std::vector<std::uint32_t> fixed;
   tip.clear();
   for (std::size_t i = 0; i < mesh.nodes_m.size(); ++i) {
@@ -67,11 +74,14 @@ std::unique_ptr<Body> loaded_beam(const TetMesh& mesh, const BodySettings& setti
 
 double tip_deflection(const Body& body, const std::vector<std::uint32_t>& tip) {
   double sum = 0.0;
-  for (const std::uint32_t node : tip) sum += body.rest_position(node).y() - body.position(node).y();
+  for (const std::uint32_t node : tip)
+    sum += body.rest_position(node).y() - body.position(node).y();
   return sum / static_cast<double>(tip.size());
 }
 
-double euler_bernoulli() { return tip_load_n() * std::pow(kLength_m, 3) / (3.0 * kYoungs_pa * second_moment()); }
+double euler_bernoulli() {
+  return tip_load_n() * std::pow(kLength_m, 3) / (3.0 * kYoungs_pa * second_moment());
+}
 
 // Linear static solution: one implicit step of h = 1000 s from rest without
 // damping, which is K u = f up to a relative M / (h^2 K) ~ 1e-9.
@@ -92,7 +102,9 @@ double static_deflection(const TetMesh& mesh, double& ms) {
 
 // Errors are compared as printed (0.001 %): differences below that are
 // solver round-off, not accuracy.
-double printed_error(const Row& row) { return std::round(std::abs(row.error_pct) * 1e3); }
+double printed_error(const Row& row) {
+  return std::round(std::abs(row.error_pct) * 1e3);
+}
 
 void mark_pareto(std::vector<Row>& rows) {
   for (Row& a : rows) {
@@ -110,14 +122,17 @@ void run_cantilever(int max_dynamic_n, int max_static_n, int steps) {
   // Critical damping of the first bending mode, so that `steps` steps of
   // 10 ms reach equilibrium when the solve is exact.
   const double area = kSide_m * kSide_m;
-  const double omega1 = 3.516 / (kLength_m * kLength_m) *
-                        std::sqrt(kYoungs_pa * second_moment() / (kDensity * area));
-  std::printf("\n## Cantilever: %g x %g x %g mm, E %g Pa, nu %g, tip load %.4g N\n", 1e3 * kLength_m,
-              1e3 * kSide_m, 1e3 * kSide_m, kYoungs_pa, kPoisson, tip_load_n());
-  std::printf("Euler-Bernoulli tip deflection P L^3/(3 E I) = %.6f mm. Mesh n: %d x n x n cells of 6 tets.\n",
-              1e3 * reference, 10);
+  const double omega1 =
+      3.516 / (kLength_m * kLength_m) * std::sqrt(kYoungs_pa * second_moment() / (kDensity * area));
+  std::printf("\n## Cantilever: %g x %g x %g mm, E %g Pa, nu %g, tip load %.4g N\n",
+              1e3 * kLength_m, 1e3 * kSide_m, 1e3 * kSide_m, kYoungs_pa, kPoisson, tip_load_n());
+  std::printf(
+      "Euler-Bernoulli tip deflection P L^3/(3 E I) = %.6f mm. Mesh n: %d x n x n cells of 6 "
+      "tets.\n",
+      1e3 * reference, 10);
   std::printf("\n### Static linear solve per mesh (one CHOLMOD solve)\n\n");
-  std::printf("| n | tets | DOF | cell mm | deflection mm | error vs EB %% | set-up + solve ms |\n");
+  std::printf(
+      "| n | tets | DOF | cell mm | deflection mm | error vs EB %% | set-up + solve ms |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   std::vector<double> cells, errors, deflections;
   std::vector<int> ns;
@@ -126,8 +141,8 @@ void run_cantilever(int max_dynamic_n, int max_static_n, int steps) {
     double ms = 0.0;
     const double d = static_deflection(mesh, ms);
     const double error = 100.0 * (d - reference) / reference;
-    std::printf("| %d | %zu | %zu | %.3f | %.6f | %+.3f | %.0f |\n", n, mesh.tets.size(), 3 * mesh.nodes_m.size(),
-                10.0 / n, 1e3 * d, error, ms);
+    std::printf("| %d | %zu | %zu | %.3f | %.6f | %+.3f | %.0f |\n", n, mesh.tets.size(),
+                3 * mesh.nodes_m.size(), 10.0 / n, 1e3 * d, error, ms);
     ns.push_back(n);
     cells.push_back(kSide_m / n);
     errors.push_back(std::abs(error));
@@ -156,15 +171,18 @@ void run_cantilever(int max_dynamic_n, int max_static_n, int steps) {
     const double d4 = deflections[static_cast<std::size_t>(k - ns.begin())];
     const double p = std::log2((d2 - d1) / (d4 - d2));
     const double limit = d4 + (d4 - d2) / (std::pow(2.0, p) - 1.0);
-    std::printf("Richardson n = %d, %d, %d: order %.2f, extrapolated deflection %.6f mm (%+.3f %% vs EB)\n", ns[i],
-                2 * ns[i], 4 * ns[i], p, 1e3 * limit, 100.0 * (limit - reference) / reference);
+    std::printf(
+        "Richardson n = %d, %d, %d: order %.2f, extrapolated deflection %.6f mm (%+.3f %% vs EB)\n",
+        ns[i], 2 * ns[i], 4 * ns[i], p, 1e3 * limit, 100.0 * (limit - reference) / reference);
   }
 
-  std::printf("\n### Stepping to rest: %d steps of 10 ms, critically damped first mode (alpha %.1f 1/s)\n\n", steps,
-              2.0 * omega1);
-  std::vector<SolverCase> cases = {cholmod_exact(),          cholmod_lagged(10),       cg_jacobi(1e-8, 2000),
-                                   cg_jacobi(1e-8, 50),      cg_jacobi(1e-8, 10),      cg_lagged(10, 1e-8, 20),
-                                   cg_lagged(0, 1e-8, 3),    cg_lagged(0, 1e-8, 1)};
+  std::printf(
+      "\n### Stepping to rest: %d steps of 10 ms, critically damped first mode (alpha %.1f "
+      "1/s)\n\n",
+      steps, 2.0 * omega1);
+  std::vector<SolverCase> cases = {
+      cholmod_exact(),     cholmod_lagged(10),      cg_jacobi(1e-8, 2000), cg_jacobi(1e-8, 50),
+      cg_jacobi(1e-8, 10), cg_lagged(10, 1e-8, 20), cg_lagged(0, 1e-8, 3), cg_lagged(0, 1e-8, 1)};
   // Fine meshes only with the solvers that stay affordable there (one
   // factorisation of the rest matrix; this load is a small deflection).
   const std::vector<SolverCase> fine_cases = {cholmod_lagged(0), cg_lagged(0, 1e-8, 3)};
@@ -200,12 +218,14 @@ void run_cantilever(int max_dynamic_n, int max_static_n, int steps) {
   }
   mark_pareto(rows);
   std::printf("Pareto front over (CPU ms/step, |error|) across all meshes and solvers.\n\n");
-  std::printf("| n | tets | solver | CPU ms/step | wall ms/step | max wall ms | CG it/step | deflection mm | error vs EB %% | Pareto |\n");
+  std::printf(
+      "| n | tets | solver | CPU ms/step | wall ms/step | max wall ms | CG it/step | deflection mm "
+      "| error vs EB %% | Pareto |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& r : rows) {
-    std::printf("| %d | %zu | %s | %.3f | %.3f | %.3f | %.1f | %.6f | %+.3f | %s |\n", r.n, r.tets, r.solver.c_str(),
-                r.ms, r.wall_ms, r.max_ms, r.iterations, 1e3 * r.deflection_m, r.error_pct,
-                r.pareto ? "**front**" : "");
+    std::printf("| %d | %zu | %s | %.3f | %.3f | %.3f | %.1f | %.6f | %+.3f | %s |\n", r.n, r.tets,
+                r.solver.c_str(), r.ms, r.wall_ms, r.max_ms, r.iterations, 1e3 * r.deflection_m,
+                r.error_pct, r.pareto ? "**front**" : "");
   }
 }
 

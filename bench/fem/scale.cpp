@@ -19,7 +19,8 @@ struct Size {
 
 TetMesh block(const Size& size) {
   const double cell = kBoxSide_m / size.cells[0];
-  return make_box_mesh(size.cells, Eigen::Vector3d(kBoxSide_m, cell * size.cells[1], cell * size.cells[2]));
+  return make_box_mesh(size.cells,
+                       Eigen::Vector3d(kBoxSide_m, cell * size.cells[1], cell * size.cells[2]));
 }
 
 std::unique_ptr<Body> block_body(const TetMesh& mesh, const SolverSettings& solver, double step_s) {
@@ -27,7 +28,8 @@ std::unique_ptr<Body> block_body(const TetMesh& mesh, const SolverSettings& solv
   settings.time_step = std::chrono::duration<double>(step_s);
   settings.solver = solver;
   settings.sleep.enabled = false;
-  BodyOrError made = Body::create(settings, mesh.nodes_m, mesh.tets, nodes_where_y_below(mesh, 1e-9));
+  BodyOrError made =
+      Body::create(settings, mesh.nodes_m, mesh.tets, nodes_where_y_below(mesh, 1e-9));
   if (!made.error.empty()) std::fprintf(stderr, "block: %s\n", made.error.c_str());
   return std::move(made.body);
 }
@@ -48,7 +50,8 @@ SphereLinks top_spheres(const TetMesh& mesh, std::size_t count) {
 }
 
 std::vector<Size> sizes(bool quick) {
-  std::vector<Size> list = {{"1k", {5, 7, 5}, 200}, {"5k", {9, 10, 9}, 100}, {"20k", {15, 15, 15}, 30}};
+  std::vector<Size> list = {
+      {"1k", {5, 7, 5}, 200}, {"5k", {9, 10, 9}, 100}, {"20k", {15, 15, 15}, 30}};
   if (!quick) list.push_back({"80k", {24, 23, 24}, 8});
   return list;
 }
@@ -62,7 +65,8 @@ std::vector<SolverCase> target_cases() {
   std::vector<SolverCase> cases = scale_cases();
   for (const auto factor : {CholmodFactorKind::kSimplicial, CholmodFactorKind::kSupernodal}) {
     for (const auto ordering : {CholmodOrdering::kAmd, CholmodOrdering::kMetis}) {
-      if (factor == CholmodFactorKind::kSupernodal && ordering == CholmodOrdering::kMetis) continue;  // the default
+      if (factor == CholmodFactorKind::kSupernodal && ordering == CholmodOrdering::kMetis)
+        continue;  // the default
       SolverCase c = cholmod_lagged(10);
       c.solver.cholmod.factor = factor;
       c.solver.cholmod.ordering = ordering;
@@ -88,8 +92,11 @@ std::vector<SolverCase> target_cases() {
 }  // namespace
 
 void run_scale(bool quick) {
-  std::printf("\n## Scale: 40 mm tongue-material block, bottom fixed, gravity, h = 2 ms, one core\n\n");
-  std::printf("| mesh | tets | DOF | L non-zeros | solver | CPU ms/step | wall ms/step | max wall ms | CG it/step | refactorisations |\n");
+  std::printf(
+      "\n## Scale: 40 mm tongue-material block, bottom fixed, gravity, h = 2 ms, one core\n\n");
+  std::printf(
+      "| mesh | tets | DOF | L non-zeros | solver | CPU ms/step | wall ms/step | max wall ms | CG "
+      "it/step | refactorisations |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Size& size : sizes(quick)) {
     const TetMesh mesh = block(size);
@@ -99,9 +106,12 @@ void run_scale(bool quick) {
       if (!body) continue;
       const double setup_ms = ms_since(start);
       const StepTiming t = time_steps(*body, 3, size.steps);
-      std::printf("| %s | %zu | %zu | %.3g | %s | %.3f | %.3f | %.3f | %.1f | %d of %d (set-up %.0f ms) |\n",
-                  size.label, mesh.tets.size(), 3 * mesh.nodes_m.size(), body->factor_nonzeros(), c.name.c_str(),
-                  t.mean_cpu_ms, t.mean_ms, t.max_ms, t.mean_iterations, t.refactorisations, size.steps, setup_ms);
+      std::printf(
+          "| %s | %zu | %zu | %.3g | %s | %.3f | %.3f | %.3f | %.1f | %d of %d (set-up %.0f ms) "
+          "|\n",
+          size.label, mesh.tets.size(), 3 * mesh.nodes_m.size(), body->factor_nonzeros(),
+          c.name.c_str(), t.mean_cpu_ms, t.mean_ms, t.max_ms, t.mean_iterations, t.refactorisations,
+          size.steps, setup_ms);
       std::fflush(stdout);
     }
   }
@@ -125,17 +135,21 @@ void run_compliance(bool quick) {
       const int repeats = 5;
       const double cpu_start = thread_cpu_ms();
       for (int r = 0; r < repeats; ++r) body->compliance(ids, links, w);
-      std::printf("| %s | %zu | %zu | %zu x %zu | %.3f |\n", size.label, mesh.tets.size(), k, 3 * k, 3 * k,
-                  (thread_cpu_ms() - cpu_start) / repeats);
+      std::printf("| %s | %zu | %zu | %zu x %zu | %.3f |\n", size.label, mesh.tets.size(), k, 3 * k,
+                  3 * k, (thread_cpu_ms() - cpu_start) / repeats);
     }
   }
 
   // Error of W from a lagged factorisation: the block pressed 5 mm down by 8
   // frozen contacts for 0.2 s, W of those 8 spheres from the rest factor and
   // from a factor of the current A, with identical trajectories (CG to 1e-10).
-  std::printf("\n### Error of W from a lagged factorisation (5k block pressed 5 mm by 8 frozen contacts)\n\n");
-  std::printf("| factor (CG to 1e-10 on the current A, so the trajectories agree) | relative Frobenius error of W | "
-              "worst diagonal error %% |\n|---|---|---|\n");
+  std::printf(
+      "\n### Error of W from a lagged factorisation (5k block pressed 5 mm by 8 frozen "
+      "contacts)\n\n");
+  std::printf(
+      "| factor (CG to 1e-10 on the current A, so the trajectories agree) | relative Frobenius "
+      "error of W | "
+      "worst diagonal error %% |\n|---|---|---|\n");
   const TetMesh mesh = block(sizes(true)[1]);
   const SphereLinks links = top_spheres(mesh, 8);
   std::vector<std::uint32_t> ids(links.size());
@@ -180,16 +194,21 @@ void run_compliance(bool quick) {
     }
     for (std::size_t i = 0; i < rows; ++i) {
       const double e = w_exact[i * rows + i];
-      worst_diagonal = std::max(worst_diagonal, std::abs(static_cast<double>(w[i * rows + i]) - e) / e);
+      worst_diagonal =
+          std::max(worst_diagonal, std::abs(static_cast<double>(w[i * rows + i]) - e) / e);
     }
-    std::printf("| %s | %.2e | %.3f |\n", name.c_str(), std::sqrt(diff / norm), 100.0 * worst_diagonal);
+    std::printf("| %s | %.2e | %.3f |\n", name.c_str(), std::sqrt(diff / norm),
+                100.0 * worst_diagonal);
   }
 }
 
 void run_target() {
-  std::printf("\n## Target: 5k-tet body at >= 500 steps/s on one core (h = 2 ms, 8 active contacts)\n\n");
-  std::printf("| solver | CPU ms/step | wall ms/step | max wall ms | steps/s (CPU) | CG it/step | refactorisations | "
-              "L non-zeros | meets 500/s |\n|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "\n## Target: 5k-tet body at >= 500 steps/s on one core (h = 2 ms, 8 active contacts)\n\n");
+  std::printf(
+      "| solver | CPU ms/step | wall ms/step | max wall ms | steps/s (CPU) | CG it/step | "
+      "refactorisations | "
+      "L non-zeros | meets 500/s |\n|---|---|---|---|---|---|---|---|---|\n");
   const TetMesh mesh = block(sizes(true)[1]);
   const SphereLinks links = top_spheres(mesh, 8);
   for (const SolverCase& c : target_cases()) {
@@ -200,7 +219,8 @@ void run_target() {
       contact.sphere_id = s;
       contact.state = ContactState::kActive;
       contact.normal = Eigen::Vector3d(0, -1, 0);
-      contact.plane_point_m = links.centre(s, body->positions_m().data()) + Eigen::Vector3d(0, 0.002, 0);
+      contact.plane_point_m =
+          links.centre(s, body->positions_m().data()) + Eigen::Vector3d(0, 0.002, 0);
       set.contacts.push_back(contact);
     }
     const int steps = 500;
@@ -222,9 +242,9 @@ void run_target() {
     }
     const double mean = total / steps;
     const double cpu = (thread_cpu_ms() - cpu_start) / steps;
-    std::printf("| %s | %.3f | %.3f | %.3f | %.0f | %.1f | %d | %.3g | %s |\n", c.name.c_str(), cpu, mean, worst,
-                1000.0 / cpu, iterations / steps, refactorisations, body->factor_nonzeros(),
-                1000.0 / cpu >= 500.0 ? "yes" : "no");
+    std::printf("| %s | %.3f | %.3f | %.3f | %.0f | %.1f | %d | %.3g | %s |\n", c.name.c_str(), cpu,
+                mean, worst, 1000.0 / cpu, iterations / steps, refactorisations,
+                body->factor_nonzeros(), 1000.0 / cpu >= 500.0 ? "yes" : "no");
   }
 }
 

@@ -26,7 +26,6 @@
 // largest and RMS difference of the force sent to the device (N); the most
 // inverted tets.
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -134,7 +133,8 @@ struct Shadow {
   std::vector<double> iterations;
   std::uint64_t factorisations_at_start = 0;
   double max_node_mm = 0.0;
-  double max_w_relative = 0.0;  // max |W - W_exact| / max |W_exact| over steps with the same spheres
+  double max_w_relative =
+      0.0;  // max |W - W_exact| / max |W_exact| over steps with the same spheres
   int max_inverted = 0;
   // W audit (CG only, whose A is assembled every step): W of a fresh
   // factorisation of the shadow's own current A, same spheres, same state.
@@ -166,8 +166,9 @@ void audit_compliance(Shadow& shadow) {
   if (spheres.empty() || w.size() != 9 * spheres.size() * spheres.size()) return;
   if (!shadow.audit->factorize()) return;  // reads the body's A as assembled this step
   shadow.audit_w.resize(w.size());
-  if (!shadow.audit_block.compute(spheres, shadow.setup->links, shadow.fixed_dof, *shadow.audit, shadow.audit_warp,
-                                  shadow.setup->body->time_step_s(), shadow.audit_w)) {
+  if (!shadow.audit_block.compute(spheres, shadow.setup->links, shadow.fixed_dof, *shadow.audit,
+                                  shadow.audit_warp, shadow.setup->body->time_step_s(),
+                                  shadow.audit_w)) {
     return;
   }
   double scale = 0.0;
@@ -273,11 +274,14 @@ void print_kernel_costs(const fahr::fem::Body& body) {
   const double factorise_ms = time_ms(10, [&] { factor.factorize(); });
   const double solve_ms = time_ms(100, [&] { factor.solve({b.data(), n}, {x.data(), n}); });
   const double block_ms = time_ms(10, [&] { factor.solve_columns(b, x, 48); });
-  const double product_ms = time_ms(100, [&] { fahr::fem::multiply_symmetric(a, b.data(), x.data()); });
-  std::printf("\nKernels on the final A (%zu DOFs, %.0f non-zeros in L, %s): factorisation %.2f ms, one solve "
-              "%.3f ms, 48-column solve (16 spheres) %.2f ms, one product with A %.3f ms (thread CPU)\n",
-              n, factor.factor_nonzeros(), factor.supernodal() ? "supernodal" : "simplicial", factorise_ms, solve_ms,
-              block_ms, product_ms);
+  const double product_ms =
+      time_ms(100, [&] { fahr::fem::multiply_symmetric(a, b.data(), x.data()); });
+  std::printf(
+      "\nKernels on the final A (%zu DOFs, %.0f non-zeros in L, %s): factorisation %.2f ms, one "
+      "solve "
+      "%.3f ms, 48-column solve (16 spheres) %.2f ms, one product with A %.3f ms (thread CPU)\n",
+      n, factor.factor_nonzeros(), factor.supernodal() ? "supernodal" : "simplicial", factorise_ms,
+      solve_ms, block_ms, product_ms);
 }
 
 }  // namespace
@@ -285,19 +289,24 @@ void print_kernel_costs(const fahr::fem::Body& body) {
 int main(int argc, char** argv) {
   fahr::common::run_solver_libraries_on_one_thread(argv);
   using namespace fahr;
-  CLI::App app{"FEM solvers on the pressed neonatal tongue against the exact step, in the whole loop"};
+  CLI::App app{
+      "FEM solvers on the pressed neonatal tongue against the exact step, in the whole loop"};
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
   double seconds = 8.0;
   std::string config_list = "shipped,lagged,pcg-it8";
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
   bool no_reference = false;
-  app.add_flag("--no-reference", no_reference, "do not add the exact run: the first configuration listed is the reference (profiling one configuration)");
+  app.add_flag("--no-reference", no_reference,
+               "do not add the exact run: the first configuration listed is the reference "
+               "(profiling one configuration)");
   double support_ratio = -1.0;
   app.add_option("--support-ratio", support_ratio,
-                 "the FEM's anatomy support springs over the node's diagonal of A (0: off); default: the FEM's");
+                 "the FEM's anatomy support springs over the node's diagonal of A (0: off); "
+                 "default: the FEM's");
   app.add_option("--configs", config_list,
-                 "comma-separated: exact, shipped, lagged, pcg-rot, pcg-rest, pcg-itN (the exact run is always made)");
+                 "comma-separated: exact, shipped, lagged, pcg-rot, pcg-rest, pcg-itN (the exact "
+                 "run is always made)");
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
@@ -334,7 +343,8 @@ int main(int argc, char** argv) {
       }
       run.factorisations_at_start = run.sim->body().factorisations();
       run.shadow.factorisations_at_start = run.shadow.setup->body->factorisations();
-      if (run.shadow.setup->body->settings().solver.kind == LinearSolver::kConjugateGradient) start_audit(run.shadow);
+      if (run.shadow.setup->body->settings().solver.kind == LinearSolver::kConjugateGradient)
+        start_audit(run.shadow);
       runs.push_back(std::move(run));
     }
     const auto steps = static_cast<std::uint64_t>(seconds * 1000.0 + 0.5);
@@ -369,10 +379,11 @@ int main(int argc, char** argv) {
           if (shadow.audit && !report.asleep && !report.refactorised) audit_compliance(shadow);
           if (!report.asleep) shadow.iterations.push_back(report.solver_iterations);
           shadow.max_inverted = std::max(shadow.max_inverted, report.inverted_elements);
-          shadow.max_node_mm =
-              std::max(shadow.max_node_mm, largest_node_distance_mm(exact.sim->body(), *shadow.setup->body));
-          shadow.max_w_relative = std::max(
-              shadow.max_w_relative, w_difference(exact.sim->fem().contact_step(), shadow.step->contact_step()));
+          shadow.max_node_mm = std::max(
+              shadow.max_node_mm, largest_node_distance_mm(exact.sim->body(), *shadow.setup->body));
+          shadow.max_w_relative =
+              std::max(shadow.max_w_relative,
+                       w_difference(exact.sim->fem().contact_step(), shadow.step->contact_step()));
         }
       }
       for (std::size_t r = 1; r < runs.size(); ++r) {
@@ -382,18 +393,24 @@ int main(int argc, char** argv) {
         run.force_sq_sum += df * df;
         ++run.force_samples;
         if (run.sim->fem_stepped()) {
-          run.max_node_mm = std::max(run.max_node_mm, largest_node_distance_mm(exact.sim->body(), run.sim->body()));
+          run.max_node_mm = std::max(run.max_node_mm,
+                                     largest_node_distance_mm(exact.sim->body(), run.sim->body()));
         }
       }
     }
-    std::printf("fem_tongue_press: %s, %.1f s simulated, %zu configurations side by side, support ratio %s; "
-                "FEM step thread CPU ms while the blade touches\n\n",
-                scene_path.c_str(), seconds, runs.size(),
-                support_ratio >= 0.0 ? std::to_string(support_ratio).c_str() : "the FEM's default");
+    std::printf(
+        "fem_tongue_press: %s, %.1f s simulated, %zu configurations side by side, support ratio "
+        "%s; "
+        "FEM step thread CPU ms while the blade touches\n\n",
+        scene_path.c_str(), seconds, runs.size(),
+        support_ratio >= 0.0 ? std::to_string(support_ratio).c_str() : "the FEM's default");
     std::printf("Closed loop (each configuration's own stack):\n\n");
-    std::printf("| configuration | CPU p50 / p99 / max | CPU all steps p99 | steps touching | refactorisations "
-                "| CG iterations mean / max | node diff max, mm | force diff max / RMS, N | peak force, N | most "
-                "inverted |\n");
+    std::printf(
+        "| configuration | CPU p50 / p99 / max | CPU all steps p99 | steps touching | "
+        "refactorisations "
+        "| CG iterations mean / max | node diff max, mm | force diff max / RMS, N | peak force, N "
+        "| most "
+        "inverted |\n");
     std::printf("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     const auto mean_max = [](const std::vector<double>& v, double& mean, double& largest) {
       double sum = 0.0;
@@ -408,21 +425,30 @@ int main(int argc, char** argv) {
       double iteration_mean = 0.0;
       double iteration_max = 0.0;
       mean_max(run.iterations, iteration_mean, iteration_max);
-      const double rms =
-          run.force_samples == 0 ? 0.0 : std::sqrt(run.force_sq_sum / static_cast<double>(run.force_samples));
+      const double rms = run.force_samples == 0
+                             ? 0.0
+                             : std::sqrt(run.force_sq_sum / static_cast<double>(run.force_samples));
       const bool reference = &run == &runs.front();
-      std::printf("| %s | %.2f / %.2f / %.2f | %.2f | %zu | %llu | %.1f / %.0f | %s | %s | %.3f | %d |\n",
-                  run.config.name.c_str(), quantile(run.cpu_touching_ms, 0.5), quantile(run.cpu_touching_ms, 0.99),
-                  quantile(run.cpu_touching_ms, 1.0), quantile(run.cpu_all_ms, 0.99), run.cpu_touching_ms.size(),
-                  static_cast<unsigned long long>(run.sim->body().factorisations() - run.factorisations_at_start),
-                  iteration_mean, iteration_max, cell(run.max_node_mm, reference).c_str(),
-                  reference ? "(reference)" : (cell(run.max_force_n, false) + " / " + cell(rms, false)).c_str(),
-                  run.peak_force_n, run.max_inverted);
+      std::printf(
+          "| %s | %.2f / %.2f / %.2f | %.2f | %zu | %llu | %.1f / %.0f | %s | %s | %.3f | %d |\n",
+          run.config.name.c_str(), quantile(run.cpu_touching_ms, 0.5),
+          quantile(run.cpu_touching_ms, 0.99), quantile(run.cpu_touching_ms, 1.0),
+          quantile(run.cpu_all_ms, 0.99), run.cpu_touching_ms.size(),
+          static_cast<unsigned long long>(run.sim->body().factorisations() -
+                                          run.factorisations_at_start),
+          iteration_mean, iteration_max, cell(run.max_node_mm, reference).c_str(),
+          reference ? "(reference)"
+                    : (cell(run.max_force_n, false) + " / " + cell(rms, false)).c_str(),
+          run.peak_force_n, run.max_inverted);
     }
-    std::printf("\nOpen loop (shadow FEMs fed the exact run's ContactSets; the exact shadow checks determinism):\n\n");
-    std::printf("| configuration | CPU p50 / p99 / max | refactorisations | CG iterations mean / max "
-                "| node diff from exact max, mm | W diff from exact run max, relative | W error vs fresh factor "
-                "p50 / p99 / max (steps) | most inverted |\n");
+    std::printf(
+        "\nOpen loop (shadow FEMs fed the exact run's ContactSets; the exact shadow checks "
+        "determinism):\n\n");
+    std::printf(
+        "| configuration | CPU p50 / p99 / max | refactorisations | CG iterations mean / max "
+        "| node diff from exact max, mm | W diff from exact run max, relative | W error vs fresh "
+        "factor "
+        "p50 / p99 / max (steps) | most inverted |\n");
     std::printf("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for (const Run& run : runs) {
       const Shadow& shadow = run.shadow;
@@ -431,14 +457,17 @@ int main(int argc, char** argv) {
       mean_max(shadow.iterations, iteration_mean, iteration_max);
       char audit[96] = "-";
       if (shadow.audit) {
-        std::snprintf(audit, sizeof audit, "%.3g / %.3g / %.3g (%zu)", quantile(shadow.audit_error, 0.5),
-                      quantile(shadow.audit_error, 0.99), quantile(shadow.audit_error, 1.0), shadow.audit_error.size());
+        std::snprintf(audit, sizeof audit, "%.3g / %.3g / %.3g (%zu)",
+                      quantile(shadow.audit_error, 0.5), quantile(shadow.audit_error, 0.99),
+                      quantile(shadow.audit_error, 1.0), shadow.audit_error.size());
       }
-      std::printf("| %s | %.2f / %.2f / %.2f | %llu | %.1f / %.0f | %.3g | %.3g | %s | %d |\n", run.config.name.c_str(),
-                  quantile(shadow.cpu_touching_ms, 0.5), quantile(shadow.cpu_touching_ms, 0.99),
-                  quantile(shadow.cpu_touching_ms, 1.0),
-                  static_cast<unsigned long long>(shadow.setup->body->factorisations() - shadow.factorisations_at_start),
-                  iteration_mean, iteration_max, shadow.max_node_mm, shadow.max_w_relative, audit, shadow.max_inverted);
+      std::printf("| %s | %.2f / %.2f / %.2f | %llu | %.1f / %.0f | %.3g | %.3g | %s | %d |\n",
+                  run.config.name.c_str(), quantile(shadow.cpu_touching_ms, 0.5),
+                  quantile(shadow.cpu_touching_ms, 0.99), quantile(shadow.cpu_touching_ms, 1.0),
+                  static_cast<unsigned long long>(shadow.setup->body->factorisations() -
+                                                  shadow.factorisations_at_start),
+                  iteration_mean, iteration_max, shadow.max_node_mm, shadow.max_w_relative, audit,
+                  shadow.max_inverted);
     }
     print_kernel_costs(runs.front().sim->body());
     return 0;

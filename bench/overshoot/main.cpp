@@ -6,9 +6,11 @@
 // force-aware response and the penalty baseline on the same script.
 //
 //   fahr_overshoot_bench [--scene FILE] [--factor 3] [--response both|force-aware|penalty]
-//                        [--fem-anatomy on|off] [--fem-support RATIO] [--youngs-pa E] [--tool-stops on|off]
+//                        [--fem-anatomy on|off] [--fem-support RATIO] [--youngs-pa E] [--tool-stops
+//                        on|off]
 //                        [--stiffening C20/C10]
-//                        [--sphere-spread service|mass|translation] [--frozen-target service|step-start|hold-centre]
+//                        [--sphere-spread service|mass|translation] [--frozen-target
+//                        service|step-start|hold-centre]
 //                        [--fem-anatomy-slide]
 //                        [--trace FILE] [--check]
 //
@@ -34,7 +36,6 @@
 // (commanded - limit) / K_c, the re-engagement force step within the
 // bound, the tongue within 1 mm of rest 1 s after the blade leaves it).
 #include <CLI/CLI.hpp>
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -56,7 +57,7 @@ namespace {
 using namespace fahr;
 
 // The overshoot script's keyframes (services/device_gateway/src/trajectory.cpp).
-constexpr double kHoldEndS = 10.5;   // the hand starts to let go
+constexpr double kHoldEndS = 10.5;  // the hand starts to let go
 constexpr double kScriptEndS = 14.5;
 // Re-engagement: the bound of services/contact/README.md ("Catching up"),
 // K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c) for the scene's coupling and a
@@ -83,7 +84,8 @@ struct Result {
   std::uint64_t lost_ticks = 0;
   bool finite = true;
   std::uint64_t divergence_resets = 0;  // FEM steps that diverged and reset the tongue to rest
-  std::uint64_t anatomy_returned = 0, anatomy_beyond_steps = 0;  // the FEM's bone rules (service_step.h)
+  std::uint64_t anatomy_returned = 0,
+                anatomy_beyond_steps = 0;  // the FEM's bone rules (service_step.h)
   double wall_s = 0.0;
   // Wall time of the base steps that ran a FEM step (the FEM step, the
   // haptic tick and its digest together: an upper bound of the FEM's), ms.
@@ -109,12 +111,14 @@ std::size_t radius_ratio_class(double ratio) {
 }
 
 // Marks the tets inverted in the body's current state.
-void mark_inverted(const fem::Body& body, const geometry::TetMesh& mesh, std::vector<std::uint8_t>& marks) {
+void mark_inverted(const fem::Body& body, const geometry::TetMesh& mesh,
+                   std::vector<std::uint8_t>& marks) {
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     const auto& tet = mesh.tets()[e];
     Eigen::Matrix3d ds;
     const Eigen::Vector3d x0 = body.position(tet[0]);
-    for (int c = 0; c < 3; ++c) ds.col(c) = body.position(tet[static_cast<std::size_t>(c) + 1]) - x0;
+    for (int c = 0; c < 3; ++c)
+      ds.col(c) = body.position(tet[static_cast<std::size_t>(c) + 1]) - x0;
     if ((ds * mesh.rest_data()[e].dm_inverse).determinant() <= 0.0) marks[e] = 1;
   }
 }
@@ -127,7 +131,8 @@ void count_by_radius_ratio(const geometry::TetMesh& mesh, Result& r) {
   const auto& rest = mesh.rest_positions();
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     const auto& t = mesh.tets()[e];
-    const std::size_t c = radius_ratio_class(geometry::tet_shape(rest[t[0]], rest[t[1]], rest[t[2]], rest[t[3]]).radius_ratio);
+    const std::size_t c = radius_ratio_class(
+        geometry::tet_shape(rest[t[0]], rest[t[1]], rest[t[2]], rest[t[3]]).radius_ratio);
     ++r.class_tets[c];
     if (r.ever_inverted[e] != 0) ++r.class_inverted[c];
     if (r.inverted_at_end[e] != 0) ++r.class_inverted_at_end[c];
@@ -137,13 +142,16 @@ void count_by_radius_ratio(const geometry::TetMesh& mesh, Result& r) {
 void print_radius_ratio_table(const Result& r) {
   const std::vector<std::size_t>& tets = r.class_tets;
   const std::vector<std::size_t>& inverted = r.class_inverted;
-  std::printf("\n| rest radius ratio | tets | inverted after some FEM step (force-aware) | share of the class |"
-              " inverted at the end of the run |\n|---|---:|---:|---:|---:|\n");
+  std::printf(
+      "\n| rest radius ratio | tets | inverted after some FEM step (force-aware) | share of the "
+      "class |"
+      " inverted at the end of the run |\n|---|---:|---:|---:|---:|\n");
   for (std::size_t c = 0; c < kRadiusRatioClasses; ++c) {
-    std::printf("| [%.2f, %.2f%s | %zu | %zu | %.1f %% | %zu |\n", kRadiusRatioEdges[c], kRadiusRatioEdges[c + 1],
-                c + 1 == kRadiusRatioClasses ? "]" : ")", tets[c], inverted[c],
-                tets[c] > 0 ? 100.0 * static_cast<double>(inverted[c]) / static_cast<double>(tets[c]) : 0.0,
-                r.class_inverted_at_end[c]);
+    std::printf(
+        "| [%.2f, %.2f%s | %zu | %zu | %.1f %% | %zu |\n", kRadiusRatioEdges[c],
+        kRadiusRatioEdges[c + 1], c + 1 == kRadiusRatioClasses ? "]" : ")", tets[c], inverted[c],
+        tets[c] > 0 ? 100.0 * static_cast<double>(inverted[c]) / static_cast<double>(tets[c]) : 0.0,
+        r.class_inverted_at_end[c]);
   }
 }
 
@@ -171,7 +179,9 @@ double max_displacement_m(const fem::Body& body) {
   return largest;
 }
 
-Eigen::Vector3d vec(const msg::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+Eigen::Vector3d vec(const msg::Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 // Inverted tets now, and how many of them lie within `near_m` of the
 // anatomy (a node that close to a bone's surface, or inside) and of the
@@ -180,7 +190,8 @@ struct Inversions {
   int count = 0;
   int near_anatomy = 0;
   int near_blade = 0;
-  double worst_rest_radius_ratio = 1.0;  // of the inverted tets at rest: are they the mesh's slivers?
+  double worst_rest_radius_ratio =
+      1.0;  // of the inverted tets at rest: are they the mesh's slivers?
 };
 
 Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
@@ -188,26 +199,29 @@ Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
   const fem::Body& body = sim.body();
   const geometry::TetMesh& mesh = sim.tongue_mesh();
   const auto& proxy = sim.command().world_from_proxy();
-  const Eigen::Quaterniond q(proxy.orientation().w(), proxy.orientation().x(), proxy.orientation().y(),
-                             proxy.orientation().z());
+  const Eigen::Quaterniond q(proxy.orientation().w(), proxy.orientation().x(),
+                             proxy.orientation().y(), proxy.orientation().z());
   const Eigen::Vector3d t = vec(proxy.position_m());
   const auto& blade = *sim.haptic_setup().tool->sdf;
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     const auto& tet = mesh.tets()[e];
     Eigen::Matrix3d ds;
     const Eigen::Vector3d x0 = body.position(tet[0]);
-    for (int c = 0; c < 3; ++c) ds.col(c) = body.position(tet[static_cast<std::size_t>(c) + 1]) - x0;
+    for (int c = 0; c < 3; ++c)
+      ds.col(c) = body.position(tet[static_cast<std::size_t>(c) + 1]) - x0;
     if ((ds * mesh.rest_data()[e].dm_inverse).determinant() > 0.0) continue;
     ++out.count;
     const auto& rest = mesh.rest_positions();
     out.worst_rest_radius_ratio = std::min(
-        out.worst_rest_radius_ratio, geometry::tet_shape(rest[tet[0]], rest[tet[1]], rest[tet[2]], rest[tet[3]]).radius_ratio);
+        out.worst_rest_radius_ratio,
+        geometry::tet_shape(rest[tet[0]], rest[tet[1]], rest[tet[2]], rest[tet[3]]).radius_ratio);
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     double nearest_bone = std::numeric_limits<double>::infinity();
     for (const auto node : tet) {
       const Eigen::Vector3d x = body.position(node);
       centroid += 0.25 * x;
-      for (const auto& field : sim.fem().setup().anatomy) nearest_bone = std::min(nearest_bone, field->sample(x).distance_m);
+      for (const auto& field : sim.fem().setup().anatomy)
+        nearest_bone = std::min(nearest_bone, field->sample(x).distance_m);
     }
     if (nearest_bone < near_m) ++out.near_anatomy;
     if (blade.query(q.conjugate() * (centroid - t)).distance_m < near_m) ++out.near_blade;
@@ -220,7 +234,9 @@ Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
 int inverted_free(const stack_sim::StackSim& sim) {
   const auto x = sim.fem().contact_step().free_positions_m();
   const geometry::TetMesh& mesh = sim.tongue_mesh();
-  const auto at = [&](std::size_t n) { return Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]); };
+  const auto at = [&](std::size_t n) {
+    return Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]);
+  };
   int count = 0;
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     const auto& tet = mesh.tets()[e];
@@ -292,7 +308,8 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   const std::string& trace_path = choices.trace_path;
   const std::string& tick_trace_path = choices.tick_trace_path;
   auto variant = std::make_shared<scene::Scene>(*scene);
-  variant->contact.response = penalty ? scene::ContactResponse::kPenalty : scene::ContactResponse::kForceAware;
+  variant->contact.response =
+      penalty ? scene::ContactResponse::kPenalty : scene::ContactResponse::kForceAware;
   if (tool_stops != "scene") variant->contact.tool_stops_at_anatomy = tool_stops == "on";
   if (youngs_pa > 0.0) {
     for (auto& body : variant->bodies) {
@@ -320,33 +337,43 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   if (choices.held_proxy == "fixed") options.held_proxy = contact::HeldProxy::kUnclamped;
   if (choices.held_proxy == "load") options.held_proxy = contact::HeldProxy::kHoldLoad;
   options.fem_tool_obstacle = choices.fem_tool_obstacle;
-  if (choices.candidate_margin_mm >= 0.0) options.candidate_margin_m = 1e-3 * choices.candidate_margin_mm;
-  if (choices.row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(choices.row_compliance);
+  if (choices.candidate_margin_mm >= 0.0)
+    options.candidate_margin_m = 1e-3 * choices.candidate_margin_mm;
+  if (choices.row_compliance != "scene")
+    options.row_compliance = haptic_service::row_compliance_named(choices.row_compliance);
   if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
   if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
   if (choices.frozen_target == "step-start") options.frozen_target = fem::FrozenTarget::kStepStart;
-  if (choices.frozen_target == "hold-centre") options.frozen_target = fem::FrozenTarget::kHoldCentre;
+  if (choices.frozen_target == "hold-centre")
+    options.frozen_target = fem::FrozenTarget::kHoldCentre;
   options.fem_anatomy_slide = choices.fem_anatomy_slide;
   options.fem_anatomy_rounds = choices.fem_anatomy_rounds;
   stack_sim::StackSim sim(variant, options);
   Result r;
   r.name = penalty ? "penalty" : "force-aware";
   r.ever_inverted.assign(sim.tongue_mesh().tet_count(), 0);
-  std::FILE* trace = open_trace(trace_path, r.name,
-                 "t_s,inverted,inverted_near_anatomy,inverted_near_blade,anatomy_nodes,anatomy_depth_mm,"
-                 "anatomy_unresolved,anatomy_rounds,sweeps,tool_active,tool_frozen,force_only,obstacle_contacts,"
-                 "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,inverted_free,fem_cpu_ms,supported_nodes,"
-                 "volume_floor_below,volume_floor_unresolved\n");
-  std::FILE* tick_trace = open_trace(tick_trace_path, r.name,
-                 "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,proxy_z,gap_mm,"
-                 "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,obstacle_reaction_n,rows,"
+  std::FILE* trace = open_trace(
+      trace_path, r.name,
+      "t_s,inverted,inverted_near_anatomy,inverted_near_blade,anatomy_nodes,anatomy_depth_mm,"
+      "anatomy_unresolved,anatomy_rounds,sweeps,tool_active,tool_frozen,force_only,obstacle_"
+      "contacts,"
+      "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,"
+      "inverted_free,fem_cpu_ms,supported_nodes,"
+      "volume_floor_below,volume_floor_unresolved\n");
+  std::FILE* tick_trace =
+      open_trace(tick_trace_path, r.name,
+                 "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,"
+                 "proxy_z,gap_mm,"
+                 "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,"
+                 "obstacle_reaction_n,rows,"
                  "pgs_converged,contacts_found,fem_step,pgs_sweeps,missing_compliance\n");
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
   bool seen_1x = false, was_lost = false, reengaged = false, left = false;
   std::uint64_t reengaged_step = 0, left_step = 0;
   Eigen::Vector3d freeze_proxy = Eigen::Vector3d::Zero(), previous_force = Eigen::Vector3d::Zero();
-  Eigen::Vector3d previous_hand = Eigen::Vector3d::Zero(), previous_hand_v = Eigen::Vector3d::Zero();
+  Eigen::Vector3d previous_hand = Eigen::Vector3d::Zero(),
+                  previous_hand_v = Eigen::Vector3d::Zero();
   const auto steps = static_cast<std::uint64_t>((kScriptEndS + 1.5) * 1000.0);
   double fem_step_total_ms = 0.0;
   std::uint64_t fem_steps = 0;
@@ -354,7 +381,9 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     const auto step_start = std::chrono::steady_clock::now();
     sim.step();
     if (sim.fem_stepped()) {
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - step_start).count();
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - step_start)
+              .count();
       fem_step_total_ms += ms;
       ++fem_steps;
       r.fem_base_step_max_ms = std::max(r.fem_base_step_max_ms, ms);
@@ -372,19 +401,24 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = vec(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
-      std::fprintf(tick_trace, "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d\n",
-                   sim.time_s(), c.lost_track() ? 1 : 0, force.norm(), force.x(), force.y(), force.z(),
-                   c.tissue_reaction_n(), 1e3 * hand.x(), 1e3 * hand.y(), 1e3 * hand.z(), 1e3 * proxy.x(),
-                   1e3 * proxy.y(), 1e3 * proxy.z(), 1e3 * gap.norm(), limit, static_cast<int>(report.state),
-                   report.catch_up_limited ? 1 : 0, report.yielded ? 1 : 0, report.implausible_step ? 1 : 0,
-                   report.tissue_force_clamped ? 1 : 0, report.obstacle_reaction_n, static_cast<int>(report.load.rows),
-                   report.pgs.converged ? 1 : 0, sim.haptic().last_phases().tissue_query.contacts,
+      std::fprintf(tick_trace,
+                   "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,"
+                   "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d\n",
+                   sim.time_s(), c.lost_track() ? 1 : 0, force.norm(), force.x(), force.y(),
+                   force.z(), c.tissue_reaction_n(), 1e3 * hand.x(), 1e3 * hand.y(), 1e3 * hand.z(),
+                   1e3 * proxy.x(), 1e3 * proxy.y(), 1e3 * proxy.z(), 1e3 * gap.norm(), limit,
+                   static_cast<int>(report.state), report.catch_up_limited ? 1 : 0,
+                   report.yielded ? 1 : 0, report.implausible_step ? 1 : 0,
+                   report.tissue_force_clamped ? 1 : 0, report.obstacle_reaction_n,
+                   static_cast<int>(report.load.rows), report.pgs.converged ? 1 : 0,
+                   sim.haptic().last_phases().tissue_query.contacts,
                    static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps,
                    report.load.missing_compliance);
     }
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
     for (const auto& contact : sim.contacts().contacts()) {
-      if (contact.kind() != msg::CONTACT_OBSTACLE) r.max_penetration_m = std::max(r.max_penetration_m, contact.penetration_m());
+      if (contact.kind() != msg::CONTACT_OBSTACLE)
+        r.max_penetration_m = std::max(r.max_penetration_m, contact.penetration_m());
     }
     if (!penalty) {
       if (!seen_1x && commanded >= limit && limit > 0.0) {
@@ -394,8 +428,10 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
       if (c.lost_track()) {
         ++r.lost_ticks;
         if (!was_lost) freeze_proxy = vec(c.world_from_proxy().position_m());
-        r.max_reaction_lost_ratio = std::max(r.max_reaction_lost_ratio, c.tissue_reaction_n() / limit);
-        r.max_held_drift_m = std::max(r.max_held_drift_m, (vec(c.world_from_proxy().position_m()) - freeze_proxy).norm());
+        r.max_reaction_lost_ratio =
+            std::max(r.max_reaction_lost_ratio, c.tissue_reaction_n() / limit);
+        r.max_held_drift_m = std::max(
+            r.max_held_drift_m, (vec(c.world_from_proxy().position_m()) - freeze_proxy).norm());
         // |gap| = L/K_c + (F_cmd - L)/K_c with F_cmd = K_c |x_d - p_freeze|:
         // the proxy stays where it froze. That holds while the device can
         // render its peak force; once the gateway lowers the limit (the Touch
@@ -405,8 +441,8 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
         if (limit >= r.limit_n) {
           ++r.lost_ticks_at_peak;
           const double f_cmd = k_c * (hand - freeze_proxy).norm();
-          r.max_gap_error_m =
-              std::max(r.max_gap_error_m, std::abs(gap.norm() - (limit / k_c + (f_cmd - limit) / k_c)));
+          r.max_gap_error_m = std::max(
+              r.max_gap_error_m, std::abs(gap.norm() - (limit / k_c + (f_cmd - limit) / k_c)));
         }
       }
       if (was_lost && !c.lost_track()) {
@@ -425,7 +461,8 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     }
     previous_force = force;
     previous_hand = hand;
-    if (sim.time_s() >= kHoldEndS && r.strain_3x == 0.0) r.strain_3x = max_green_strain(sim.body(), sim.tongue_mesh());
+    if (sim.time_s() >= kHoldEndS && r.strain_3x == 0.0)
+      r.strain_3x = max_green_strain(sim.body(), sim.tongue_mesh());
     if (sim.fem_stepped()) {
       const fem::StepReport& report = sim.fem().last_report();
       r.max_inverted = std::max(r.max_inverted, report.inverted_elements);
@@ -436,22 +473,26 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
         // 1 mm: a tet that close to bone or blade is pressed by it.
         const Inversions inv = locate_inversions(sim, 1e-3);
         const ToolContacts tc = count_contacts(sim.contacts());
-        std::fprintf(trace, "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,%d,%d\n", sim.time_s(), inv.count,
-                     inv.near_anatomy, inv.near_blade, report.projection.obstacle_nodes,
-                     1e3 * report.projection.obstacle_deepest_m, report.projection.obstacle_unresolved,
-                     report.projection.obstacle_rounds, report.projection.sweeps, tc.active, tc.frozen, tc.force_only,
-                     tc.obstacle, c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
-                     1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio, inverted_free(sim),
-                     1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
-                     report.projection.obstacle_supported, report.projection.volume_floor_below,
-                     report.projection.volume_floor_unresolved);
+        std::fprintf(
+            trace,
+            "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,%d,%d\n",
+            sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
+            report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
+            report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
+            report.projection.sweeps, tc.active, tc.frozen, tc.force_only, tc.obstacle,
+            c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
+            1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio, inverted_free(sim),
+            1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
+            report.projection.obstacle_supported, report.projection.volume_floor_below,
+            report.projection.volume_floor_unresolved);
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
     if (!left && sim.time_s() > kHoldEndS) {
       bool touching = false;
       for (const auto& contact : sim.contacts().contacts()) {
-        touching = touching || (contact.kind() != msg::CONTACT_OBSTACLE && contact.state() != msg::CONSTRAINT_CANDIDATE);
+        touching = touching || (contact.kind() != msg::CONTACT_OBSTACLE &&
+                                contact.state() != msg::CONSTRAINT_CANDIDATE);
       }
       if (!touching) {
         left = true;
@@ -488,60 +529,77 @@ int main(int argc, char** argv) {
   std::string response = "both";
   std::string fem_anatomy = "on";
   app.add_option("--scene", scene_path, "scene file");
-  app.add_option("--sphere-spread", choices.spread, "how the FEM spreads a sphere's correction (default: the service's)")
+  app.add_option("--sphere-spread", choices.spread,
+                 "how the FEM spreads a sphere's correction (default: the service's)")
       ->check(CLI::IsMember({"service", "mass", "translation"}));
   app.add_option("--frozen-target", choices.frozen_target,
-                 "where the FEM holds a frozen sphere: its centre at the step's start or the haptic side's hold centre "
+                 "where the FEM holds a frozen sphere: its centre at the step's start or the "
+                 "haptic side's hold centre "
                  "(default: the service's)")
       ->check(CLI::IsMember({"service", "step-start", "hold-centre"}));
   app.add_option("--volume-floor", choices.volume_floor,
-                 "no tet ends a FEM step below this share of its rest volume (solver.volume_floor_ratio); 0: off "
+                 "no tet ends a FEM step below this share of its rest volume "
+                 "(solver.volume_floor_ratio); 0: off "
                  "(default: the scene's)")
       ->check(CLI::Range(0.0, 0.9));
-  app.add_flag("--fem-anatomy-slide", choices.fem_anatomy_slide,
-               "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
-  app.add_option("--fem-anatomy-rounds", choices.fem_anatomy_rounds,
-                 "the FEM's tool/anatomy alternation rounds per step (services/fem obstacle_projection.h "
-                 "max_rounds); default the FEM's")
+  app.add_flag(
+      "--fem-anatomy-slide", choices.fem_anatomy_slide,
+      "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
+  app.add_option(
+         "--fem-anatomy-rounds", choices.fem_anatomy_rounds,
+         "the FEM's tool/anatomy alternation rounds per step (services/fem obstacle_projection.h "
+         "max_rounds); default the FEM's")
       ->check(CLI::Range(1, 1000));
   app.add_option("--response", response, "which response to run")
       ->check(CLI::IsMember({"both", "force-aware", "penalty"}));
   app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")
       ->check(CLI::IsMember({"on", "off"}));
-  app.add_option("--fem-support", choices.support_ratio,
-                 "the FEM's anatomy support springs, stiffness over the node's diagonal of A; 0: off "
-                 "(default: the service's)")
+  app.add_option(
+         "--fem-support", choices.support_ratio,
+         "the FEM's anatomy support springs, stiffness over the node's diagonal of A; 0: off "
+         "(default: the service's)")
       ->check(CLI::Range(0.0, 1e6));
-  app.add_option("--tool-stops", choices.tool_stops, "the tool stops at the rigid anatomy (default: as the scene says)")
+  app.add_option("--tool-stops", choices.tool_stops,
+                 "the tool stops at the rigid anatomy (default: as the scene says)")
       ->check(CLI::IsMember({"scene", "on", "off"}));
-  app.add_option("--youngs-pa", choices.youngs_pa, "overrides the deformable body's Young's modulus, Pa (default: the scene's)")
+  app.add_option("--youngs-pa", choices.youngs_pa,
+                 "overrides the deformable body's Young's modulus, Pa (default: the scene's)")
       ->check(CLI::Range(1.0, 1e9));
   app.add_option("--stiffening", choices.stiffening,
                  "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
       ->check(CLI::Range(0.0, 100.0));
   app.add_option("--trace", choices.trace_path, "per-FEM-step CSV, FILE.<response>.csv");
-  app.add_option("--tick-trace", choices.tick_trace_path, "per-tick CSV (force, hand, proxy, gap), FILE.<response>.csv");
-  app.add_option("--factor", choices.factor, "overshoot: the hand's pull as a multiple of the device's peak force")
+  app.add_option("--tick-trace", choices.tick_trace_path,
+                 "per-tick CSV (force, hand, proxy, gap), FILE.<response>.csv");
+  app.add_option("--factor", choices.factor,
+                 "overshoot: the hand's pull as a multiple of the device's peak force")
       ->check(CLI::Range(1.0, 10.0));
   app.add_option("--held-proxy", choices.held_proxy,
-                 "while the device has lost track: limit (back off to keep the tissue within the limit), stay "
-                 "(stay where it froze, tissue forces scaled to the limit), load (stay, the tissue held by that load alone, "
+                 "while the device has lost track: limit (back off to keep the tissue within the "
+                 "limit), stay "
+                 "(stay where it froze, tissue forces scaled to the limit), load (stay, the tissue "
+                 "held by that load alone, "
                  "force only) or fixed (a diagnostic: stay, tissue "
                  "forces unclamped)")
       ->check(CLI::IsMember({"limit", "stay", "load", "fixed"}));
   app.add_option("--candidate-margin-mm", choices.candidate_margin_mm,
-                 "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; default the service's 1")
+                 "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; "
+                 "default the service's 1")
       ->check(CLI::Range(0.0, 5.0));
   app.add_flag("--fem-tool-obstacle", choices.fem_tool_obstacle,
-               "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose, not only the "
+               "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose, "
+               "not only the "
                "ContactSet's spheres (services/fem contact_step.h set_tool_obstacle)");
   app.add_option("--row-compliance", choices.row_compliance,
-                 "experimental: which rows get W when the blade touches more spheres than the FEM sends W for: "
-                 "scene (its solver.compliance_columns decides), deepest, keep or free (services/haptic/main haptic_setup.h "
+                 "experimental: which rows get W when the blade touches more spheres than the FEM "
+                 "sends W for: "
+                 "scene (its solver.compliance_columns decides), deepest, keep or free "
+                 "(services/haptic/main haptic_setup.h "
                  "RowCompliance)")
       ->check(CLI::IsMember({"scene", "deepest", "keep", "free"}));
   app.add_option("--w-normals", choices.w_normals,
-                 "W along the normals for this many spheres (the scene's solver.compliance_columns: normals and "
+                 "W along the normals for this many spheres (the scene's "
+                 "solver.compliance_columns: normals and "
                  "max_candidate_contacts); 0: the scene's")
       ->check(CLI::Range(0, 64));
   app.add_flag("--check", check, "exit 1 unless the force-aware run meets the targets");
@@ -553,43 +611,65 @@ int main(int argc, char** argv) {
     const Result fa = response != "penalty" ? run(scene, false, choices) : Result{};
     const Result pe = response != "force-aware" ? run(scene, true, choices) : Result{};
     const auto mm = [](double m) { return 1e3 * m; };
-    std::printf("## Overshoot on the neonatal tongue (%.0fx the device's peak force, hold 5 s)\n\n", choices.factor);
+    std::printf("## Overshoot on the neonatal tongue (%.0fx the device's peak force, hold 5 s)\n\n",
+                choices.factor);
     std::printf("| figure | force-aware | penalty |\n|---|---:|---:|\n");
     std::printf("| device limit (peak renderable) N | %.2f | %.2f |\n", fa.limit_n, pe.limit_n);
-    std::printf("| largest commanded force N | %.2f | %.2f |\n", fa.max_commanded_n, pe.max_commanded_n);
-    std::printf("| largest tissue reaction N | %.3f | %.3f |\n", fa.max_reaction_n, pe.max_reaction_n);
-    std::printf("| largest reaction / limit while lost track | %.4f | - |\n", fa.max_reaction_lost_ratio);
-    std::printf("| lost-track ticks | %llu | - |\n", static_cast<unsigned long long>(fa.lost_ticks));
-    std::printf("| max Green strain at 1x / at the end of the hold | %.3f / %.3f | - / %.3f |\n", fa.strain_1x,
-                fa.strain_3x, pe.strain_3x);
-    std::printf("| largest published-gap error mm (lost-track ticks at the peak limit) | %.3f (%llu) | - |\n",
-                mm(fa.max_gap_error_m), static_cast<unsigned long long>(fa.lost_ticks_at_peak));
-    std::printf("| held proxy's largest distance from where it froze mm | %.3f | - |\n", mm(fa.max_held_drift_m));
+    std::printf("| largest commanded force N | %.2f | %.2f |\n", fa.max_commanded_n,
+                pe.max_commanded_n);
+    std::printf("| largest tissue reaction N | %.3f | %.3f |\n", fa.max_reaction_n,
+                pe.max_reaction_n);
+    std::printf("| largest reaction / limit while lost track | %.4f | - |\n",
+                fa.max_reaction_lost_ratio);
+    std::printf("| lost-track ticks | %llu | - |\n",
+                static_cast<unsigned long long>(fa.lost_ticks));
+    std::printf("| max Green strain at 1x / at the end of the hold | %.3f / %.3f | - / %.3f |\n",
+                fa.strain_1x, fa.strain_3x, pe.strain_3x);
+    std::printf(
+        "| largest published-gap error mm (lost-track ticks at the peak limit) | %.3f (%llu) | - "
+        "|\n",
+        mm(fa.max_gap_error_m), static_cast<unsigned long long>(fa.lost_ticks_at_peak));
+    std::printf("| held proxy's largest distance from where it froze mm | %.3f | - |\n",
+                mm(fa.max_held_drift_m));
     std::printf("| largest force step in 50 ms of re-engagement N (bound) | %.3f (%.3f) | - |\n",
                 fa.max_reengage_step_n, fa.reengage_bound_n);
-    std::printf("| deepest tool penetration mm | %.2f | %.2f |\n", mm(fa.max_penetration_m), mm(pe.max_penetration_m));
-    std::printf("| deepest tongue node into the anatomy before the FEM moved it out mm | %.2f | %.2f |\n",
-                mm(fa.max_anatomy_depth_m), mm(pe.max_anatomy_depth_m));
+    std::printf("| deepest tool penetration mm | %.2f | %.2f |\n", mm(fa.max_penetration_m),
+                mm(pe.max_penetration_m));
+    std::printf(
+        "| deepest tongue node into the anatomy before the FEM moved it out mm | %.2f | %.2f |\n",
+        mm(fa.max_anatomy_depth_m), mm(pe.max_anatomy_depth_m));
     std::printf("| most inverted tets | %d | %d |\n", fa.max_inverted, pe.max_inverted);
-    std::printf("| largest elastic energy mJ | %.2f | %.2f |\n", 1e3 * fa.max_elastic_j, 1e3 * pe.max_elastic_j);
-    std::printf("| tongue displacement 1 s after the blade left mm | %.2f | %.2f |\n", mm(fa.displacement_after_m),
-                mm(pe.displacement_after_m));
+    std::printf("| largest elastic energy mJ | %.2f | %.2f |\n", 1e3 * fa.max_elastic_j,
+                1e3 * pe.max_elastic_j);
+    std::printf("| tongue displacement 1 s after the blade left mm | %.2f | %.2f |\n",
+                mm(fa.displacement_after_m), mm(pe.displacement_after_m));
     std::printf("| all finite | %s | %s |\n", fa.finite ? "yes" : "no", pe.finite ? "yes" : "no");
     std::printf("| FEM steps that diverged (tongue reset to rest) | %llu | %llu |\n",
-                static_cast<unsigned long long>(fa.divergence_resets), static_cast<unsigned long long>(pe.divergence_resets));
-    std::printf("| FEM: nodes let back through a bone / node-steps beyond a bone | %llu / %llu | %llu / %llu |\n",
-                static_cast<unsigned long long>(fa.anatomy_returned), static_cast<unsigned long long>(fa.anatomy_beyond_steps),
-                static_cast<unsigned long long>(pe.anatomy_returned), static_cast<unsigned long long>(pe.anatomy_beyond_steps));
+                static_cast<unsigned long long>(fa.divergence_resets),
+                static_cast<unsigned long long>(pe.divergence_resets));
+    std::printf(
+        "| FEM: nodes let back through a bone / node-steps beyond a bone | %llu / %llu | %llu / "
+        "%llu |\n",
+        static_cast<unsigned long long>(fa.anatomy_returned),
+        static_cast<unsigned long long>(fa.anatomy_beyond_steps),
+        static_cast<unsigned long long>(pe.anatomy_returned),
+        static_cast<unsigned long long>(pe.anatomy_beyond_steps));
     std::printf("| wall time s | %.1f | %.1f |\n", fa.wall_s, pe.wall_s);
-    std::printf("| base step with a FEM step (FEM + haptic tick + digest) ms mean / max | %.2f / %.2f | %.2f / %.2f |\n",
-                fa.fem_base_step_mean_ms, fa.fem_base_step_max_ms, pe.fem_base_step_mean_ms, pe.fem_base_step_max_ms);
-    std::printf("| FEM step CPU ms median / p99 / max (period %.1f) | %.2f / %.2f / %.2f | %.2f / %.2f / %.2f |\n",
-                1e3 / scene->rates.fem_hz, fa.fem_cpu_median_ms, fa.fem_cpu_p99_ms, fa.fem_cpu_max_ms,
-                pe.fem_cpu_median_ms, pe.fem_cpu_p99_ms, pe.fem_cpu_max_ms);
+    std::printf(
+        "| base step with a FEM step (FEM + haptic tick + digest) ms mean / max | %.2f / %.2f | "
+        "%.2f / %.2f |\n",
+        fa.fem_base_step_mean_ms, fa.fem_base_step_max_ms, pe.fem_base_step_mean_ms,
+        pe.fem_base_step_max_ms);
+    std::printf(
+        "| FEM step CPU ms median / p99 / max (period %.1f) | %.2f / %.2f / %.2f | %.2f / %.2f / "
+        "%.2f |\n",
+        1e3 / scene->rates.fem_hz, fa.fem_cpu_median_ms, fa.fem_cpu_p99_ms, fa.fem_cpu_max_ms,
+        pe.fem_cpu_median_ms, pe.fem_cpu_p99_ms, pe.fem_cpu_max_ms);
     for (const auto& body : scene->bodies) {
       if (!body.deformable) continue;
       const auto& m = body.deformable->material;
-      const double stiffening = choices.stiffening >= 0.0 ? choices.stiffening : m.yeoh_c20_over_c10;
+      const double stiffening =
+          choices.stiffening >= 0.0 ? choices.stiffening : m.yeoh_c20_over_c10;
       std::printf("\ntongue material: E %.0f Pa, Yeoh C20/C10 %.2f (compression stiffening%s)\n",
                   choices.youngs_pa > 0.0 ? choices.youngs_pa : m.youngs_modulus_pa, stiffening,
                   stiffening > 0.0 ? "" : " off");
@@ -602,13 +682,19 @@ int main(int argc, char** argv) {
       std::printf("%s: %s\n", ok ? "ok" : "FAIL", what);
       failures += ok ? 0 : 1;
     };
-    expect(fa.finite && fa.divergence_resets == 0, "force-aware: every force and gap finite, no FEM step diverged");
+    expect(fa.finite && fa.divergence_resets == 0,
+           "force-aware: every force and gap finite, no FEM step diverged");
     expect(fa.max_inverted == 0, "force-aware: no inverted tet");
     expect(fa.lost_ticks > 0, "force-aware: the hand pushed past the limit (lost track)");
-    expect(fa.max_reaction_lost_ratio <= 1.05, "force-aware: reaction <= 1.05 x limit while lost track");
-    expect(fa.strain_3x <= fa.strain_1x * 1.05 + 1e-3, "force-aware: no strain growth from 1x to 3x");
-    expect(fa.max_gap_error_m <= 1e-4, "force-aware: published gap = (commanded - limit) / K_c within 0.1 mm at the peak limit");
-    expect(fa.max_reengage_step_n <= fa.reengage_bound_n + 1e-9, "force-aware: re-engagement force step within the bound");
+    expect(fa.max_reaction_lost_ratio <= 1.05,
+           "force-aware: reaction <= 1.05 x limit while lost track");
+    expect(fa.strain_3x <= fa.strain_1x * 1.05 + 1e-3,
+           "force-aware: no strain growth from 1x to 3x");
+    expect(
+        fa.max_gap_error_m <= 1e-4,
+        "force-aware: published gap = (commanded - limit) / K_c within 0.1 mm at the peak limit");
+    expect(fa.max_reengage_step_n <= fa.reengage_bound_n + 1e-9,
+           "force-aware: re-engagement force step within the bound");
     expect(fa.displacement_after_m >= 0.0 && fa.displacement_after_m <= 1e-3,
            "force-aware: tongue within 1 mm of rest 1 s after the blade left it");
     return failures == 0 ? 0 : 1;

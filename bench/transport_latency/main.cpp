@@ -47,7 +47,8 @@ std::vector<std::string> split(const std::string& text) {
 int run_pong(Vendor vendor, std::uint32_t domain, const std::string& size) {
   const Payload payload = payload_named(size);
   auto transport = make_transport_echo(vendor, domain, payload);
-  auto raw = vendor == Vendor::kFastDds ? make_raw_fast_echo(domain, payload) : make_raw_cyclone_echo(domain, payload);
+  auto raw = vendor == Vendor::kFastDds ? make_raw_fast_echo(domain, payload)
+                                        : make_raw_cyclone_echo(domain, payload);
   // Until the parent closes our stdin (or ten minutes pass).
   char c = 0;
   while (read(STDIN_FILENO, &c, 1) > 0) {
@@ -124,7 +125,8 @@ bool warm_up(PingPath& path, std::uint64_t& id) {
   return false;
 }
 
-void time_block(PingPath& path, std::uint64_t& id, int n, std::vector<std::int64_t>& rtt_ns, int& lost) {
+void time_block(PingPath& path, std::uint64_t& id, int n, std::vector<std::int64_t>& rtt_ns,
+                int& lost) {
   for (int i = 0; i < n; ++i) {
     const std::int64_t start = common::monotonic_now_ns();
     path.ping(++id);
@@ -136,10 +138,11 @@ void time_block(PingPath& path, std::uint64_t& id, int n, std::vector<std::int64
   }
 }
 
-void print_row(const Payload& payload, const std::string& pair, const char* path, const Stats& s, int lost,
-               double ratio) {
-  std::printf("| %-19s | %-21s | %-9s | %6zu | %8.1f | %8.1f | %8.1f | %9.1f | %5d |", payload.name.c_str(),
-              pair.c_str(), path, s.count, s.median_us, s.p99_us, s.p999_us, s.max_us, lost);
+void print_row(const Payload& payload, const std::string& pair, const char* path, const Stats& s,
+               int lost, double ratio) {
+  std::printf("| %-19s | %-21s | %-9s | %6zu | %8.1f | %8.1f | %8.1f | %9.1f | %5d |",
+              payload.name.c_str(), pair.c_str(), path, s.count, s.median_us, s.p99_us, s.p999_us,
+              s.max_us, lost);
   if (ratio > 0) {
     std::printf(" %5.2f |\n", ratio);
   } else {
@@ -150,7 +153,9 @@ void print_row(const Payload& payload, const std::string& pair, const char* path
 
 int run_benchmark(int round_trips, int large_round_trips, const std::vector<std::string>& sizes,
                   const std::vector<std::string>& pairs) {
-  std::printf("| payload             | ping -> pong          | path      | trips  | median us | p99 us | p99.9 us | max us | lost | transport/raw median |\n");
+  std::printf(
+      "| payload             | ping -> pong          | path      | trips  | median us | p99 us | "
+      "p99.9 us | max us | lost | transport/raw median |\n");
   std::printf("|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
   std::uint32_t domain = 60;
   for (const auto& size : sizes) {
@@ -159,8 +164,8 @@ int run_benchmark(int round_trips, int large_round_trips, const std::vector<std:
     for (const auto& pair : pairs) {
       const Vendor ping_vendor = pair[0] == 'f' ? Vendor::kFastDds : Vendor::kCyclone;
       const Vendor pong_vendor = pair[1] == 'f' ? Vendor::kFastDds : Vendor::kCyclone;
-      const std::string pair_name =
-          std::string(common::vendor_name(ping_vendor)) + " -> " + std::string(common::vendor_name(pong_vendor));
+      const std::string pair_name = std::string(common::vendor_name(ping_vendor)) + " -> " +
+                                    std::string(common::vendor_name(pong_vendor));
       ++domain;
       PongProcess pong(pong_vendor, domain, size);
       auto transport = make_transport_ping(ping_vendor, domain, payload);
@@ -168,7 +173,8 @@ int run_benchmark(int round_trips, int large_round_trips, const std::vector<std:
                                                  : make_raw_cyclone_ping(domain, payload);
       std::uint64_t id = 0;
       if (!warm_up(*transport, id) || !warm_up(*raw, id)) {
-        std::printf("| %s | %s | no echo: pong side never answered |\n", payload.name.c_str(), pair_name.c_str());
+        std::printf("| %s | %s | no echo: pong side never answered |\n", payload.name.c_str(),
+                    pair_name.c_str());
         continue;
       }
       // Interleave blocks so both paths see the same machine load.
@@ -181,7 +187,8 @@ int run_benchmark(int round_trips, int large_round_trips, const std::vector<std:
       }
       const Stats t = stats_of(transport_ns);
       const Stats r = stats_of(raw_ns);
-      print_row(payload, pair_name, "transport", t, transport_lost, r.median_us > 0 ? t.median_us / r.median_us : 0);
+      print_row(payload, pair_name, "transport", t, transport_lost,
+                r.median_us > 0 ? t.median_us / r.median_us : 0);
       print_row(payload, pair_name, "raw", r, raw_lost, 0);
     }
   }
@@ -216,5 +223,6 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  return bench::run_benchmark(round_trips, large_round_trips, bench::split(sizes), bench::split(pairs));
+  return bench::run_benchmark(round_trips, large_round_trips, bench::split(sizes),
+                              bench::split(pairs));
 }

@@ -40,8 +40,10 @@ class EchoPath {
   virtual ~EchoPath() = default;
 };
 
-std::unique_ptr<PingPath> make_transport_ping(common::Vendor vendor, std::uint32_t domain, const Payload& payload);
-std::unique_ptr<EchoPath> make_transport_echo(common::Vendor vendor, std::uint32_t domain, const Payload& payload);
+std::unique_ptr<PingPath> make_transport_ping(common::Vendor vendor, std::uint32_t domain,
+                                              const Payload& payload);
+std::unique_ptr<EchoPath> make_transport_echo(common::Vendor vendor, std::uint32_t domain,
+                                              const Payload& payload);
 std::unique_ptr<PingPath> make_raw_fast_ping(std::uint32_t domain, const Payload& payload);
 std::unique_ptr<EchoPath> make_raw_fast_echo(std::uint32_t domain, const Payload& payload);
 std::unique_ptr<PingPath> make_raw_cyclone_ping(std::uint32_t domain, const Payload& payload);

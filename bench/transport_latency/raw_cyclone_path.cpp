@@ -14,10 +14,18 @@
 namespace fahr::bench {
 namespace {
 
-std::uint64_t id_of(const fahr_msg_DevicePose& s) { return s.servo_tick; }
-std::uint64_t id_of(const fahr_msg_DeformationState& s) { return s.step; }
-void set_id(fahr_msg_DevicePose& s, std::uint64_t id) { s.servo_tick = id; }
-void set_id(fahr_msg_DeformationState& s, std::uint64_t id) { s.step = id; }
+std::uint64_t id_of(const fahr_msg_DevicePose& s) {
+  return s.servo_tick;
+}
+std::uint64_t id_of(const fahr_msg_DeformationState& s) {
+  return s.step;
+}
+void set_id(fahr_msg_DevicePose& s, std::uint64_t id) {
+  s.servo_tick = id;
+}
+void set_id(fahr_msg_DeformationState& s, std::uint64_t id) {
+  s.step = id;
+}
 
 template <class T>
 const dds_topic_descriptor_t& descriptor();
@@ -42,8 +50,10 @@ class RawCycloneEndpoint {
     dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
     dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-    const dds_entity_t out = dds_create_topic(participant_, &descriptor<T>(), out_topic, nullptr, nullptr);
-    const dds_entity_t in = dds_create_topic(participant_, &descriptor<T>(), in_topic, nullptr, nullptr);
+    const dds_entity_t out =
+        dds_create_topic(participant_, &descriptor<T>(), out_topic, nullptr, nullptr);
+    const dds_entity_t in =
+        dds_create_topic(participant_, &descriptor<T>(), in_topic, nullptr, nullptr);
     writer_ = dds_create_writer(participant_, out, qos, nullptr);
     in_topic_ = in;
     qos_ = qos;
@@ -88,14 +98,17 @@ class RawCycloneEndpoint {
 template <class T>
 class RawCyclonePing final : public PingPath, private RawCycloneEndpoint<T> {
  public:
-  RawCyclonePing(std::uint32_t domain, const Payload& payload) : RawCycloneEndpoint<T>(domain, kRawPing, kRawPong) {
+  RawCyclonePing(std::uint32_t domain, const Payload& payload)
+      : RawCycloneEndpoint<T>(domain, kRawPing, kRawPong) {
     if constexpr (std::is_same_v<T, fahr_msg_DeformationState>) {
       positions_.assign(payload.payload_bytes / 8, 0.5F);
       velocities_.assign(payload.payload_bytes / 8, -0.5F);
       sample_.positions_m = {static_cast<std::uint32_t>(positions_.size()),
-                             static_cast<std::uint32_t>(positions_.size()), positions_.data(), false};
+                             static_cast<std::uint32_t>(positions_.size()), positions_.data(),
+                             false};
       sample_.velocities_mps = {static_cast<std::uint32_t>(velocities_.size()),
-                                static_cast<std::uint32_t>(velocities_.size()), velocities_.data(), false};
+                                static_cast<std::uint32_t>(velocities_.size()), velocities_.data(),
+                                false};
     }
     this->start_reading();
   }
@@ -104,7 +117,9 @@ class RawCyclonePing final : public PingPath, private RawCycloneEndpoint<T> {
     set_id(sample_, id);
     this->write(sample_);
   }
-  bool wait_echo(std::uint64_t id, std::chrono::milliseconds timeout) override { return waiter_.wait(id, timeout); }
+  bool wait_echo(std::uint64_t id, std::chrono::milliseconds timeout) override {
+    return waiter_.wait(id, timeout);
+  }
 
  private:
   void on_sample(const T& sample) override { waiter_.arrived(id_of(sample)); }
@@ -117,7 +132,8 @@ class RawCyclonePing final : public PingPath, private RawCycloneEndpoint<T> {
 template <class T>
 class RawCycloneEcho final : public EchoPath, private RawCycloneEndpoint<T> {
  public:
-  explicit RawCycloneEcho(std::uint32_t domain) : RawCycloneEndpoint<T>(domain, kRawPong, kRawPing) {
+  explicit RawCycloneEcho(std::uint32_t domain)
+      : RawCycloneEndpoint<T>(domain, kRawPong, kRawPing) {
     this->start_reading();
   }
   ~RawCycloneEcho() override { this->stop_reading(); }

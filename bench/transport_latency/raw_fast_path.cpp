@@ -10,7 +10,6 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-
 #include <functional>
 #include <stdexcept>
 
@@ -24,10 +23,18 @@ namespace {
 
 namespace dds = eprosima::fastdds::dds;
 
-std::uint64_t id_of(const msg::DevicePose& s) { return s.servo_tick(); }
-std::uint64_t id_of(const msg::DeformationState& s) { return s.step(); }
-void set_id(msg::DevicePose& s, std::uint64_t id) { s.servo_tick(id); }
-void set_id(msg::DeformationState& s, std::uint64_t id) { s.step(id); }
+std::uint64_t id_of(const msg::DevicePose& s) {
+  return s.servo_tick();
+}
+std::uint64_t id_of(const msg::DeformationState& s) {
+  return s.step();
+}
+void set_id(msg::DevicePose& s, std::uint64_t id) {
+  s.servo_tick(id);
+}
+void set_id(msg::DeformationState& s, std::uint64_t id) {
+  s.step(id);
+}
 
 // A participant with one writer and one reader whose listener hands every
 // sample to `on_sample`.
@@ -100,7 +107,9 @@ class RawFastPing final : public PingPath {
     set_id(sample_, id);
     endpoint_.write(sample_);
   }
-  bool wait_echo(std::uint64_t id, std::chrono::milliseconds timeout) override { return waiter_.wait(id, timeout); }
+  bool wait_echo(std::uint64_t id, std::chrono::milliseconds timeout) override {
+    return waiter_.wait(id, timeout);
+  }
 
  private:
   EchoWaiter waiter_;
@@ -121,13 +130,18 @@ class RawFastEcho final : public EchoPath {
 }  // namespace
 
 std::unique_ptr<PingPath> make_raw_fast_ping(std::uint32_t domain, const Payload& payload) {
-  if (payload.small) return std::make_unique<RawFastPing<msg::DevicePose, msg::DevicePosePubSubType>>(domain, payload);
-  return std::make_unique<RawFastPing<msg::DeformationState, msg::DeformationStatePubSubType>>(domain, payload);
+  if (payload.small)
+    return std::make_unique<RawFastPing<msg::DevicePose, msg::DevicePosePubSubType>>(domain,
+                                                                                     payload);
+  return std::make_unique<RawFastPing<msg::DeformationState, msg::DeformationStatePubSubType>>(
+      domain, payload);
 }
 
 std::unique_ptr<EchoPath> make_raw_fast_echo(std::uint32_t domain, const Payload& payload) {
-  if (payload.small) return std::make_unique<RawFastEcho<msg::DevicePose, msg::DevicePosePubSubType>>(domain);
-  return std::make_unique<RawFastEcho<msg::DeformationState, msg::DeformationStatePubSubType>>(domain);
+  if (payload.small)
+    return std::make_unique<RawFastEcho<msg::DevicePose, msg::DevicePosePubSubType>>(domain);
+  return std::make_unique<RawFastEcho<msg::DeformationState, msg::DeformationStatePubSubType>>(
+      domain);
 }
 
 }  // namespace fahr::bench

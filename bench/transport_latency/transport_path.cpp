@@ -24,10 +24,18 @@ common::TransportConfig config_for(common::Vendor vendor, std::uint32_t domain) 
   return config;
 }
 
-std::uint64_t id_of(const msg::DevicePose& s) { return s.servo_tick(); }
-std::uint64_t id_of(const msg::DeformationState& s) { return s.step(); }
-void set_id(msg::DevicePose& s, std::uint64_t id) { s.servo_tick(id); }
-void set_id(msg::DeformationState& s, std::uint64_t id) { s.step(id); }
+std::uint64_t id_of(const msg::DevicePose& s) {
+  return s.servo_tick();
+}
+std::uint64_t id_of(const msg::DeformationState& s) {
+  return s.step();
+}
+void set_id(msg::DevicePose& s, std::uint64_t id) {
+  s.servo_tick(id);
+}
+void set_id(msg::DeformationState& s, std::uint64_t id) {
+  s.step(id);
+}
 void size(msg::DevicePose&, std::size_t) {}
 void size(msg::DeformationState& s, std::size_t bytes) {
   s.positions_m().assign(bytes / 8, 0.5F);
@@ -41,14 +49,18 @@ class TransportPing final : public PingPath {
       : participant_(config_for(vendor, domain)),
         pub_(participant_, bench_qos(), kTransportPing),
         sub_(participant_, bench_qos(), kTransportPong,
-             [this](const T& sample, const common::SampleInfo&) { waiter_.arrived(id_of(sample)); }) {
+             [this](const T& sample, const common::SampleInfo&) {
+               waiter_.arrived(id_of(sample));
+             }) {
     size(sample_, payload.payload_bytes);
   }
   void ping(std::uint64_t id) override {
     set_id(sample_, id);
     pub_.write(sample_);
   }
-  bool wait_echo(std::uint64_t id, std::chrono::milliseconds timeout) override { return waiter_.wait(id, timeout); }
+  bool wait_echo(std::uint64_t id, std::chrono::milliseconds timeout) override {
+    return waiter_.wait(id, timeout);
+  }
 
  private:
   EchoWaiter waiter_;
@@ -64,10 +76,11 @@ class TransportEcho final : public EchoPath {
   TransportEcho(common::Vendor vendor, std::uint32_t domain)
       : participant_(config_for(vendor, domain)),
         pub_(participant_, bench_qos(), kTransportPong),
-        sub_(participant_, bench_qos(), kTransportPing, [this](const T& sample, const common::SampleInfo&) {
-          echo_ = sample;  // reuses capacity after the first
-          pub_.write(echo_);
-        }) {}
+        sub_(participant_, bench_qos(), kTransportPing,
+             [this](const T& sample, const common::SampleInfo&) {
+               echo_ = sample;  // reuses capacity after the first
+               pub_.write(echo_);
+             }) {}
 
  private:
   T echo_;
@@ -78,12 +91,15 @@ class TransportEcho final : public EchoPath {
 
 }  // namespace
 
-std::unique_ptr<PingPath> make_transport_ping(common::Vendor vendor, std::uint32_t domain, const Payload& payload) {
-  if (payload.small) return std::make_unique<TransportPing<msg::DevicePose>>(vendor, domain, payload);
+std::unique_ptr<PingPath> make_transport_ping(common::Vendor vendor, std::uint32_t domain,
+                                              const Payload& payload) {
+  if (payload.small)
+    return std::make_unique<TransportPing<msg::DevicePose>>(vendor, domain, payload);
   return std::make_unique<TransportPing<msg::DeformationState>>(vendor, domain, payload);
 }
 
-std::unique_ptr<EchoPath> make_transport_echo(common::Vendor vendor, std::uint32_t domain, const Payload& payload) {
+std::unique_ptr<EchoPath> make_transport_echo(common::Vendor vendor, std::uint32_t domain,
+                                              const Payload& payload) {
   if (payload.small) return std::make_unique<TransportEcho<msg::DevicePose>>(vendor, domain);
   return std::make_unique<TransportEcho<msg::DeformationState>>(vendor, domain);
 }

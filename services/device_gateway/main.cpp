@@ -15,12 +15,12 @@
 #include <thread>
 #include <vector>
 
-#include "fahr/common/stop_signal.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/config_error.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/participant.h"
 #include "fahr/common/publisher.h"
+#include "fahr/common/stop_signal.h"
 #include "fahr/common/subscriber.h"
 #include "fahr/device/recording.h"
 #include "fahr/device/remote_input_backend.h"
@@ -30,16 +30,15 @@
 #ifdef FAHR_HAVE_OPENHAPTICS
 #include "fahr/device/openhaptics_backend.h"
 #endif
+#include "fahr/common/service_reporter.h"
 #include "fahr/gateway_service/gateway_options.h"
 #include "fahr/gateway_service/msg_conversion.h"
-#include "fahr/common/service_reporter.h"
 #include "fahr/gateway_service/status_reporter.h"
 
 namespace fahr::gateway_service {
 namespace {
 
 using namespace std::chrono_literals;
-
 
 // The remote-input topic (the browser's mouse device publishes DevicePose there).
 constexpr std::string_view kRemoteInputTopic = "fahr/RemoteInput";
@@ -57,7 +56,8 @@ struct Setup {
 std::optional<Setup> make_setup(const GatewayOptions& o) {
   Setup s;
   if (!device::model_by_name(o.model, s.config.model)) {
-    std::fprintf(stderr, "fahr_device_gateway: --model: unknown device '%s' (touch_x, touch)\n", o.model.c_str());
+    std::fprintf(stderr, "fahr_device_gateway: --model: unknown device '%s' (touch_x, touch)\n",
+                 o.model.c_str());
     return std::nullopt;
   }
   s.duration_s = o.duration_s;
@@ -65,21 +65,24 @@ std::optional<Setup> make_setup(const GatewayOptions& o) {
     device::Script script = device::Script::kIntubation;
     device::script_by_name(o.script, script);
     const device::HandImpedance hand;
-    auto trajectory = script == device::Script::kIntubation
-                          ? device::intubation_script()
-                          : device::overshoot_script(s.config.model.peak_force_n, hand.stiffness_npm);
+    auto trajectory =
+        script == device::Script::kIntubation
+            ? device::intubation_script()
+            : device::overshoot_script(s.config.model.peak_force_n, hand.stiffness_npm);
     if (s.duration_s == 0.0) s.duration_s = trajectory.duration().count();
-    s.backend = std::make_unique<device::SimulatedBackend>(std::move(trajectory), hand, s.config.model,
-                                                           s.config.mapping, s.config.period);
+    s.backend = std::make_unique<device::SimulatedBackend>(
+        std::move(trajectory), hand, s.config.model, s.config.mapping, s.config.period);
   } else if (o.backend == "replay") {
     device::Recording recording;
-    if (const std::string error = device::read_recording(o.replay_file, recording); !error.empty()) {
+    if (const std::string error = device::read_recording(o.replay_file, recording);
+        !error.empty()) {
       std::fprintf(stderr, "fahr_device_gateway: --replay-file: %s\n", error.c_str());
       return std::nullopt;
     }
     if (s.duration_s == 0.0 && !recording.samples.empty()) {
       s.duration_s = 1e-9 * static_cast<double>(recording.samples.back().device_time_ns -
-                                                recording.samples.front().device_time_ns) + 1e-3;
+                                                recording.samples.front().device_time_ns) +
+                     1e-3;
     }
     s.backend = std::make_unique<device::ReplayBackend>(std::move(recording));
   } else if (o.backend == "remote") {
@@ -88,10 +91,13 @@ std::optional<Setup> make_setup(const GatewayOptions& o) {
     s.backend = std::move(remote);
   } else {
 #ifdef FAHR_HAVE_OPENHAPTICS
-    std::fprintf(stderr, "fahr_device_gateway: the OpenHaptics servo loop runs in the HD scheduler; "
-                         "use --mode realtime (not wired to the HD scheduler in this build yet)\n");
+    std::fprintf(stderr,
+                 "fahr_device_gateway: the OpenHaptics servo loop runs in the HD scheduler; "
+                 "use --mode realtime (not wired to the HD scheduler in this build yet)\n");
 #else
-    std::fprintf(stderr, "fahr_device_gateway: built without OpenHaptics (HD/hd.h and libHD not found by CMake)\n");
+    std::fprintf(
+        stderr,
+        "fahr_device_gateway: built without OpenHaptics (HD/hd.h and libHD not found by CMake)\n");
 #endif
     return std::nullopt;
   }
@@ -103,13 +109,15 @@ void try_realtime(int priority) {
   // Opt-in: lock memory (no page faults in the loop) and run SCHED_FIFO.
   // Both need privileges; without them the loop runs as a normal thread.
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    std::fprintf(stderr, "fahr_device_gateway: mlockall failed (%s): continuing unlocked\n", std::strerror(errno));
+    std::fprintf(stderr, "fahr_device_gateway: mlockall failed (%s): continuing unlocked\n",
+                 std::strerror(errno));
   }
   sched_param param{};
   param.sched_priority = priority;
   if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
-    std::fprintf(stderr, "fahr_device_gateway: SCHED_FIFO %d refused (%s): continuing at normal priority\n", priority,
-                 std::strerror(errno));
+    std::fprintf(stderr,
+                 "fahr_device_gateway: SCHED_FIFO %d refused (%s): continuing at normal priority\n",
+                 priority, std::strerror(errno));
   } else {
     std::fprintf(stderr, "fahr_device_gateway: running SCHED_FIFO priority %d\n", priority);
   }
@@ -119,7 +127,8 @@ void try_realtime(int priority) {
 void wait_until(std::int64_t deadline_ns, std::int64_t spin_ns) {
   const std::int64_t sleep_until_ns = deadline_ns - spin_ns;
   const std::int64_t now_ns = common::monotonic_now_ns();
-  if (sleep_until_ns > now_ns) std::this_thread::sleep_for(std::chrono::nanoseconds(sleep_until_ns - now_ns));
+  if (sleep_until_ns > now_ns)
+    std::this_thread::sleep_for(std::chrono::nanoseconds(sleep_until_ns - now_ns));
   while (common::monotonic_now_ns() < deadline_ns) {
   }
 }
@@ -149,18 +158,20 @@ void fill_snapshot(const device::ServoCore& core, const Setup& setup, LoopState&
 void after_tick(const device::DevicePoseSample& pose, std::uint64_t written_seq, LoopState& state) {
   if (written_seq != pose.seq) ++state.seq_mismatches;
   state.snapshot.safety_state = pose.safety_state;
-  if (state.recording && state.recorded.size() < state.recorded.capacity()) state.recorded.push_back(pose);
+  if (state.recording && state.recorded.size() < state.recorded.capacity())
+    state.recorded.push_back(pose);
 }
 
-int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& participant, GatewayMetrics& metrics, common::TickRecorder& recorder,
-                 LoopState& state) {
+int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& participant,
+                 GatewayMetrics& metrics, common::TickRecorder& recorder, LoopState& state) {
   device::ServoCore core(setup.config, *setup.backend);
   common::Publisher<msg::DevicePose> pose_pub(participant);
   common::Subscriber<msg::ForceCommand> command_sub(participant);
   std::unique_ptr<common::Subscriber<msg::DevicePose>> remote_sub;
   if (setup.remote != nullptr) {
     remote_sub = std::make_unique<common::Subscriber<msg::DevicePose>>(
-        participant, common::QosProfile::for_role(common::TopicRole::kServoStream), kRemoteInputTopic);
+        participant, common::QosProfile::for_role(common::TopicRole::kServoStream),
+        kRemoteInputTopic);
   }
   try_realtime(o.rt_priority);
   msg::DevicePose pose_msg;
@@ -171,7 +182,8 @@ int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& par
   const auto total_ticks = static_cast<std::uint64_t>(setup.duration_s * 1000.0);
   const std::int64_t start_ns = common::monotonic_now_ns();
   std::int64_t deadline_ns = start_ns;
-  for (std::uint64_t tick = 0; !common::stop_requested() && (total_ticks == 0 || tick < total_ticks); ++tick) {
+  for (std::uint64_t tick = 0;
+       !common::stop_requested() && (total_ticks == 0 || tick < total_ticks); ++tick) {
     // --- the servo tick: no allocation, blocking or logging from here ...
     const std::int64_t tick_start_ns = common::monotonic_now_ns();
     const std::int64_t cpu_start_ns = common::thread_cpu_now_ns();
@@ -206,12 +218,14 @@ int run_realtime(const GatewayOptions& o, Setup& setup, common::Participant& par
   return 0;
 }
 
-int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& participant, GatewayMetrics& metrics, common::TickRecorder& recorder,
-                 LoopState& state) {
+int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& participant,
+                 GatewayMetrics& metrics, common::TickRecorder& recorder, LoopState& state) {
   device::ServoCore core(setup.config, *setup.backend);
-  common::Publisher<msg::DevicePose> pose_pub(participant, common::lockstep_output_qos<msg::DevicePose>());
+  common::Publisher<msg::DevicePose> pose_pub(participant,
+                                              common::lockstep_output_qos<msg::DevicePose>());
   std::unique_ptr<common::StepInput<msg::ForceCommand>> input;
-  if (o.force_input_period > 0) input = std::make_unique<common::StepInput<msg::ForceCommand>>(participant);
+  if (o.force_input_period > 0)
+    input = std::make_unique<common::StepInput<msg::ForceCommand>>(participant);
   common::LockstepClient client(participant, "device_gateway");
   client.join();
   common::OutputHash hash;
@@ -219,7 +233,9 @@ int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& par
   device::ForceCommandSample command;
   std::uint64_t last_command_seq = 0;
   const auto total_ticks = static_cast<std::uint64_t>(setup.duration_s * 1000.0);
-  for (std::uint64_t k = 0; !common::stop_requested() && (total_ticks == 0 || k < total_ticks) && client.wait_for_grant(k, 20s); ++k) {
+  for (std::uint64_t k = 0; !common::stop_requested() && (total_ticks == 0 || k < total_ticks) &&
+                            client.wait_for_grant(k, 20s);
+       ++k) {
     const std::int64_t tick_start_ns = common::monotonic_now_ns();
     const std::int64_t cpu_start_ns = common::thread_cpu_now_ns();
     const device::ForceCommandSample* incoming = nullptr;
@@ -239,7 +255,8 @@ int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& par
         }
       }
     }
-    const auto& pose = core.tick(std::chrono::nanoseconds(setup.config.period * static_cast<std::int64_t>(k)), incoming);
+    const auto& pose = core.tick(
+        std::chrono::nanoseconds(setup.config.period * static_cast<std::int64_t>(k)), incoming);
     to_msg(pose, o.device_id, pose_msg);
     pose_msg.header().sim_step(k);
     pose_msg.header().sim_time_ns(pose.device_time_ns);
@@ -256,7 +273,8 @@ int run_lockstep(const GatewayOptions& o, Setup& setup, common::Participant& par
   }
   fill_snapshot(core, setup, state);
   metrics.offer(state.snapshot);
-  std::printf("lockstep: %llu steps, DevicePose hash %016llx\n", static_cast<unsigned long long>(core.ticks()),
+  std::printf("lockstep: %llu steps, DevicePose hash %016llx\n",
+              static_cast<unsigned long long>(core.ticks()),
               static_cast<unsigned long long>(hash.value()));
   return 0;
 }
@@ -267,14 +285,15 @@ int run(int argc, char** argv) {
   auto setup = make_setup(*options);
   if (!setup) return 2;
   common::install_stop_handlers();
-  common::Participant participant(
-      common::transport_config_from(options->dds, options->domain, options->profile, "device_gateway"));
+  common::Participant participant(common::transport_config_from(
+      options->dds, options->domain, options->profile, "device_gateway"));
   common::TickRecorder recorder;
   GatewayMetrics metrics;
   common::ServiceReporter reporter(
       participant,
-      {"device_gateway", 1000.0, std::chrono::milliseconds(static_cast<long>(1000.0 / options->status_hz))}, recorder,
-      [&metrics](auto& figures) { metrics.fill(figures); });
+      {"device_gateway", 1000.0,
+       std::chrono::milliseconds(static_cast<long>(1000.0 / options->status_hz))},
+      recorder, [&metrics](auto& figures) { metrics.fill(figures); });
   LoopState state;
   if (!options->record_file.empty()) {
     const double seconds = setup->duration_s > 0.0 ? setup->duration_s : kMaxRecordedSeconds;
@@ -282,8 +301,9 @@ int run(int argc, char** argv) {
     state.recording = true;
   }
   std::fprintf(stderr, "fahr_device_gateway: %s, backend %s, model %s, %s, %.1f s\n",
-               std::string(common::vendor_name(participant.vendor())).c_str(), options->backend.c_str(),
-               setup->config.model.name.c_str(), options->mode.c_str(), setup->duration_s);
+               std::string(common::vendor_name(participant.vendor())).c_str(),
+               options->backend.c_str(), setup->config.model.name.c_str(), options->mode.c_str(),
+               setup->duration_s);
   reporter.set_state(msg::SERVICE_RUNNING);
   const int code = options->mode == "lockstep"
                        ? run_lockstep(*options, *setup, participant, metrics, recorder, state)
@@ -292,7 +312,8 @@ int run(int argc, char** argv) {
   reporter.report();
   std::printf("device_gateway: %s\n", metrics.summary(reporter.late_periods()).c_str());
   if (state.seq_mismatches > 0) {
-    std::fprintf(stderr, "fahr_device_gateway: %llu DevicePose seq mismatches (pose seq != writer seq)\n",
+    std::fprintf(stderr,
+                 "fahr_device_gateway: %llu DevicePose seq mismatches (pose seq != writer seq)\n",
                  static_cast<unsigned long long>(state.seq_mismatches));
   }
   if (state.recording) {

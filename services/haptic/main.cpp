@@ -9,7 +9,6 @@
 //                       [--duration-s S] [--mode realtime|lockstep] [--collision aist|triangle]
 //                       [--spin] [--rt-priority N]
 #include <CLI/CLI.hpp>
-
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -23,18 +22,18 @@
 #include "fahr/common/realtime.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/stop_signal.h"
-#include "fahr/metrics/duration_histogram.h"
 #include "fahr/common/subscriber.h"
-#include "fahr/runtime/cpu_pinning.h"
-#include "fahr/runtime/scene_transport.h"
-#include "fahr/runtime/service_main.h"
-#include "fahr/runtime/service_options.h"
-#include "fahr/scene/load_scene.h"
 #include "fahr/haptic_service/haptic_loop.h"
 #include "fahr/haptic_service/haptic_setup.h"
 #include "fahr/haptic_service/scene_publication.h"
 #include "fahr/haptic_service/tissue_feed.h"
 #include "fahr/haptic_service/tissue_snapshot.h"
+#include "fahr/metrics/duration_histogram.h"
+#include "fahr/runtime/cpu_pinning.h"
+#include "fahr/runtime/scene_transport.h"
+#include "fahr/runtime/service_main.h"
+#include "fahr/runtime/service_options.h"
+#include "fahr/scene/load_scene.h"
 
 namespace fahr::haptic_service {
 namespace {
@@ -58,8 +57,8 @@ struct WaitPolicy {
   int rt_priority = 0;
 };
 
-void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop& loop, common::TickRecorder& recorder,
-                  double duration_s, const WaitPolicy& wait) {
+void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop& loop,
+                  common::TickRecorder& recorder, double duration_s, const WaitPolicy& wait) {
   common::Subscriber<msg::DevicePose> poses(participant);
   common::Publisher<msg::ForceCommand> commands(participant);
   // The ContactSet's write (tens of microseconds: serialisation and send)
@@ -127,24 +126,29 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
     if (previous_start_ns != 0 && t0 - previous_start_ns > kLongPeriodNs) ++long_periods;
     previous_start_ns = t0;
   }
-  std::printf("fahr_haptic_service: ContactSets handed over %llu, written %llu, refused %llu (the rest superseded "
-              "before their write)\n",
-              static_cast<unsigned long long>(contact_sets.handed()),
-              static_cast<unsigned long long>(contact_sets.written()),
-              static_cast<unsigned long long>(contact_sets.refused()));
+  std::printf(
+      "fahr_haptic_service: ContactSets handed over %llu, written %llu, refused %llu (the rest "
+      "superseded "
+      "before their write)\n",
+      static_cast<unsigned long long>(contact_sets.handed()),
+      static_cast<unsigned long long>(contact_sets.written()),
+      static_cast<unsigned long long>(contact_sets.refused()));
   const auto& m = feed.metrics();
-  std::printf("fahr_haptic_service: %llu FEM states digested (%llu refused), worst digest %.0f us\n",
-              static_cast<unsigned long long>(m.fem_states.load()), static_cast<unsigned long long>(m.bad_states.load()),
-              m.digest_us_peak.load());
+  std::printf(
+      "fahr_haptic_service: %llu FEM states digested (%llu refused), worst digest %.0f us\n",
+      static_cast<unsigned long long>(m.fem_states.load()),
+      static_cast<unsigned long long>(m.bad_states.load()), m.digest_us_peak.load());
   const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
-  std::printf("fahr_haptic_service: tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f over %llu ticks; "
-              "periods > 1.5 ms: %llu\n",
-              us(tick_cpu.percentile(0.5)), us(tick_cpu.percentile(0.99)), us(tick_cpu.percentile(0.999)),
-              us(tick_cpu.max()), static_cast<unsigned long long>(tick_cpu.count()),
-              static_cast<unsigned long long>(long_periods));
+  std::printf(
+      "fahr_haptic_service: tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f over %llu ticks; "
+      "periods > 1.5 ms: %llu\n",
+      us(tick_cpu.percentile(0.5)), us(tick_cpu.percentile(0.99)), us(tick_cpu.percentile(0.999)),
+      us(tick_cpu.max()), static_cast<unsigned long long>(tick_cpu.count()),
+      static_cast<unsigned long long>(long_periods));
   const auto print_part = [&](const char* name, const metrics::DurationHistogram& h) {
-    std::printf("fahr_haptic_service: tick part %-22s us median %.0f p99 %.0f p99.9 %.0f max %.0f\n", name,
-                us(h.percentile(0.5)), us(h.percentile(0.99)), us(h.percentile(0.999)), us(h.max()));
+    std::printf(
+        "fahr_haptic_service: tick part %-22s us median %.0f p99 %.0f p99.9 %.0f max %.0f\n", name,
+        us(h.percentile(0.5)), us(h.percentile(0.99)), us(h.percentile(0.999)), us(h.max()));
   };
   print_part("work (thread CPU)", work_cpu);
   print_part("publishing (thread CPU)", publish_cpu);
@@ -163,14 +167,18 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
   const auto haptic_steps = static_cast<std::uint64_t>(scene.rates.haptic_period() / base);
   const auto fem_steps = static_cast<std::uint64_t>(scene.rates.fem_period() / base);
   if (haptic_steps != 1) {
-    std::fprintf(stderr, "fahr_haptic_service: lockstep needs the haptic rate to be the base rate (%.0f Hz)\n",
-                 1e9 / static_cast<double>(base.count()));
+    std::fprintf(
+        stderr,
+        "fahr_haptic_service: lockstep needs the haptic rate to be the base rate (%.0f Hz)\n",
+        1e9 / static_cast<double>(base.count()));
     return 2;
   }
   common::StepInput<msg::DevicePose> poses(participant);
   common::StepInput<msg::DeformationState> states(participant);
-  common::Publisher<msg::ForceCommand> commands(participant, common::lockstep_output_qos<msg::ForceCommand>());
-  common::Publisher<msg::ContactSet> contact_sets(participant, common::lockstep_output_qos<msg::ContactSet>());
+  common::Publisher<msg::ForceCommand> commands(participant,
+                                                common::lockstep_output_qos<msg::ForceCommand>());
+  common::Publisher<msg::ContactSet> contact_sets(participant,
+                                                  common::lockstep_output_qos<msg::ContactSet>());
   common::LockstepClient client(participant, "haptic");
   client.join();
   TissueDigest digest(setup);
@@ -192,8 +200,10 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
         return 1;
       }
       if (!digest.digest(*state, tissue)) {
-        std::fprintf(stderr, "fahr_haptic_service: DeformationState of FEM step %llu does not fit the mesh\n",
-                     static_cast<unsigned long long>(*f));
+        std::fprintf(
+            stderr,
+            "fahr_haptic_service: DeformationState of FEM step %llu does not fit the mesh\n",
+            static_cast<unsigned long long>(*f));
         return 1;
       }
       digested_fem_step = f;
@@ -218,7 +228,8 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
     recorder.push({k, t0, common::monotonic_now_ns() - t0, common::thread_cpu_now_ns() - c0});
     client.complete_through(k, hash.value());
   }
-  std::printf("fahr_haptic_service: lockstep output hash %016llx\n", static_cast<unsigned long long>(hash.value()));
+  std::printf("fahr_haptic_service: lockstep output hash %016llx\n",
+              static_cast<unsigned long long>(hash.value()));
   return 0;
 }
 
@@ -227,13 +238,16 @@ int run(int argc, char** argv) {
   runtime::ServiceOptions options;
   runtime::add_service_options(app, options);
   WaitPolicy wait;
-  app.add_flag("--spin", wait.spin, "real time: busy-poll for DevicePoses (a core of its own) instead of sleeping");
+  app.add_flag("--spin", wait.spin,
+               "real time: busy-poll for DevicePoses (a core of its own) instead of sleeping");
   app.add_option("--rt-priority", wait.rt_priority,
-                 "real time: SCHED_FIFO priority 1-99 for the tick thread (needs CAP_SYS_NICE; refused gracefully)")
+                 "real time: SCHED_FIFO priority 1-99 for the tick thread (needs CAP_SYS_NICE; "
+                 "refused gracefully)")
       ->check(CLI::Range(0, 99));
   std::string collision = "aist";
   app.add_option("--collision", collision,
-                 "tool-tissue collision: aist (the paper's spheres) or triangle (the baseline it is measured against)")
+                 "tool-tissue collision: aist (the paper's spheres) or triangle (the baseline it "
+                 "is measured against)")
       ->check(CLI::IsMember({"aist", "triangle"}));
   CLI11_PARSE(app, argc, argv);
   runtime::pin_to_cpus(options.cpus);
@@ -250,40 +264,50 @@ int run(int argc, char** argv) {
   HapticLoop loop(setup);
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
 
-  common::Participant participant(runtime::transport_for(*scene, options.dds, options.domain, options.profile, "haptic"));
+  common::Participant participant(
+      runtime::transport_for(*scene, options.dds, options.domain, options.profile, "haptic"));
   common::TickRecorder recorder;
   // Real time: FEM states are digested on the feed's own thread.
   std::unique_ptr<TissueFeed> feed;
   if (!lockstep) feed = std::make_unique<TissueFeed>(participant, setup);
-  const auto status_period = std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period());
-  common::ServiceReporter reporter(participant,
-                                   {"haptic", scene->rates.haptic_hz, status_period > 0ms ? status_period : 250ms},
-                                   recorder, [&](auto& metrics) {
-                                     loop.append_metrics(metrics);
-                                     if (feed) feed->append_metrics(metrics);
-                                   });
+  const auto status_period =
+      std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period());
+  common::ServiceReporter reporter(
+      participant, {"haptic", scene->rates.haptic_hz, status_period > 0ms ? status_period : 250ms},
+      recorder, [&](auto& metrics) {
+        loop.append_metrics(metrics);
+        if (feed) feed->append_metrics(metrics);
+      });
   // Transient local: the writer must live as long as the run for late
   // joiners to get the samples.
   common::Publisher<msg::SceneDescription> scene_out(participant);
   auto descriptions = describe_scene(setup);
   for (auto& d : descriptions) scene_out.write(d);
 
-  std::printf("fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres), tool '%s' (%zu surface samples), "
-              "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s\n",
-              std::string(common::vendor_name(participant.vendor())).c_str(), setup.deformable->name.c_str(),
-              setup.mesh.node_count(), setup.layout.size(), setup.tool->scene_body->name.c_str(),
-              setup.tool_samples.points_m().size(), setup.tissue_obstacles.size(), setup.tool_obstacles.size(),
-              collision.c_str(), scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s);
+  std::printf(
+      "fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres), tool '%s' (%zu surface "
+      "samples), "
+      "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s\n",
+      std::string(common::vendor_name(participant.vendor())).c_str(),
+      setup.deformable->name.c_str(), setup.mesh.node_count(), setup.layout.size(),
+      setup.tool->scene_body->name.c_str(), setup.tool_samples.points_m().size(),
+      setup.tissue_obstacles.size(), setup.tool_obstacles.size(), collision.c_str(),
+      scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s);
   reporter.set_state(msg::SERVICE_RUNNING);
-  const int status = lockstep ? run_lockstep(participant, setup, loop, recorder)
-                              : (run_realtime(participant, *feed, loop, recorder, duration_s, wait), 0);
+  const int status = lockstep
+                         ? run_lockstep(participant, setup, loop, recorder)
+                         : (run_realtime(participant, *feed, loop, recorder, duration_s, wait), 0);
   reporter.set_state(msg::SERVICE_STOPPING);
   reporter.report();
   const auto& m = loop.metrics();
-  std::printf("fahr_haptic_service: %llu ticks on %llu FEM states, lost-track episodes %llu, peak |F| %.3f N, "
-              "worst tick %.0f us\n",
-              static_cast<unsigned long long>(m.ticks.load()), static_cast<unsigned long long>(m.snapshots.load()),
-              static_cast<unsigned long long>(m.lost_track_episodes.load()), m.peak_force_n.load(), m.tick_us_peak.load());
+  std::printf(
+      "fahr_haptic_service: %llu ticks on %llu FEM states, lost-track episodes %llu, peak |F| %.3f "
+      "N, "
+      "worst tick %.0f us\n",
+      static_cast<unsigned long long>(m.ticks.load()),
+      static_cast<unsigned long long>(m.snapshots.load()),
+      static_cast<unsigned long long>(m.lost_track_episodes.load()), m.peak_force_n.load(),
+      m.tick_us_peak.load());
   return status;
 }
 
@@ -291,5 +315,6 @@ int run(int argc, char** argv) {
 }  // namespace fahr::haptic_service
 
 int main(int argc, char** argv) {
-  return fahr::runtime::run_service_main("fahr_haptic_service", fahr::haptic_service::run, argc, argv);
+  return fahr::runtime::run_service_main("fahr_haptic_service", fahr::haptic_service::run, argc,
+                                         argv);
 }

@@ -11,7 +11,6 @@
 // Exit status: 0 when every step was granted and completed, 1 on a stall
 // (a participant made no progress within the timeout), 2 on bad flags.
 #include <CLI/CLI.hpp>
-
 #include <chrono>
 #include <cstdio>
 #include <sstream>
@@ -30,10 +29,12 @@ int main(int argc, char** argv) {
   std::uint64_t steps = 0;
   double base_period_ms = 1.0;
   double stall_timeout_s = 60.0;
-  app.add_option("--participants", participants_csv, "comma-separated lockstep names (device_gateway, fem, haptic)")
+  app.add_option("--participants", participants_csv,
+                 "comma-separated lockstep names (device_gateway, fem, haptic)")
       ->required();
   app.add_option("--steps", steps, "base steps to grant")->required()->check(CLI::PositiveNumber);
-  app.add_option("--base-period-ms", base_period_ms, "simulated time of one base step, ms")->check(CLI::PositiveNumber);
+  app.add_option("--base-period-ms", base_period_ms, "simulated time of one base step, ms")
+      ->check(CLI::PositiveNumber);
   app.add_option("--stall-timeout-s", stall_timeout_s, "fail when nothing progresses this long")
       ->check(CLI::PositiveNumber);
   app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds, inprocess");
@@ -52,20 +53,25 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    common::Participant participant(common::transport_config_from(dds, domain, profile, "lockstep_clock"));
+    common::Participant participant(
+        common::transport_config_from(dds, domain, profile, "lockstep_clock"));
     const auto base = std::chrono::duration_cast<std::chrono::nanoseconds>(
         std::chrono::duration<double, std::milli>(base_period_ms));
     common::LockstepCoordinator coordinator(participant, base);
     const auto start = std::chrono::steady_clock::now();
     const auto result = coordinator.run(
-        names, steps, std::chrono::milliseconds(static_cast<std::int64_t>(stall_timeout_s * 1000.0)));
-    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        names, steps,
+        std::chrono::milliseconds(static_cast<std::int64_t>(stall_timeout_s * 1000.0)));
+    const double wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("lockstep_clock: %s after %llu of %llu steps, %.2f s wall (%.2fx real time)\n",
-                result.completed ? "completed" : "STALLED", static_cast<unsigned long long>(result.steps),
+                result.completed ? "completed" : "STALLED",
+                static_cast<unsigned long long>(result.steps),
                 static_cast<unsigned long long>(steps), wall_s,
                 static_cast<double>(result.steps) * base_period_ms * 1e-3 / wall_s);
     for (const auto& [name, hash] : result.hashes) {
-      std::printf("lockstep_clock: hash %s %016llx\n", name.c_str(), static_cast<unsigned long long>(hash));
+      std::printf("lockstep_clock: hash %s %016llx\n", name.c_str(),
+                  static_cast<unsigned long long>(hash));
     }
     return result.completed ? 0 : 1;
   } catch (const common::ConfigError& e) {

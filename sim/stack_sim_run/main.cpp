@@ -15,7 +15,6 @@
 // --w-normals N: W along the ContactSet's normals for N spheres (the
 // scene's solver.compliance_columns: normals), with rows by free depth.
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -34,13 +33,15 @@ int main(int argc, char** argv) {
   std::string script = "intubation";
   double seconds = 4.0;
   app.add_option("--scene", scene_path, "scene file");
-  app.add_option("--script", script, "the simulated hand's script")->check(CLI::IsMember({"intubation", "overshoot"}));
+  app.add_option("--script", script, "the simulated hand's script")
+      ->check(CLI::IsMember({"intubation", "overshoot"}));
   std::string collision = "aist";
   std::string fem_anatomy = "on";
   double support_ratio = -1.0;
-  app.add_option("--fem-support", support_ratio,
-                 "the FEM's anatomy support springs, stiffness over the node's diagonal of A; 0: off "
-                 "(default: the service's)")
+  app.add_option(
+         "--fem-support", support_ratio,
+         "the FEM's anatomy support springs, stiffness over the node's diagonal of A; 0: off "
+         "(default: the service's)")
       ->check(CLI::Range(0.0, 1e6));
   app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")
       ->check(CLI::IsMember({"on", "off"}));
@@ -52,23 +53,27 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 100.0));
   double volume_floor = -1.0;
   app.add_option("--volume-floor", volume_floor,
-                 "no tet ends a FEM step below this share of its rest volume (solver.volume_floor_ratio); 0: off "
+                 "no tet ends a FEM step below this share of its rest volume "
+                 "(solver.volume_floor_ratio); 0: off "
                  "(default: the scene's)")
       ->check(CLI::Range(0.0, 0.9));
   bool fem_anatomy_slide = false;
-  app.add_flag("--fem-anatomy-slide", fem_anatomy_slide,
-               "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
+  app.add_flag(
+      "--fem-anatomy-slide", fem_anatomy_slide,
+      "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
   int fem_anatomy_rounds = 0;
-  app.add_option("--fem-anatomy-rounds", fem_anatomy_rounds,
-                 "the FEM's tool/anatomy alternation rounds per step (services/fem obstacle_projection.h "
-                 "max_rounds); default the FEM's")
+  app.add_option(
+         "--fem-anatomy-rounds", fem_anatomy_rounds,
+         "the FEM's tool/anatomy alternation rounds per step (services/fem obstacle_projection.h "
+         "max_rounds); default the FEM's")
       ->check(CLI::Range(1, 1000));
   bool fem_tool_obstacle = false;
   app.add_flag("--fem-tool-obstacle", fem_tool_obstacle,
                "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose");
   std::string row_compliance = "scene";
   app.add_option("--row-compliance", row_compliance,
-                 "which rows the haptic tick keeps: scene (its solver.compliance_columns decides), deepest, keep or "
+                 "which rows the haptic tick keeps: scene (its solver.compliance_columns decides), "
+                 "deepest, keep or "
                  "free (services/haptic/main haptic_setup.h RowCompliance)")
       ->check(CLI::IsMember({"scene", "deepest", "keep", "free"}));
   int w_normals = 0;
@@ -78,27 +83,31 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 64));
   double candidate_margin_mm = -1.0;
   app.add_option("--candidate-margin-mm", candidate_margin_mm,
-                 "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; default the service's 1")
+                 "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; "
+                 "default the service's 1")
       ->check(CLI::Range(0.0, 5.0));
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     stack_sim::StackOptions options;
-    options.script = script == "overshoot" ? device::Script::kOvershoot : device::Script::kIntubation;
+    options.script =
+        script == "overshoot" ? device::Script::kOvershoot : device::Script::kIntubation;
     options.fem_anatomy = fem_anatomy == "on";
     if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
     options.fem_tool_obstacle = fem_tool_obstacle;
     options.fem_anatomy_slide = fem_anatomy_slide;
     options.fem_anatomy_rounds = fem_anatomy_rounds;
     if (candidate_margin_mm >= 0.0) options.candidate_margin_m = 1e-3 * candidate_margin_mm;
-    if (row_compliance != "scene") options.row_compliance = haptic_service::row_compliance_named(row_compliance);
-    options.collision =
-        collision == "triangle" ? haptic_service::CollisionMethod::kTriangle : haptic_service::CollisionMethod::kAist;
+    if (row_compliance != "scene")
+      options.row_compliance = haptic_service::row_compliance_named(row_compliance);
+    options.collision = collision == "triangle" ? haptic_service::CollisionMethod::kTriangle
+                                                : haptic_service::CollisionMethod::kAist;
     auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));
     if (volume_floor >= 0.0) scene->solver.volume_floor_ratio = volume_floor;
     for (auto& body : scene->bodies) {
-      if (body.deformable && stiffening >= 0.0) body.deformable->material.yeoh_c20_over_c10 = stiffening;
+      if (body.deformable && stiffening >= 0.0)
+        body.deformable->material.yeoh_c20_over_c10 = stiffening;
     }
     if (w_normals > 0) {
       scene->solver.compliance_columns = scene::ComplianceColumns::kNormals;
@@ -116,16 +125,19 @@ int main(int argc, char** argv) {
     std::uint64_t unconverged = 0;
     // Wall time of the tick's phases (a preempted tick shows in the tail).
     std::vector<double> tissue_query_us, anatomy_query_us, response_us;
-    std::vector<double> query_nodes, query_spheres, query_contacts, query_inside;  // the AIST query's work per tick
+    std::vector<double> query_nodes, query_spheres, query_contacts,
+        query_inside;  // the AIST query's work per tick
     // The tissue query on the first tick of a FEM state (every sphere moved:
     // the floors of the last query bound less, and the refit left the data
     // cold) and on the ticks after it (only the blade moved).
-    std::vector<double> query_new_state_us, query_same_state_us, spheres_new_state, spheres_same_state;
+    std::vector<double> query_new_state_us, query_same_state_us, spheres_new_state,
+        spheres_same_state;
     std::uint64_t states_seen = sim.haptic().metrics().snapshots.load(std::memory_order_relaxed);
     for (std::uint64_t k = 0; k < steps; ++k) {
       sim.step();
       const auto& report = sim.haptic().response().report();
-      pgs_cost.push_back(static_cast<double>(report.pgs_work.row_visits) * static_cast<double>(report.load.rows));
+      pgs_cost.push_back(static_cast<double>(report.pgs_work.row_visits) *
+                         static_cast<double>(report.load.rows));
       pgs_solves.push_back(report.pgs_work.solves);
       rows.push_back(static_cast<double>(report.load.rows));
       unconverged += report.pgs_work.unconverged;
@@ -138,23 +150,30 @@ int main(int argc, char** argv) {
       query_contacts.push_back(phases.tissue_query.contacts);
       query_inside.push_back(phases.tissue_query.spheres_inside);
       const std::uint64_t states = sim.haptic().metrics().snapshots.load(std::memory_order_relaxed);
-      (states != states_seen ? query_new_state_us : query_same_state_us).push_back(phases.tissue_query_us);
-      (states != states_seen ? spheres_new_state : spheres_same_state).push_back(phases.tissue_query.spheres_tested);
+      (states != states_seen ? query_new_state_us : query_same_state_us)
+          .push_back(phases.tissue_query_us);
+      (states != states_seen ? spheres_new_state : spheres_same_state)
+          .push_back(phases.tissue_query.spheres_tested);
       states_seen = states;
       const auto& f = sim.command().force_n();
       peak_force = std::max(peak_force, std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z()));
     }
-    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("stack_sim: %llu steps, %.2f s wall (%.2fx real time), peak |F| %.3f N; FEM: %llu steps, stale "
-                "contact sets %llu, max inverted elements %llu, resets after divergence %llu\n",
-                static_cast<unsigned long long>(steps), wall_s, seconds / wall_s, peak_force,
-                static_cast<unsigned long long>(sim.body().step_index()),
-                static_cast<unsigned long long>(sim.fem().stale_sets()),
-                static_cast<unsigned long long>(sim.fem().inverted_max()),
-                static_cast<unsigned long long>(sim.fem().divergence_resets()));
-    std::printf("stack_sim: FEM anatomy: nodes let back through a bone %llu, node-steps beyond a bone %llu\n",
-                static_cast<unsigned long long>(sim.fem().anatomy_returned()),
-                static_cast<unsigned long long>(sim.fem().anatomy_beyond_steps()));
+    const double wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf(
+        "stack_sim: %llu steps, %.2f s wall (%.2fx real time), peak |F| %.3f N; FEM: %llu steps, "
+        "stale "
+        "contact sets %llu, max inverted elements %llu, resets after divergence %llu\n",
+        static_cast<unsigned long long>(steps), wall_s, seconds / wall_s, peak_force,
+        static_cast<unsigned long long>(sim.body().step_index()),
+        static_cast<unsigned long long>(sim.fem().stale_sets()),
+        static_cast<unsigned long long>(sim.fem().inverted_max()),
+        static_cast<unsigned long long>(sim.fem().divergence_resets()));
+    std::printf(
+        "stack_sim: FEM anatomy: nodes let back through a bone %llu, node-steps beyond a bone "
+        "%llu\n",
+        static_cast<unsigned long long>(sim.fem().anatomy_returned()),
+        static_cast<unsigned long long>(sim.fem().anatomy_beyond_steps()));
     const auto& cpu = sim.haptic_tick_cpu();
     const auto& fem_cpu = sim.fem_step_cpu();
     std::printf("stack_sim: FEM step CPU ms median %.2f p99 %.2f max %.2f\n",
@@ -162,39 +181,51 @@ int main(int argc, char** argv) {
                 1e-6 * static_cast<double>(fem_cpu.percentile(0.99).count()),
                 1e-6 * static_cast<double>(fem_cpu.max().count()));
     const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
-    std::printf("stack_sim: haptic tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f\n", us(cpu.percentile(0.5)),
-                us(cpu.percentile(0.99)), us(cpu.percentile(0.999)), us(cpu.max()));
+    std::printf("stack_sim: haptic tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f\n",
+                us(cpu.percentile(0.5)), us(cpu.percentile(0.99)), us(cpu.percentile(0.999)),
+                us(cpu.max()));
     const auto quantile = [](std::vector<double> v, double q) {
       if (v.empty()) return 0.0;
       const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
       std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(i), v.end());
       return v[i];
     };
-    std::printf("stack_sim: rows per tick p50 %.0f p99 %.0f max %.0f; PGS solves per tick p99 %.0f max %.0f; "
-                "PGS row visits x rows p50 %.0f p99 %.0f p99.9 %.0f max %.0f; unconverged solves %llu\n",
-                quantile(rows, 0.5), quantile(rows, 0.99), quantile(rows, 1.0), quantile(pgs_solves, 0.99),
-                quantile(pgs_solves, 1.0), quantile(pgs_cost, 0.5), quantile(pgs_cost, 0.99), quantile(pgs_cost, 0.999),
-                quantile(pgs_cost, 1.0), static_cast<unsigned long long>(unconverged));
+    std::printf(
+        "stack_sim: rows per tick p50 %.0f p99 %.0f max %.0f; PGS solves per tick p99 %.0f max "
+        "%.0f; "
+        "PGS row visits x rows p50 %.0f p99 %.0f p99.9 %.0f max %.0f; unconverged solves %llu\n",
+        quantile(rows, 0.5), quantile(rows, 0.99), quantile(rows, 1.0), quantile(pgs_solves, 0.99),
+        quantile(pgs_solves, 1.0), quantile(pgs_cost, 0.5), quantile(pgs_cost, 0.99),
+        quantile(pgs_cost, 0.999), quantile(pgs_cost, 1.0),
+        static_cast<unsigned long long>(unconverged));
     const auto print_phase = [&](const char* name, const std::vector<double>& wall_us) {
-      std::printf("stack_sim: tick phase %-14s wall us p50 %.1f p99 %.1f p99.9 %.1f\n", name, quantile(wall_us, 0.5),
-                  quantile(wall_us, 0.99), quantile(wall_us, 0.999));
+      std::printf("stack_sim: tick phase %-14s wall us p50 %.1f p99 %.1f p99.9 %.1f\n", name,
+                  quantile(wall_us, 0.5), quantile(wall_us, 0.99), quantile(wall_us, 0.999));
     };
     print_phase("tissue query", tissue_query_us);
     print_phase("  new state", query_new_state_us);
     print_phase("  same state", query_same_state_us);
     print_phase("anatomy query", anatomy_query_us);
     print_phase("response", response_us);
-    std::printf("stack_sim: AIST query per tick: tree nodes p50 %.0f p99 %.0f, spheres tested p50 %.0f p99 %.0f, "
-                "contacts p50 %.0f p99 %.0f max %.0f, centre inside p99 %.0f max %.0f\n",
-                quantile(query_nodes, 0.5), quantile(query_nodes, 0.99), quantile(query_spheres, 0.5),
-                quantile(query_spheres, 0.99), quantile(query_contacts, 0.5), quantile(query_contacts, 0.99),
-                quantile(query_contacts, 1.0), quantile(query_inside, 0.99), quantile(query_inside, 1.0));
-    std::printf("stack_sim: AIST spheres tested on a new FEM state p50 %.0f p99 %.0f, on the same state p50 %.0f p99 %.0f\n",
-                quantile(spheres_new_state, 0.5), quantile(spheres_new_state, 0.99), quantile(spheres_same_state, 0.5),
-                quantile(spheres_same_state, 0.99));
-    std::printf("lockstep_clock: hash device_gateway %016llx\n", static_cast<unsigned long long>(sim.gateway_hash()));
-    std::printf("lockstep_clock: hash fem %016llx\n", static_cast<unsigned long long>(sim.fem_hash()));
-    std::printf("lockstep_clock: hash haptic %016llx\n", static_cast<unsigned long long>(sim.haptic_hash()));
+    std::printf(
+        "stack_sim: AIST query per tick: tree nodes p50 %.0f p99 %.0f, spheres tested p50 %.0f p99 "
+        "%.0f, "
+        "contacts p50 %.0f p99 %.0f max %.0f, centre inside p99 %.0f max %.0f\n",
+        quantile(query_nodes, 0.5), quantile(query_nodes, 0.99), quantile(query_spheres, 0.5),
+        quantile(query_spheres, 0.99), quantile(query_contacts, 0.5),
+        quantile(query_contacts, 0.99), quantile(query_contacts, 1.0), quantile(query_inside, 0.99),
+        quantile(query_inside, 1.0));
+    std::printf(
+        "stack_sim: AIST spheres tested on a new FEM state p50 %.0f p99 %.0f, on the same state "
+        "p50 %.0f p99 %.0f\n",
+        quantile(spheres_new_state, 0.5), quantile(spheres_new_state, 0.99),
+        quantile(spheres_same_state, 0.5), quantile(spheres_same_state, 0.99));
+    std::printf("lockstep_clock: hash device_gateway %016llx\n",
+                static_cast<unsigned long long>(sim.gateway_hash()));
+    std::printf("lockstep_clock: hash fem %016llx\n",
+                static_cast<unsigned long long>(sim.fem_hash()));
+    std::printf("lockstep_clock: hash haptic %016llx\n",
+                static_cast<unsigned long long>(sim.haptic_hash()));
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fahr_stack_sim_run: %s\n", e.what());

@@ -2,9 +2,9 @@
 #include <gtest/gtest.h>
 
 #include "allocation_counter.h"
-#include "fahr/geometry/signed_distance_field.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
+#include "fahr/geometry/signed_distance_field.h"
 #include "test_meshes.h"
 
 namespace fahr::collision {
@@ -20,7 +20,8 @@ TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
   SphereState stretch_state(layout, rest);  // the smallest-stretch radius rule
   geometry::SdfOptions options;
   options.cell_size_m = 1e-3;
-  const geometry::SignedDistanceField slab(test::box_surface({-0.06, -0.04, -0.02}, {0.0, -0.005, 0.02}), options);
+  const geometry::SignedDistanceField slab(
+      test::box_surface({-0.06, -0.04, -0.02}, {0.0, -0.005, 0.02}), options);
   const FieldGrid slab_grid(slab);
   RigidBody body{0, &slab, Eigen::Isometry3d::Identity()};
   PrePenetrationMemory memory(layout.size());

@@ -22,8 +22,9 @@ TEST(TriangleBaseline, BlockOnASlabAfterDeformation) {
   std::size_t sunk = 0;
   for (const auto& p : mesh.rest_positions()) {
     const bool bottom = p.y() < 1e-12;
-    sunk += bottom && surface_to_node.end() != std::find(surface_to_node.begin(), surface_to_node.end(),
-                                                         static_cast<geometry::Index>(&p - &mesh.rest_positions()[0]))
+    sunk += bottom && surface_to_node.end() !=
+                          std::find(surface_to_node.begin(), surface_to_node.end(),
+                                    static_cast<geometry::Index>(&p - &mesh.rest_positions()[0]))
                 ? 1
                 : 0;
     x.push_back(p.x());
@@ -53,7 +54,8 @@ TEST(TriangleBaseline, ToolVertexContactsActOnTheNearestFaceCorner) {
   std::vector<geometry::Index> surface_to_node;
   const geometry::SurfaceMesh tissue = mesh.boundary_surface(&surface_to_node);
   // A 1.8 mm square peg whose bottom is 0.1 mm below the top face (y = 10 mm).
-  const geometry::SurfaceMesh peg = test::box_surface({0.0031, 0.0099, 0.0031}, {0.0049, 0.02, 0.0049});
+  const geometry::SurfaceMesh peg =
+      test::box_surface({0.0031, 0.0099, 0.0031}, {0.0049, 0.02, 0.0049});
   TriangleBaseline baseline(tissue, surface_to_node, peg);
   std::vector<TriangleContact> contacts;
   baseline.collide(Eigen::Isometry3d::Identity(), contacts);
@@ -64,7 +66,8 @@ TEST(TriangleBaseline, ToolVertexContactsActOnTheNearestFaceCorner) {
     ASSERT_GE(c.acting_tissue_vertex, 0);
     EXPECT_NEAR(c.depth_m, 1e-4, 1e-12);
     EXPECT_NEAR(c.normal.y(), -1.0, 1e-12);
-    const Eigen::Vector3d corner = tissue.vertices()[static_cast<std::size_t>(c.acting_tissue_vertex)];
+    const Eigen::Vector3d corner =
+        tissue.vertices()[static_cast<std::size_t>(c.acting_tissue_vertex)];
     EXPECT_NEAR(corner.y(), 0.01, 1e-12);
     // The 2.5 mm grid vertex nearest the peg's corner.
     EXPECT_NEAR(corner.x(), c.point_m.x() < 0.004 ? 0.0025 : 0.005, 1e-12);
@@ -84,7 +87,8 @@ TEST(TriangleBaseline, AVertexInFrontOfTheNearestFaceIsOutside) {
   TriangleBaseline baseline(tissue, surface_to_node, plate);
   std::vector<TriangleContact> contacts;
   baseline.collide(Eigen::Isometry3d::Identity(), contacts);
-  EXPECT_TRUE(contacts.empty()) << contacts.size() << " contacts, the first " << contacts.front().depth_m << " m deep";
+  EXPECT_TRUE(contacts.empty()) << contacts.size() << " contacts, the first "
+                                << contacts.front().depth_m << " m deep";
   baseline.collide(Eigen::Isometry3d::Identity(), contacts, 1e-3);
   ASSERT_FALSE(contacts.empty());
   for (const auto& c : contacts) {

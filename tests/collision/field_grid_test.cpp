@@ -1,16 +1,17 @@
 // FieldGrid: the single-precision copy of a field's grid reads the same
 // trilinear values, its gradient is the interpolant's, and queries through it
 // find the same contacts as through the field's own grid.
+#include "fahr/collision/field_grid.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-#include "fahr/geometry/signed_distance_field.h"
-#include "fahr/collision/field_grid.h"
-#include "fahr/sphere_layout/fill_spheres.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/sphere_layout/fill_spheres.h"
 #include "test_meshes.h"
 
 namespace fahr::collision {
@@ -31,7 +32,8 @@ TEST(FieldGrid, ReadsTheFieldsTrilinearValues) {
   // Points inside, near and outside the surface, and beyond the grid.
   for (int i = 0; i < 400; ++i) {
     const double t = 0.37 * i;
-    const Eigen::Vector3d p(12e-3 * std::sin(t), 11e-3 * std::cos(1.3 * t), 13e-3 * std::sin(0.7 * t + 1.0));
+    const Eigen::Vector3d p(12e-3 * std::sin(t), 11e-3 * std::cos(1.3 * t),
+                            13e-3 * std::sin(0.7 * t + 1.0));
     EXPECT_NEAR(grid.distance(p), sdf.grid_distance(p), grid.storage_error_m() + 1e-12) << i;
     Eigen::Vector3d gradient;
     EXPECT_NEAR(grid.distance_gradient(p, gradient), grid.distance(p), 1e-12);
@@ -45,9 +47,11 @@ TEST(FieldGrid, ReadsTheFieldsTrilinearValues) {
   }
   const Eigen::Vector3d far(0.2, 0.0, 0.0);
   EXPECT_NEAR(grid.distance(far), sdf.grid_distance(far), 1e-8);
-  EXPECT_TRUE(std::isnan(grid.distance(Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0, 0))));
+  EXPECT_TRUE(
+      std::isnan(grid.distance(Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0, 0))));
   EXPECT_TRUE(std::isinf(FieldGrid().distance(Eigen::Vector3d::Zero())));
-  EXPECT_TRUE(std::isnan(grid.read(Eigen::Vector3d(0, std::numeric_limits<double>::quiet_NaN(), 0)).value));
+  EXPECT_TRUE(
+      std::isnan(grid.read(Eigen::Vector3d(0, std::numeric_limits<double>::quiet_NaN(), 0)).value));
   EXPECT_TRUE(std::isinf(FieldGrid().read(Eigen::Vector3d::Zero()).value));
 }
 
@@ -58,7 +62,8 @@ TEST(FieldGrid, GradientIsTheInterpolantsAndPointsOutward) {
   for (int i = 0; i < 100; ++i) {
     const double t = 0.61 * i;
     // Points 5.2-7 mm from the centre: outside the ball, within the grid.
-    const Eigen::Vector3d dir = Eigen::Vector3d(std::sin(t), std::cos(1.7 * t), std::sin(2.3 * t + 0.4)).normalized();
+    const Eigen::Vector3d dir =
+        Eigen::Vector3d(std::sin(t), std::cos(1.7 * t), std::sin(2.3 * t + 0.4)).normalized();
     // The offset keeps p off the grid planes (x = 0 is one), where the
     // interpolant's gradient jumps and a central difference straddles it.
     const Eigen::Vector3d p = (5.2e-3 + 1.8e-3 * (0.5 + 0.5 * std::sin(3.1 * t))) * dir +

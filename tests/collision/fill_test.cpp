@@ -6,10 +6,10 @@
 #include <iostream>
 #include <limits>
 
+#include "fahr/collision/sphere_state.h"
 #include "fahr/geometry/signed_distance_field.h"
 #include "fahr/sphere_layout/coverage.h"
 #include "fahr/sphere_layout/fill_spheres.h"
-#include "fahr/collision/sphere_state.h"
 #include "test_meshes.h"
 
 namespace fahr::collision {
@@ -21,7 +21,8 @@ constexpr double kCentreToleranceM = 1e-12;
 // The coverage target on the ~40 mm neonatal tongue.
 constexpr double kCoverageTargetM = 0.5e-3;
 
-void expect_weights_valid(const sphere_layout::SphereLayout& layout, const geometry::TetMesh& mesh) {
+void expect_weights_valid(const sphere_layout::SphereLayout& layout,
+                          const geometry::TetMesh& mesh) {
   for (std::size_t i = 0; i < layout.size(); ++i) {
     double sum = 0.0;
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
@@ -62,7 +63,8 @@ TEST(Fill, WeightsSumToOneAndReproduceTheCentreOnTheTongue) {
 }
 
 // The share of a sphere's weight on boundary nodes.
-double surface_share(const sphere_layout::SphereLayout& layout, std::size_t sphere, const std::vector<bool>& on_boundary) {
+double surface_share(const sphere_layout::SphereLayout& layout, std::size_t sphere,
+                     const std::vector<bool>& on_boundary) {
   double share = 0.0;
   const auto nodes = layout.nodes(sphere);
   const auto weights = layout.weights(sphere);
@@ -126,7 +128,8 @@ TEST(Fill, RestStateCentresFollowTheNodes) {
 
 TEST(Fill, IsDeterministic) {
   const auto& mesh = test::neonatal_tongue();
-  const sphere_layout::SphereLayout again = sphere_layout::fill_spheres(mesh, sphere_layout::FillSettings{});
+  const sphere_layout::SphereLayout again =
+      sphere_layout::fill_spheres(mesh, sphere_layout::FillSettings{});
   EXPECT_EQ(again.size(), test::neonatal_layout().size());
   EXPECT_EQ(again.fingerprint(), test::neonatal_layout().fingerprint());
 }
@@ -142,7 +145,8 @@ TEST(Fill, CoverageOnTheNeonatalTongueIsBelowTarget) {
   sphere_layout::CoverageSettings coverage;
   coverage.sample_spacing_m = 0.2e-3;  // finer than the closure's own samples
   coverage.voxel_size_m = 0.2e-3;
-  const sphere_layout::CoverageReport report = sphere_layout::measure_coverage(rest.centres_m(), rest.radii_m(), boundary, sdf, coverage);
+  const sphere_layout::CoverageReport report =
+      sphere_layout::measure_coverage(rest.centres_m(), rest.radii_m(), boundary, sdf, coverage);
   std::cout << "neonatal tongue: " << layout.size() << " spheres, boundary->union "
             << report.boundary_to_union_max_m * 1e3 << " mm, union->boundary "
             << report.union_to_boundary_max_m * 1e3 << " mm\n";
@@ -161,7 +165,8 @@ TEST(Fill, WithoutHuggingTheCoverageGapIsLarge) {
   const geometry::SurfaceMesh boundary = mesh.boundary_surface();
   const geometry::SignedDistanceField sdf(boundary, geometry::SdfOptions{});
   const SphereState rest(layout);
-  const sphere_layout::CoverageReport report = sphere_layout::measure_coverage(rest.centres_m(), rest.radii_m(), boundary, sdf, sphere_layout::CoverageSettings{});
+  const sphere_layout::CoverageReport report = sphere_layout::measure_coverage(
+      rest.centres_m(), rest.radii_m(), boundary, sdf, sphere_layout::CoverageSettings{});
   EXPECT_GT(report.hausdorff_m(), 2.0 * kCoverageTargetM);
 }
 

@@ -9,11 +9,11 @@
 #include <cstdio>
 #include <vector>
 
-#include "fahr/geometry/signed_distance_field.h"
 #include "fahr/collision/deepest_contacts.h"
 #include "fahr/collision/field_grid.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
+#include "fahr/geometry/signed_distance_field.h"
 #include "test_meshes.h"
 
 namespace fahr::collision {

@@ -7,11 +7,11 @@
 #include <limits>
 #include <vector>
 
-#include "fahr/geometry/signed_distance_field.h"
 #include "fahr/collision/field_grid.h"
-#include "fahr/sphere_layout/fill_spheres.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/sphere_layout/fill_spheres.h"
 #include "test_meshes.h"
 
 namespace fahr::collision {
@@ -101,7 +101,8 @@ TEST(Query, PlaneContactsAreExact) {
     EXPECT_EQ(c.body_id, 7u);
     EXPECT_NEAR(c.depth_m, b.state.radii_m()[c.sphere_id] - (centre.y() - h), kPlaneToleranceM);
     EXPECT_NEAR(c.normal.y(), 1.0, kPlaneToleranceM);
-    EXPECT_NEAR((c.point_m - Eigen::Vector3d(centre.x(), h, centre.z())).norm(), 0.0, kPlaneToleranceM);
+    EXPECT_NEAR((c.point_m - Eigen::Vector3d(centre.x(), h, centre.z())).norm(), 0.0,
+                kPlaneToleranceM);
   }
 }
 
@@ -149,11 +150,13 @@ TEST(Query, ShortcutsGiveThePerSphereRuleOnTheTongue) {
   geometry::SdfOptions options;
   options.cell_size_m = 0.5e-3;
   const geometry::SignedDistanceField slab(
-      test::box_surface({lo.x() - 0.01, -0.0012, lo.z() - 0.01}, {hi.x() + 0.01, 0.0, hi.z() + 0.01}), options);
+      test::box_surface({lo.x() - 0.01, -0.0012, lo.z() - 0.01},
+                        {hi.x() + 0.01, 0.0, hi.z() + 0.01}),
+      options);
   const FieldGrid copy(slab);
   RigidBody body{3, &slab, Eigen::Isometry3d::Identity(), &copy};
-  body.world_from_body =
-      Eigen::Translation3d(0.0, hi.y() - 3e-3, 0.0) * Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ());
+  body.world_from_body = Eigen::Translation3d(0.0, hi.y() - 3e-3, 0.0) *
+                         Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ());
   QuerySettings settings;
   settings.exact_narrow_phase = false;
   settings.candidate_margin_m = 1e-3;
@@ -180,15 +183,19 @@ TEST(Query, ShortcutsGiveThePerSphereRuleOnTheTongue) {
     const bool expected = r - grid > -settings.candidate_margin_m;
     ASSERT_EQ(reported[id] == 1, expected) << "sphere " << id << " grid " << grid << " r " << r;
     if (expected) {
-      const auto it = std::find_if(buffer.begin(), buffer.end(), [&](const SphereContact& c) { return c.sphere_id == id; });
+      const auto it = std::find_if(buffer.begin(), buffer.end(),
+                                   [&](const SphereContact& c) { return c.sphere_id == id; });
       EXPECT_EQ(it->depth_m, r - grid) << "sphere " << id;
     }
     inside += grid <= 0.0 ? 1 : 0;
     // Surely within the approach margin (the grid within one error of the
     // distance) and outside: remembered by this query, as it is.
-    if (grid > 0.0 && grid + error - r - settings.candidate_margin_m <= settings.approach_margin_m) {
+    if (grid > 0.0 &&
+        grid + error - r - settings.candidate_margin_m <= settings.approach_margin_m) {
       Eigen::Vector3d centre;
-      ASSERT_TRUE(memory.recall(static_cast<std::uint32_t>(slot), 1, settings.max_memory_age, centre)) << id;
+      ASSERT_TRUE(
+          memory.recall(static_cast<std::uint32_t>(slot), 1, settings.max_memory_age, centre))
+          << id;
       EXPECT_EQ(centre, p) << "sphere " << id;
       ++remembered;
     }
@@ -237,7 +244,8 @@ TEST(Query, SphereContactsMatchTheAnalyticDistance) {
     ASSERT_GT(d, 0.0) << "no centre is inside the ball in this case";
     EXPECT_NEAR(c.depth_m, b.state.radii_m()[c.sphere_id] - d, kIcosphereToleranceM);
     EXPECT_NEAR(c.normal.dot((centre - o).normalized()), 1.0, 1e-3);
-    EXPECT_NEAR((c.point_m - (o + radius * (centre - o).normalized())).norm(), 0.0, kIcospherePointToleranceM);
+    EXPECT_NEAR((c.point_m - (o + radius * (centre - o).normalized())).norm(), 0.0,
+                kIcospherePointToleranceM);
   }
   // Every sphere that overlaps the ball by more than the tessellation error is reported.
   std::size_t expected = 0;
@@ -301,8 +309,10 @@ TEST(Query, NormalComesFromThePrePenetrationCentreThroughAThinPlate) {
       EXPECT_GT(c.normal.y(), 0.99) << "step " << step << " sphere " << c.sphere_id;
       const double plate_top = body.world_from_body.translation().y() + 0.0005;
       deep += b.state.centres_m()[c.sphere_id].y() < plate_top - 0.0005 ? 1 : 0;
-      EXPECT_NEAR(c.depth_m, b.state.radii_m()[c.sphere_id] - (b.state.centres_m()[c.sphere_id].y() - plate_top),
-                  kPlaneToleranceM);
+      EXPECT_NEAR(
+          c.depth_m,
+          b.state.radii_m()[c.sphere_id] - (b.state.centres_m()[c.sphere_id].y() - plate_top),
+          kPlaneToleranceM);
     }
   }
   EXPECT_GT(deep, 0u) << "some centres passed the mid-plane";
@@ -314,8 +324,8 @@ TEST(Query, NormalComesFromThePrePenetrationCentreThroughAThinPlate) {
 // (flat_gradient_tolerance) stays within its stated error. Contacts whose
 // centre lies inside the body are left out: their normal depends on the
 // memory's pre-penetration centre, which a fresh memory does not have.
-void expect_same_contacts(const RigidBody& body, const Eigen::Vector3d& step, int steps, double flat_tolerance,
-                          double tolerance_m, double point_tolerance_m,
+void expect_same_contacts(const RigidBody& body, const Eigen::Vector3d& step, int steps,
+                          double flat_tolerance, double tolerance_m, double point_tolerance_m,
                           bool (*centre_inside)(const RigidBody&, const Eigen::Vector3d&)) {
   Block& b = block();
   QuerySettings hinted;
@@ -398,7 +408,8 @@ TEST(Query, OverflowIsAFlagAndANanPoseTouchesNothing) {
 
   body.world_from_body.translation().x() = std::numeric_limits<double>::quiet_NaN();
   ContactBuffer buffer(64);
-  const QueryStats nan_stats = query_spheres(b.tree, b.state, body, QuerySettings{}, memory, buffer);
+  const QueryStats nan_stats =
+      query_spheres(b.tree, b.state, body, QuerySettings{}, memory, buffer);
   EXPECT_EQ(buffer.size(), 0u);
   EXPECT_TRUE(nan_stats.body_skipped);
 }
@@ -420,7 +431,8 @@ TEST(Query, OpenToolSurfaceIsRefusedByTheField) {
   auto box = test::box_surface({0, 0, 0}, {0.01, 0.01, 0.01});
   std::vector<geometry::Triangle> open(box.triangles().begin(), box.triangles().end() - 1);
   const geometry::SurfaceMesh surface(box.vertices(), open);
-  EXPECT_THROW(geometry::SignedDistanceField(surface, geometry::SdfOptions{}), std::invalid_argument);
+  EXPECT_THROW(geometry::SignedDistanceField(surface, geometry::SdfOptions{}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // SphereState's radius rules under a uniaxial squash: the volume rule scales
 // radii by the cube root of the volume change, the smallest-stretch rule by
 // the squash itself, so the sphere stays inside its rest sphere's image.
+#include "fahr/collision/sphere_state.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +10,6 @@
 #include <vector>
 
 #include "fahr/sphere_layout/fill_spheres.h"
-#include "fahr/collision/sphere_state.h"
 #include "test_meshes.h"
 
 namespace fahr::collision {
@@ -16,7 +17,8 @@ namespace {
 
 TEST(SphereState, SmallestStretchRuleFollowsTheSquash) {
   const geometry::TetMesh mesh = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 4);
-  const sphere_layout::SphereLayout layout = sphere_layout::fill_spheres(mesh, sphere_layout::FillSettings{});
+  const sphere_layout::SphereLayout layout =
+      sphere_layout::fill_spheres(mesh, sphere_layout::FillSettings{});
   std::vector<double> rest, squashed;
   constexpr double kSquash = 0.7;  // y scaled by 0.7, x and z kept: volume 0.7
   for (const auto& p : mesh.rest_positions()) {
@@ -40,16 +42,19 @@ TEST(SphereState, SmallestStretchRuleFollowsTheSquash) {
   // A rigid rotation keeps the radii under both rules.
   std::vector<double> turned;
   const double c = std::cos(0.5), s = std::sin(0.5);
-  for (const auto& p : mesh.rest_positions()) turned.insert(turned.end(), {c * p.x() - s * p.y(), s * p.x() + c * p.y(), p.z()});
+  for (const auto& p : mesh.rest_positions())
+    turned.insert(turned.end(), {c * p.x() - s * p.y(), s * p.x() + c * p.y(), p.z()});
   ASSERT_TRUE(stretch.update(layout, turned));
   for (std::size_t i = 0; i < layout.size(); ++i) {
-    EXPECT_NEAR(stretch.radii_m()[i], layout.sphere(i).rest_radius_m, 1e-9 * layout.sphere(i).rest_radius_m);
+    EXPECT_NEAR(stretch.radii_m()[i], layout.sphere(i).rest_radius_m,
+                1e-9 * layout.sphere(i).rest_radius_m);
   }
 }
 
 TEST(SphereState, SmallestStretchRuleRefusesShortRestPositions) {
   const geometry::TetMesh mesh = test::block_tet_mesh({0, 0, 0}, {0.01, 0.01, 0.01}, 2);
-  const sphere_layout::SphereLayout layout = sphere_layout::fill_spheres(mesh, sphere_layout::FillSettings{});
+  const sphere_layout::SphereLayout layout =
+      sphere_layout::fill_spheres(mesh, sphere_layout::FillSettings{});
   const std::vector<double> too_short(3, 0.0);
   EXPECT_THROW(SphereState(layout, too_short), std::invalid_argument);
 }

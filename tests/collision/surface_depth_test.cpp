@@ -11,10 +11,10 @@
 #include <stdexcept>
 #include <vector>
 
-#include "fahr/geometry/signed_distance_field.h"
-#include "fahr/sphere_layout/fill_spheres.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/sphere_layout/fill_spheres.h"
 #include "test_meshes.h"
 
 namespace fahr::collision {
@@ -39,7 +39,7 @@ struct SquashedBlock {
     const double widen = 1.0 / std::sqrt(kSquash);
     for (const auto& p : mesh.rest_positions()) {
       squashed.insert(squashed.end(), {0.5 * kSide + widen * (p.x() - 0.5 * kSide), kSquash * p.y(),
-                                        0.5 * kSide + widen * (p.z() - 0.5 * kSide)});
+                                       0.5 * kSide + widen * (p.z() - 0.5 * kSide)});
     }
   }
 };
@@ -53,7 +53,8 @@ const SquashedBlock& squashed_block() {
 geometry::SignedDistanceField pressing_plate(double underside_m) {
   geometry::SdfOptions options;
   options.cell_size_m = 0.5e-3;
-  return geometry::SignedDistanceField(test::box_surface({-0.01, underside_m, -0.01}, {0.02, 0.02, 0.02}), options);
+  return geometry::SignedDistanceField(
+      test::box_surface({-0.01, underside_m, -0.01}, {0.02, 0.02, 0.02}), options);
 }
 
 TEST(SurfaceAnchor, EverySphereHasOneOnTheRestBoundary) {
@@ -134,7 +135,8 @@ TEST(SurfaceDepth, IsTheFlattenedSurfacesTruePenetrationWhereTheSphereDepthIsNot
   tree.refit(state);
   const auto plate = pressing_plate(b.top_m - kPenetration);
   RigidBody body{3, &plate, Eigen::Isometry3d::Identity()};
-  for (const auto probe : {QuerySettings::SurfaceProbe::kFacePoint, QuerySettings::SurfaceProbe::kAnchor}) {
+  for (const auto probe :
+       {QuerySettings::SurfaceProbe::kFacePoint, QuerySettings::SurfaceProbe::kAnchor}) {
     QuerySettings settings;
     settings.surface_probe = probe;
     PrePenetrationMemory memory(b.layout.size());

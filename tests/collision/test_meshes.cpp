@@ -13,7 +13,9 @@ namespace fahr::collision::test {
 
 geometry::TetMesh block_tet_mesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int n) {
   std::vector<Eigen::Vector3d> x;
-  auto id = [n](int i, int j, int k) { return static_cast<geometry::Index>(i + (n + 1) * (j + (n + 1) * k)); };
+  auto id = [n](int i, int j, int k) {
+    return static_cast<geometry::Index>(i + (n + 1) * (j + (n + 1) * k));
+  };
   for (int k = 0; k <= n; ++k)
     for (int j = 0; j <= n; ++j)
       for (int i = 0; i <= n; ++i) {
@@ -44,17 +46,20 @@ geometry::TetMesh block_tet_mesh(const Eigen::Vector3d& lo, const Eigen::Vector3
 
 geometry::SurfaceMesh box_surface(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   std::vector<Eigen::Vector3d> v;
-  for (int k = 0; k < 8; ++k) v.emplace_back((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
+  for (int k = 0; k < 8; ++k)
+    v.emplace_back((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
   // Two triangles per face, counter-clockwise seen from outside.
-  std::vector<geometry::Triangle> t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                                       {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  std::vector<geometry::Triangle> t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6},
+                                       {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},
+                                       {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
   return geometry::SurfaceMesh(std::move(v), std::move(t));
 }
 
 geometry::SurfaceMesh icosphere(const Eigen::Vector3d& centre, double radius, int subdivisions) {
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                                    {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                                    {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                                    {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
   for (auto& p : v) p.normalize();
   std::vector<geometry::Triangle> t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                        {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
@@ -86,12 +91,14 @@ geometry::SurfaceMesh icosphere(const Eigen::Vector3d& centre, double radius, in
 }
 
 const geometry::TetMesh& neonatal_tongue() {
-  static const geometry::TetMesh mesh = geometry::load_tetgen(std::string(FAHR_NEONATAL_DIR) + "/tongue", 0.001);
+  static const geometry::TetMesh mesh =
+      geometry::load_tetgen(std::string(FAHR_NEONATAL_DIR) + "/tongue", 0.001);
   return mesh;
 }
 
 const sphere_layout::SphereLayout& neonatal_layout() {
-  static const sphere_layout::SphereLayout layout = sphere_layout::fill_spheres(neonatal_tongue(), sphere_layout::FillSettings{});
+  static const sphere_layout::SphereLayout layout =
+      sphere_layout::fill_spheres(neonatal_tongue(), sphere_layout::FillSettings{});
   return layout;
 }
 

@@ -17,8 +17,8 @@ int main(int argc, char** argv) {
     config.domain_id = static_cast<std::uint32_t>(std::atoi(argv[3]));
     config.participant_name = std::string("lockstep_") + argv[1];
     fahr::common::Participant participant(config);
-    const auto hash = fahr::test::run_lockstep_participant(participant, argv[1],
-                                                           static_cast<std::uint32_t>(std::atoi(argv[4])));
+    const auto hash = fahr::test::run_lockstep_participant(
+        participant, argv[1], static_cast<std::uint32_t>(std::atoi(argv[4])));
     std::printf("%s %016llx\n", argv[1], static_cast<unsigned long long>(hash));
     return 0;
   } catch (const std::exception& e) {

@@ -1,14 +1,13 @@
 // Seeded sample contents for interop tests.
 #include "sample_factory.h"
 
-#include "fahr/common/backend.h"
-
 #include <algorithm>
 #include <random>
 
 #include "contact_setPubSubTypes.h"
 #include "deformation_statePubSubTypes.h"
 #include "device_posePubSubTypes.h"
+#include "fahr/common/backend.h"
 #include "force_commandPubSubTypes.h"
 #include "scene_descriptionPubSubTypes.h"
 #include "service_statusPubSubTypes.h"
@@ -255,7 +254,8 @@ void fill(msg::StepAck& s, std::uint64_t seed, std::size_t) {
 
 template <class T>
 std::vector<std::uint8_t> cdr_bytes(const T& sample) {
-  auto* type = static_cast<eprosima::fastdds::dds::TopicDataType*>(common::detail::type_support<T>().make_fast_type());
+  auto* type = static_cast<eprosima::fastdds::dds::TopicDataType*>(
+      common::detail::type_support<T>().make_fast_type());
   T copy = sample;
   eprosima::fastrtps::rtps::SerializedPayload_t payload(type->getSerializedSizeProvider(&copy)());
   type->serialize(&copy, &payload);

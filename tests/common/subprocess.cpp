@@ -32,7 +32,9 @@ Subprocess::~Subprocess() {
   }
 }
 
-void Subprocess::signal(int signo) const { kill(pid_, signo); }
+void Subprocess::signal(int signo) const {
+  kill(pid_, signo);
+}
 
 int Subprocess::wait(int timeout_ms) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);

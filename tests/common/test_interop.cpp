@@ -26,7 +26,8 @@ struct VendorPair {
 };
 
 std::string pair_name(const testing::TestParamInfo<VendorPair>& info) {
-  return std::string(common::vendor_name(info.param.local)) + "_to_" + std::string(common::vendor_name(info.param.peer));
+  return std::string(common::vendor_name(info.param.local)) + "_to_" +
+         std::string(common::vendor_name(info.param.peer));
 }
 
 bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
@@ -43,7 +44,8 @@ void expect_round_trip(common::Participant& participant, std::size_t sequence_le
   SCOPED_TRACE(std::string(common::TopicTraits<T>::kName));
   common::Publisher<T> ping(participant, test_qos(), ping_topic<T>());
   common::Subscriber<T> pong(participant, test_qos(), pong_topic<T>());
-  ASSERT_TRUE(wait_until([&] { return ping.matched_readers() > 0 && pong.matched_writers() > 0; }, 15s))
+  ASSERT_TRUE(
+      wait_until([&] { return ping.matched_readers() > 0 && pong.matched_writers() > 0; }, 15s))
       << "peer never matched";
   T sent;
   fill(sent, 42 + sequence_length, sequence_length);
@@ -63,8 +65,8 @@ class Interop : public testing::TestWithParam<VendorPair> {};
 
 TEST_P(Interop, EveryTopicTypeCrossesIntact) {
   const VendorPair pair = GetParam();
-  Subprocess peer({executable_dir() + "/transport_peer", "echo", std::string(common::vendor_name(pair.peer)),
-                   std::to_string(pair.domain), "60"});
+  Subprocess peer({executable_dir() + "/transport_peer", "echo",
+                   std::string(common::vendor_name(pair.peer)), std::to_string(pair.domain), "60"});
   common::TransportConfig config;
   config.vendor = pair.local;
   config.domain_id = pair.domain;

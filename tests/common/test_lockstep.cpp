@@ -31,9 +31,10 @@ std::map<std::string, std::uint64_t> run_processes(Vendor coordinator_vendor, Ve
                                                    Vendor slow_vendor, std::uint32_t domain,
                                                    std::uint32_t jitter_seed) {
   const std::string peer = executable_dir() + "/lockstep_peer";
-  Subprocess fast({peer, "fast", std::string(common::vendor_name(fast_vendor)), std::to_string(domain),
-                   std::to_string(jitter_seed)});
-  Subprocess slow({peer, "slow", std::string(common::vendor_name(slow_vendor)), std::to_string(domain),
+  Subprocess fast({peer, "fast", std::string(common::vendor_name(fast_vendor)),
+                   std::to_string(domain), std::to_string(jitter_seed)});
+  Subprocess slow({peer, "slow", std::string(common::vendor_name(slow_vendor)),
+                   std::to_string(domain),
                    std::to_string(jitter_seed + (jitter_seed != 0 ? 1 : 0))});
   common::TransportConfig config;
   config.vendor = coordinator_vendor;
@@ -56,8 +57,12 @@ std::map<std::string, std::uint64_t> run_in_process(std::uint32_t jitter_seed) {
   common::Participant fast_participant(config);
   common::Participant slow_participant(config);
   common::LockstepCoordinator coordinator(coordinator_participant, 1ms);
-  auto fast = std::async(std::launch::async, [&] { return run_lockstep_participant(fast_participant, "fast", jitter_seed); });
-  auto slow = std::async(std::launch::async, [&] { return run_lockstep_participant(slow_participant, "slow", jitter_seed); });
+  auto fast = std::async(std::launch::async, [&] {
+    return run_lockstep_participant(fast_participant, "fast", jitter_seed);
+  });
+  auto slow = std::async(std::launch::async, [&] {
+    return run_lockstep_participant(slow_participant, "slow", jitter_seed);
+  });
   const auto result = coordinator.run({"fast", "slow"}, kSteps, 20s);
   EXPECT_TRUE(result.completed);
   EXPECT_EQ(fast.get(), result.hashes.at("fast"));

@@ -4,17 +4,15 @@
 // the vendors' own threads do not count against the loop under test.
 #include <gtest/gtest.h>
 
-#include "allocation_counter.h"
-
 #include <chrono>
 #include <cstdlib>
 #include <new>
 #include <thread>
 
+#include "allocation_counter.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/subscriber.h"
 #include "sample_factory.h"
-
 
 namespace fahr::test {
 namespace {

@@ -40,11 +40,17 @@ class QosEvents : public testing::TestWithParam<Case> {
     c.participant_name = "test_qos_events";
     return c;
   }
-  std::vector<std::string> writer(int period_ms, int deadline_ms, int lease_ms, int total_ms, int silent_at_ms,
-                                  int silent_ms) const {
-    return {executable_dir() + "/transport_peer", "writer", std::string(common::vendor_name(GetParam().vendor)),
-            std::to_string(GetParam().domain), std::to_string(period_ms), std::to_string(deadline_ms),
-            std::to_string(lease_ms), std::to_string(total_ms), std::to_string(silent_at_ms),
+  std::vector<std::string> writer(int period_ms, int deadline_ms, int lease_ms, int total_ms,
+                                  int silent_at_ms, int silent_ms) const {
+    return {executable_dir() + "/transport_peer",
+            "writer",
+            std::string(common::vendor_name(GetParam().vendor)),
+            std::to_string(GetParam().domain),
+            std::to_string(period_ms),
+            std::to_string(deadline_ms),
+            std::to_string(lease_ms),
+            std::to_string(total_ms),
+            std::to_string(silent_at_ms),
             std::to_string(silent_ms)};
   }
 };
@@ -59,11 +65,12 @@ TEST_P(QosEvents, DeadlineMissesCountTheSilence) {
     std::lock_guard lock(mutex);
     for (int i = 0; i < e.total_count_change; ++i) misses_ns.push_back(e.time_ns);
   });
-  common::Subscriber<msg::DevicePose> reader(participant, qos_under_test(10, 0), kQosTopic,
-                                             [&](const msg::DevicePose&, const common::SampleInfo& info) {
-                                               std::lock_guard lock(mutex);
-                                               arrivals_ns.push_back(info.receive_time_ns);
-                                             });
+  common::Subscriber<msg::DevicePose> reader(
+      participant, qos_under_test(10, 0), kQosTopic,
+      [&](const msg::DevicePose&, const common::SampleInfo& info) {
+        std::lock_guard lock(mutex);
+        arrivals_ns.push_back(info.receive_time_ns);
+      });
   // Writes every 5 ms for 1.2 s, silent from 600 ms for 100 ms.
   Subprocess peer(writer(5, 10, 0, 1200, 600, 100));
   ASSERT_EQ(peer.wait(20000), 0);
@@ -72,7 +79,8 @@ TEST_P(QosEvents, DeadlineMissesCountTheSilence) {
   // The silence is the longest gap between arrivals.
   std::size_t gap_end = 1;
   for (std::size_t i = 1; i < arrivals_ns.size(); ++i) {
-    if (arrivals_ns[i] - arrivals_ns[i - 1] > arrivals_ns[gap_end] - arrivals_ns[gap_end - 1]) gap_end = i;
+    if (arrivals_ns[i] - arrivals_ns[i - 1] > arrivals_ns[gap_end] - arrivals_ns[gap_end - 1])
+      gap_end = i;
   }
   const std::int64_t gap_start_ns = arrivals_ns[gap_end - 1];
   const std::int64_t gap_stop_ns = arrivals_ns[gap_end];
@@ -80,7 +88,8 @@ TEST_P(QosEvents, DeadlineMissesCountTheSilence) {
   int in_gap = 0;
   int while_periodic = 0;
   for (auto t : misses_ns) {
-    if (t < arrivals_ns.front() || t > arrivals_ns.back()) continue;  // before the first / after the last sample
+    if (t < arrivals_ns.front() || t > arrivals_ns.back())
+      continue;  // before the first / after the last sample
     if (t >= gap_start_ns && t <= gap_stop_ns + 2'000'000) {
       ++in_gap;
     } else {
@@ -104,19 +113,23 @@ TEST_P(QosEvents, StoppedWriterIsReportedNotAlive) {
     return true;
   };
   auto& events = participant.events();
-  ASSERT_TRUE(wait_for([&] { return events.alive_writers() == 1; }, 15s)) << "writer never became alive";
+  ASSERT_TRUE(wait_for([&] { return events.alive_writers() == 1; }, 15s))
+      << "writer never became alive";
   peer.signal(SIGSTOP);
   const auto stopped = std::chrono::steady_clock::now();
-  ASSERT_TRUE(wait_for([&] { return events.not_alive_writers() == 1; }, 3s)) << "SIGSTOPped writer still alive";
+  ASSERT_TRUE(wait_for([&] { return events.not_alive_writers() == 1; }, 3s))
+      << "SIGSTOPped writer still alive";
   const auto detection = std::chrono::steady_clock::now() - stopped;
   EXPECT_LT(detection, 1s) << "lease is 100 ms";
   peer.signal(SIGCONT);
-  EXPECT_TRUE(wait_for([&] { return events.alive_writers() == 1 && events.not_alive_writers() == 0; }, 5s))
+  EXPECT_TRUE(
+      wait_for([&] { return events.alive_writers() == 1 && events.not_alive_writers() == 0; }, 5s))
       << "resumed writer not alive again";
 }
 
 INSTANTIATE_TEST_SUITE_P(Vendors, QosEvents,
-                         testing::Values(Case{Vendor::kFastDds, 21}, Case{Vendor::kCyclone, 22}), case_name);
+                         testing::Values(Case{Vendor::kFastDds, 21}, Case{Vendor::kCyclone, 22}),
+                         case_name);
 
 }  // namespace
 }  // namespace fahr::test

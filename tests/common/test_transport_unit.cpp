@@ -141,12 +141,14 @@ TEST(Config, MissingAndMalformedProfilesAreRefused) {
   const auto dir = std::filesystem::temp_directory_path() / "fahr_profiles";
   std::filesystem::create_directories(dir);
   const auto bad_fast = (dir / "bad_fast.xml").string();
-  std::ofstream(bad_fast) << "<profiles><participant profile_name=\"x\"><rtps><unclosed></profiles>";
+  std::ofstream(bad_fast)
+      << "<profiles><participant profile_name=\"x\"><rtps><unclosed></profiles>";
   config.profile_file = bad_fast;
   EXPECT_THROW(Participant p(config), ConfigError);
 
   const auto bad_cyclone = (dir / "bad_cyclone.xml").string();
-  std::ofstream(bad_cyclone) << "<CycloneDDS><Domain><General><NoSuchSetting>1</NoSuchSetting></General></Domain></CycloneDDS>";
+  std::ofstream(bad_cyclone) << "<CycloneDDS><Domain><General><NoSuchSetting>1</NoSuchSetting></"
+                                "General></Domain></CycloneDDS>";
   config.vendor = Vendor::kCyclone;
   config.domain_id = 17;
   config.profile_file = bad_cyclone;
@@ -169,8 +171,9 @@ TEST(ServiceReporter, ReportsTickStatisticsLatePeriodsAndQosEvents) {
   common::Subscriber<msg::ServiceStatus> status(p);
   common::Subscriber<msg::ServiceEvents> events(p);
   common::TickRecorder recorder;
-  common::ServiceReporter reporter(p, {"test_service", 1000.0, std::chrono::hours(1)}, recorder,
-                                   [](auto& metrics) { metrics.emplace_back("latency_p99_ms", 1.25); });
+  common::ServiceReporter reporter(
+      p, {"test_service", 1000.0, std::chrono::hours(1)}, recorder,
+      [](auto& metrics) { metrics.emplace_back("latency_p99_ms", 1.25); });
   std::int64_t start = 1'000'000'000;
   for (std::uint64_t tick = 0; tick < 101; ++tick) {
     start += tick == 50 ? 3'000'000 : 1'000'000;  // one period of 3 ms: late
@@ -191,7 +194,8 @@ TEST(ServiceReporter, ReportsTickStatisticsLatePeriodsAndQosEvents) {
   ASSERT_TRUE(events.fetch_newest());
   EXPECT_EQ(events.newest().tick_spans().size(), 101U);
   bool saw_match = false;
-  for (const auto& e : events.newest().qos_events()) saw_match |= e.kind() == msg::QOS_PUBLICATION_MATCHED;
+  for (const auto& e : events.newest().qos_events())
+    saw_match |= e.kind() == msg::QOS_PUBLICATION_MATCHED;
   EXPECT_TRUE(saw_match) << "the reporter's own publications matched the test's readers";
 }
 
@@ -234,7 +238,8 @@ TEST(BackgroundPublisher, WritesTheNewestAndAccountsForEverySample) {
 
 TEST(TickRecorder, DropsWhenFullInsteadOfBlocking) {
   common::TickRecorder recorder;
-  for (std::size_t i = 0; i < common::TickRecorder::kCapacity + 10; ++i) recorder.push({i, 0, 0, 0});
+  for (std::size_t i = 0; i < common::TickRecorder::kCapacity + 10; ++i)
+    recorder.push({i, 0, 0, 0});
   EXPECT_EQ(recorder.dropped(), 10U);
   std::size_t n = 0;
   recorder.drain([&](const common::TickRecord&) { ++n; });

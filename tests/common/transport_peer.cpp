@@ -32,10 +32,11 @@ template <class T>
 struct Echo final : EchoBase {
   explicit Echo(Participant& p)
       : publisher(p, test::test_qos(), test::pong_topic<T>()),
-        subscriber(p, test::test_qos(), test::ping_topic<T>(), [this](const T& sample, const SampleInfo&) {
-          T copy = sample;
-          publisher.write(copy);
-        }) {}
+        subscriber(p, test::test_qos(), test::ping_topic<T>(),
+                   [this](const T& sample, const SampleInfo&) {
+                     T copy = sample;
+                     publisher.write(copy);
+                   }) {}
   Publisher<T> publisher;
   Subscriber<T> subscriber;
 };
@@ -62,14 +63,16 @@ int run_writer(Participant& participant, char** argv) {
   const int total_ms = std::atoi(argv[3]);
   const int silent_at_ms = std::atoi(argv[4]);
   const int silent_ms = std::atoi(argv[5]);
-  Publisher<msg::DevicePose> publisher(participant, test::qos_under_test(deadline_ms, lease_ms), test::kQosTopic);
+  Publisher<msg::DevicePose> publisher(participant, test::qos_under_test(deadline_ms, lease_ms),
+                                       test::kQosTopic);
   msg::DevicePose pose;
   const auto start = std::chrono::steady_clock::now();
   auto next = start;
   for (int tick = 0;; ++tick) {
     next += milliseconds(period_ms);
     std::this_thread::sleep_until(next);
-    const auto elapsed = std::chrono::duration_cast<milliseconds>(std::chrono::steady_clock::now() - start).count();
+    const auto elapsed =
+        std::chrono::duration_cast<milliseconds>(std::chrono::steady_clock::now() - start).count();
     if (elapsed >= total_ms) break;
     if (elapsed >= silent_at_ms && elapsed < silent_at_ms + silent_ms) continue;
     pose.servo_tick(static_cast<std::uint64_t>(tick));

@@ -42,7 +42,8 @@ Trace press(ContactResponse& response, test::SyntheticPatch& patch, double limit
       if (!was_lost) trace.frozen_proxy = out.proxy_position_m;
       trace.froze = true;
       trace.max_reaction_lost = std::max(trace.max_reaction_lost, out.tissue_reaction_n);
-      trace.proxy_drift_lost = std::max(trace.proxy_drift_lost, (out.proxy_position_m - trace.frozen_proxy).norm());
+      trace.proxy_drift_lost =
+          std::max(trace.proxy_drift_lost, (out.proxy_position_m - trace.frozen_proxy).norm());
       int frozen = 0, force_only = 0;
       for (const fem::Contact& c : response.contacts()) {
         frozen += c.state == fem::ContactState::kFrozen;

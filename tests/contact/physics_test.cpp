@@ -13,8 +13,8 @@ TEST(Physics, FlatPunchMatchesBoussinesqAtEveryFemRate) {
   for (const double hz : {50.0, 200.0, 1000.0}) {
     const sim::PunchResult r = sim::run_punch_experiment(hz, 0.005, 0.001, fem_static_npm);
     EXPECT_TRUE(r.finite);
-    EXPECT_LT(std::abs(r.haptic_error), 0.10) << hz << " Hz: haptic " << r.haptic_force_n << " N, Boussinesq "
-                                              << r.boussinesq_n << " N";
+    EXPECT_LT(std::abs(r.haptic_error), 0.10)
+        << hz << " Hz: haptic " << r.haptic_force_n << " N, Boussinesq " << r.boussinesq_n << " N";
     // The solve reproduces the FEM's own static force closely.
     EXPECT_LT(std::abs(r.haptic_vs_fem), 0.03) << hz << " Hz";
   }
@@ -22,7 +22,8 @@ TEST(Physics, FlatPunchMatchesBoussinesqAtEveryFemRate) {
 
 TEST(Physics, OvershootStaysStableAndWithinTheLimit) {
   constexpr double kLimitN = 1.0;
-  const sim::OvershootResult r = sim::run_overshoot_experiment(sim::Method::kForceAware, kLimitN, 0.0);
+  const sim::OvershootResult r =
+      sim::run_overshoot_experiment(sim::Method::kForceAware, kLimitN, 0.0);
   EXPECT_TRUE(r.finite);
   EXPECT_EQ(r.max_inverted, 0);
   EXPECT_GE(r.max_commanded_n, 3.0 * kLimitN);

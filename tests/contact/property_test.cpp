@@ -40,9 +40,11 @@ TEST_P(Property, RandomTrajectoriesStaySafe) {
   EXPECT_EQ(failures, 0);
   // The runs exercise the decision, not only free motion.
   EXPECT_GT(froze, kRunsPerBlock / 10);
-  std::printf("runs %d-%d: %d lost track at least once; max reaction/limit %.4f, max command/limit %.4f, "
-              "max persistent penetration %.2f um\n",
-              first, first + kRunsPerBlock - 1, froze, worst_reaction, worst_command, 1e6 * worst_penetration_m);
+  std::printf(
+      "runs %d-%d: %d lost track at least once; max reaction/limit %.4f, max command/limit %.4f, "
+      "max persistent penetration %.2f um\n",
+      first, first + kRunsPerBlock - 1, froze, worst_reaction, worst_command,
+      1e6 * worst_penetration_m);
 }
 
 INSTANTIATE_TEST_SUITE_P(Blocks, Property, ::testing::Range(0, kBlocks));

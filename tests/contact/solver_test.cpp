@@ -9,7 +9,6 @@
 #include "fahr/contact/contact_solver.h"
 #include "fahr/contact/coupling.h"
 #include "fahr/contact/pgs.h"
-
 #include "synthetic.h"
 
 namespace fahr::contact {
@@ -50,7 +49,8 @@ TEST(Pgs, CoupledRowsMeetTheComplementarityConditions) {
   for (double& v : b) v = 1e-3 * uniform(random);  // m
   PgsSettings settings;
   settings.max_sweeps = 5000;
-  const PgsReport report = solve_pgs(s.data(), stride, k, b.data(), lambda.data(), residual.data(), settings);
+  const PgsReport report =
+      solve_pgs(s.data(), stride, k, b.data(), lambda.data(), residual.data(), settings);
   EXPECT_TRUE(report.converged);
   int active = 0;
   for (std::size_t i = 0; i < k; ++i) {
@@ -102,16 +102,19 @@ TEST(TissueCompliance, AlongNormalsReadsAsTheBlocksForTheFemsNormalAndItsOpposit
   std::vector<Eigen::Vector3d> m(k);
   for (std::size_t t = 0; t < k; ++t) {
     m[t] = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
-    for (std::size_t d = 0; d < 3; ++d) normals[3 * t + d] = static_cast<float>(m[t][static_cast<Eigen::Index>(d)]);
+    for (std::size_t d = 0; d < 3; ++d)
+      normals[3 * t + d] = static_cast<float>(m[t][static_cast<Eigen::Index>(d)]);
   }
   for (std::size_t r = 0; r < 3 * k; ++r) {
     for (std::size_t c = 0; c < 3 * k; ++c) {
-      blocks[r * 3 * k + c] = static_cast<float>(w(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)));
+      blocks[r * 3 * k + c] =
+          static_cast<float>(w(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)));
     }
     for (std::size_t t = 0; t < k; ++t) {
       // Through the float normals, as the FEM's columns are.
       const Eigen::Vector3d mt(normals[3 * t], normals[3 * t + 1], normals[3 * t + 2]);
-      const Eigen::RowVector3d row = w.block<1, 3>(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(3 * t));
+      const Eigen::RowVector3d row =
+          w.block<1, 3>(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(3 * t));
       along[r * k + t] = static_cast<float>(row.dot(mt.transpose()));
     }
   }
@@ -127,11 +130,13 @@ TEST(TissueCompliance, AlongNormalsReadsAsTheBlocksForTheFemsNormalAndItsOpposit
       const Eigen::Vector3d mt(normals[3 * t], normals[3 * t + 1], normals[3 * t + 2]);
       for (const double sign : {1.0, -1.0}) {
         const Eigen::Vector3d n = sign * mt;
-        EXPECT_NEAR(by_normals.normal_compliance(s, m[s], t, n), full.normal_compliance(s, m[s], t, n), 1e-9);
+        EXPECT_NEAR(by_normals.normal_compliance(s, m[s], t, n),
+                    full.normal_compliance(s, m[s], t, n), 1e-9);
         EXPECT_LT((by_normals.column(s, t, n) - full.column(s, t, n)).norm(), 1e-9);
       }
       const Eigen::Vector3d turned = (mt + 0.05 * mt.unitOrthogonal()).normalized();
-      EXPECT_LT((by_normals.column(s, t, turned) - turned.dot(mt) * full.column(s, t, mt)).norm(), 1e-9);
+      EXPECT_LT((by_normals.column(s, t, turned) - turned.dot(mt) * full.column(s, t, mt)).norm(),
+                1e-9);
     }
   }
 }
@@ -141,7 +146,8 @@ TEST(ContactSolver, LocalStiffnessIsSymmetricAndBoundedByTheCoupling) {
   // Tilt the normals so the active set spans several directions.
   for (std::size_t i = 0; i < patch.rows.size(); ++i) {
     const double angle = 0.3 * static_cast<double>(i) / 12.0;
-    patch.rows[i].normal = Eigen::Vector3d(std::sin(angle), -std::cos(angle), 0.1 * angle).normalized();
+    patch.rows[i].normal =
+        Eigen::Vector3d(std::sin(angle), -std::cos(angle), 0.1 * angle).normalized();
   }
   ContactSolver solver(16);
   solver.load(patch.rows, patch.compliance(), 1e-3);
@@ -149,7 +155,8 @@ TEST(ContactSolver, LocalStiffnessIsSymmetricAndBoundedByTheCoupling) {
   solver.solve_coupled(k, Eigen::Vector3d(0.001, -0.003, 0), PgsSettings{});
   const Eigen::Matrix3d stiffness = solver.local_stiffness(k);
   EXPECT_LT((stiffness - stiffness.transpose()).norm(), 1e-9 * k);
-  const Eigen::Vector3d eigen = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(stiffness).eigenvalues();
+  const Eigen::Vector3d eigen =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(stiffness).eigenvalues();
   EXPECT_GE(eigen.minCoeff(), -1e-9);
   EXPECT_LE(eigen.maxCoeff(), k * (1 + 1e-12));
 }
@@ -158,7 +165,7 @@ TEST(ContactSolver, RigidObstacleStopsTheProxy) {
   ContactRow wall;
   wall.kind = RowKind::kObstacle;
   wall.id = 3;
-  wall.normal = Eigen::Vector3d(1, 0, 0);            // the obstacle lies in +x of the tool
+  wall.normal = Eigen::Vector3d(1, 0, 0);  // the obstacle lies in +x of the tool
   wall.tool_point_m = Eigen::Vector3d(0, 0, 0);
   wall.other_point_m = Eigen::Vector3d(0.0005, 0, 0);  // 0.5 mm gap
   ContactSolver solver(4);

@@ -25,15 +25,16 @@ struct IntubationRun {
 // pressing pose's height) through a jittery link: the full loop.
 IntubationRun run_intubation(bool with_wall) {
   device::GatewayConfig config;
-  device::SimulatedBackend backend(device::intubation_script(), device::HandImpedance{}, config.model, config.mapping,
-                                   config.period);
+  device::SimulatedBackend backend(device::intubation_script(), device::HandImpedance{},
+                                   config.model, config.mapping, config.period);
   device::ServoCore core(config, backend);
   VirtualWall wall;
   wall.wall_y_m = with_wall ? -0.5e-3 : -1.0;
   DelayLink link(DelayLink::Settings{});
   IntubationRun run;
   PoseHash hash;
-  const auto ticks = static_cast<std::uint64_t>(device::intubation_script().duration().count() / 1e-3);
+  const auto ticks =
+      static_cast<std::uint64_t>(device::intubation_script().duration().count() / 1e-3);
   for (std::uint64_t t = 0; t < ticks; ++t) {
     const auto& pose = core.tick(tick_time(t), link.receive(t));
     link.send(t, wall.answer(pose));
@@ -49,7 +50,8 @@ TEST(Determinism, TwoSimulatedIntubationsGiveTheSameStream) {
   const IntubationRun first = run_intubation(true);
   const IntubationRun second = run_intubation(true);
   std::printf("intubation: %zu DevicePose samples, hash %016llx / %016llx\n", first.poses.size(),
-              static_cast<unsigned long long>(first.hash), static_cast<unsigned long long>(second.hash));
+              static_cast<unsigned long long>(first.hash),
+              static_cast<unsigned long long>(second.hash));
   EXPECT_EQ(first.hash, second.hash);
   EXPECT_EQ(first.poses.size(), 13000U);
 }

@@ -3,17 +3,15 @@
 // back-end the library has and hostile commands mixed in.
 #include <gtest/gtest.h>
 
-#include "allocation_counter.h"
-
 #include <cstdlib>
 #include <limits>
 #include <new>
 
+#include "allocation_counter.h"
 #include "fahr/device/remote_input_backend.h"
 #include "fahr/device/replay_backend.h"
 #include "fahr/device/simulated_backend.h"
 #include "test_support.h"
-
 
 namespace fahr::test {
 namespace {
@@ -26,15 +24,23 @@ device::ForceCommandSample hostile(std::uint64_t tick, const Vec3& position_m) {
   c.force_n = Vec3(0.0, 0.2, 0.0);
   c.stiffness_npm(1, 1) = 800.0;
   switch (tick % 5) {
-    case 1: c.force_n *= 1e12; break;
-    case 2: c.force_n.x() = std::numeric_limits<double>::quiet_NaN(); break;
-    case 3: c.answered_pose_seq = tick > 100 ? tick - 100 : 0; break;
-    default: break;
+    case 1:
+      c.force_n *= 1e12;
+      break;
+    case 2:
+      c.force_n.x() = std::numeric_limits<double>::quiet_NaN();
+      break;
+    case 3:
+      c.answered_pose_seq = tick > 100 ? tick - 100 : 0;
+      break;
+    default:
+      break;
   }
   return c;
 }
 
-void run_ticks(device::ServoCore& core, std::uint64_t first, std::uint64_t count, const Vec3& position_m) {
+void run_ticks(device::ServoCore& core, std::uint64_t first, std::uint64_t count,
+               const Vec3& position_m) {
   for (std::uint64_t t = first; t < first + count; ++t) {
     const device::ForceCommandSample c = hostile(t, position_m);
     core.tick(tick_time(t), t > 0 ? &c : nullptr);
@@ -43,8 +49,8 @@ void run_ticks(device::ServoCore& core, std::uint64_t first, std::uint64_t count
 
 TEST(NoAllocation, SimulatedServoTick) {
   device::GatewayConfig config;
-  device::SimulatedBackend backend(device::intubation_script(), device::HandImpedance{}, config.model, config.mapping,
-                                   config.period);
+  device::SimulatedBackend backend(device::intubation_script(), device::HandImpedance{},
+                                   config.model, config.mapping, config.period);
   device::ServoCore core(config, backend);
   run_ticks(core, 0, 100, Vec3::Zero());  // warm-up
   AllocationCounter counter;

@@ -13,7 +13,7 @@ namespace fahr::test {
 namespace {
 
 struct RunResult {
-  double max_energy_to_hand_j = 0.0;   // largest net energy delivered to the hand at any time
+  double max_energy_to_hand_j = 0.0;  // largest net energy delivered to the hand at any time
   double final_energy_to_hand_j = 0.0;
   double peak_force_n = 0.0;
   double max_step_n = 0.0;
@@ -68,11 +68,12 @@ RunResult run(bool send_stiffness, bool passivity, const DelayLink::Settings& li
 }
 
 void report(const char* name, const RunResult& r) {
-  std::printf("%-44s max E_hand %+9.3f mJ, final %+9.3f mJ, peak |F| %.3f N, max dF %.3f N, PC %llu ticks "
-              "(%.3f mJ removed), %llu commands, %llu dropped\n",
-              name, r.max_energy_to_hand_j * 1e3, r.final_energy_to_hand_j * 1e3, r.peak_force_n, r.max_step_n,
-              static_cast<unsigned long long>(r.pc_active_ticks), r.dissipated_j * 1e3,
-              static_cast<unsigned long long>(r.commands), static_cast<unsigned long long>(r.dropped));
+  std::printf(
+      "%-44s max E_hand %+9.3f mJ, final %+9.3f mJ, peak |F| %.3f N, max dF %.3f N, PC %llu ticks "
+      "(%.3f mJ removed), %llu commands, %llu dropped\n",
+      name, r.max_energy_to_hand_j * 1e3, r.final_energy_to_hand_j * 1e3, r.peak_force_n,
+      r.max_step_n, static_cast<unsigned long long>(r.pc_active_ticks), r.dissipated_j * 1e3,
+      static_cast<unsigned long long>(r.commands), static_cast<unsigned long long>(r.dropped));
 }
 
 // Energy the device may have given the hand at any instant and still count

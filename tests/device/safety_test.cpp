@@ -53,11 +53,13 @@ class SafetyTest : public testing::Test {
       c.answered_pose_seq = core_.ticks();
       tick(core_.ticks() == 0 ? nullptr : &c);
     }
-    ASSERT_EQ(core_.tick(tick_time(core_.ticks()), nullptr).safety_state, SafetyState::kForceEnabled);
+    ASSERT_EQ(core_.tick(tick_time(core_.ticks()), nullptr).safety_state,
+              SafetyState::kForceEnabled);
   }
 
   double max_step_n() const {
-    return core_.config().safety.max_force_rate_nps * std::chrono::duration<double>(core_.config().period).count();
+    return core_.config().safety.max_force_rate_nps *
+           std::chrono::duration<double>(core_.config().period).count();
   }
 
   ScriptedBackend backend_;
@@ -77,7 +79,8 @@ TEST_F(SafetyTest, HugeForcesAndWildStiffnessNeverExceedPeakOrRate) {
     backend_.reading.linear_velocity_mps = Vec3(unit(rng), unit(rng), unit(rng)) * 0.2;
     const double scale = std::pow(10.0, exponent(rng));
     ForceCommandSample c = command(Vec3(unit(rng), unit(rng), unit(rng)) * scale);
-    for (int k = 0; k < 9; ++k) c.stiffness_npm(k / 3, k % 3) = unit(rng) * std::pow(10.0, exponent(rng) % 12);
+    for (int k = 0; k < 9; ++k)
+      c.stiffness_npm(k / 3, k % 3) = unit(rng) * std::pow(10.0, exponent(rng) % 12);
     const auto& pose = tick(&c);
     peak_seen_n = std::max(peak_seen_n, pose.rendered_force_n.norm());
   }
@@ -85,11 +88,14 @@ TEST_F(SafetyTest, HugeForcesAndWildStiffnessNeverExceedPeakOrRate) {
   EXPECT_GT(counters.saturated_ticks, 4000U);
   EXPECT_GT(counters.rate_limited_ticks, 1000U);
   EXPECT_EQ(counters.non_finite_outputs, 0U);
-  EXPECT_GT(peak_seen_n, 0.9 * core_.config().model.peak_force_n);  // the limit is reached, not avoided
-  std::printf("hostile forces: peak rendered %.4f N (limit %.2f N), saturated %llu, rate-limited %llu ticks\n",
-              peak_seen_n, core_.config().model.peak_force_n,
-              static_cast<unsigned long long>(counters.saturated_ticks),
-              static_cast<unsigned long long>(counters.rate_limited_ticks));
+  EXPECT_GT(peak_seen_n,
+            0.9 * core_.config().model.peak_force_n);  // the limit is reached, not avoided
+  std::printf(
+      "hostile forces: peak rendered %.4f N (limit %.2f N), saturated %llu, rate-limited %llu "
+      "ticks\n",
+      peak_seen_n, core_.config().model.peak_force_n,
+      static_cast<unsigned long long>(counters.saturated_ticks),
+      static_cast<unsigned long long>(counters.rate_limited_ticks));
 }
 
 TEST_F(SafetyTest, SaturationScalesTheVectorKeepingItsDirection) {
@@ -120,7 +126,8 @@ TEST_F(SafetyTest, ForceStepsAreRateLimited) {
 
 TEST_F(SafetyTest, NonFiniteCommandsAreRejectedAndCounted) {
   engage();
-  const double bad_values[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+  const double bad_values[] = {std::numeric_limits<double>::quiet_NaN(),
+                               std::numeric_limits<double>::infinity(),
                                -std::numeric_limits<double>::infinity()};
   std::uint64_t injected = 0;
   for (int round = 0; round < 30; ++round) {
@@ -215,7 +222,8 @@ TEST_F(SafetyTest, NoKickOnConnect) {
   for (std::uint32_t i = 0; i < cycles; ++i) {
     const ForceCommandSample c = command(Vec3(0.0, 0.1, 0.0));
     const auto& pose = tick(&c);
-    EXPECT_EQ(pose.safety_state, i + 1 < cycles ? SafetyState::kEngaging : SafetyState::kForceEnabled);
+    EXPECT_EQ(pose.safety_state,
+              i + 1 < cycles ? SafetyState::kEngaging : SafetyState::kForceEnabled);
   }
   EXPECT_EQ(core_.safety_counters().engage_events, 1U);
   // Once engaged, a step to 5 N is a ramp, not a kick.

@@ -59,10 +59,10 @@ class DelayLink {
   struct Settings {
     std::uint32_t seed = 7;
     int base_delay_ticks = 1;
-    double spike_probability = 0.2;   // per command
+    double spike_probability = 0.2;  // per command
     int spike_min_ticks = 2;
     int spike_max_ticks = 5;
-    double burst_probability = 0.002; // per tick: a lost burst starts
+    double burst_probability = 0.002;  // per tick: a lost burst starts
     int burst_min_ticks = 10;
     int burst_max_ticks = 40;
   };
@@ -78,7 +78,8 @@ class DelayLink {
       return;
     }
     int delay = settings_.base_delay_ticks;
-    if (uniform_(rng_) < settings_.spike_probability) delay = pick(settings_.spike_min_ticks, settings_.spike_max_ticks);
+    if (uniform_(rng_) < settings_.spike_probability)
+      delay = pick(settings_.spike_min_ticks, settings_.spike_max_ticks);
     in_flight_.push_back({tick + static_cast<std::uint64_t>(delay), command});
   }
 

@@ -24,8 +24,10 @@ TEST(Thermal, SustainedOverloadDeratesToContinuousAndRecovers) {
     if (thermal.renderable_force_n() >= model.peak_force_n) burst_s += 1e-3;
     thermal.update(std::min(3.0 * model.peak_force_n, thermal.renderable_force_n()), dt);
   }
-  std::printf("thermal: peak available for %.3f s from cold; after 300 s: %.4f N (continuous %.2f N), heat %.4f\n",
-              burst_s, thermal.renderable_force_n(), model.continuous_force_n, thermal.heat());
+  std::printf(
+      "thermal: peak available for %.3f s from cold; after 300 s: %.4f N (continuous %.2f N), heat "
+      "%.4f\n",
+      burst_s, thermal.renderable_force_n(), model.continuous_force_n, thermal.heat());
   // Bursts get the peak for a while (below a second for tau 30 s, from cold) ...
   EXPECT_GT(burst_s, 0.3);
   EXPECT_LT(burst_s, 2.0);

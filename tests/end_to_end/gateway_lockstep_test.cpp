@@ -17,9 +17,10 @@ namespace {
 using namespace std::chrono_literals;
 
 std::uint64_t run_gateway(common::Vendor vendor, std::uint32_t domain) {
-  Subprocess gateway({FAHR_GATEWAY, "--mode", "lockstep", "--dds", std::string(common::vendor_name(vendor)),
-                      "--domain", std::to_string(domain), "--backend", "simulated", "--script", "intubation",
-                      "--duration-s", "0", "--force-input-period", "0"});
+  Subprocess gateway({FAHR_GATEWAY, "--mode", "lockstep", "--dds",
+                      std::string(common::vendor_name(vendor)), "--domain", std::to_string(domain),
+                      "--backend", "simulated", "--script", "intubation", "--duration-s", "0",
+                      "--force-input-period", "0"});
   common::TransportConfig config;
   config.vendor = vendor;
   config.domain_id = domain;

@@ -45,48 +45,51 @@ TEST(Allocation, StepAllocatesNothing) {
   const TetMesh mesh = test::bar_mesh(2);
   // Every mode with the linear material and with compression stiffening.
   for (const double stiffening : {0.0, kTongueYeohC20OverC10})
-  for (const Mode& mode : modes()) {
-    BodySettings settings;
-    settings.solver = mode.solver;
-    settings.material.yeoh_c20_over_c10 = stiffening;
-    // The modes that must not refactorise keep a changed scale from doing so.
-    if (!mode.refactorises) settings.solver.refactor_stiffening_change = 0.0;
-    settings.sleep.enabled = false;
-    auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
-    ASSERT_NE(body, nullptr);
-    SphereLinks links;
-    const std::array<double, 4> w = {0.25, 0.25, 0.25, 0.25};
-    ASSERT_EQ(links.add_sphere(mesh.tets.back(), w, 0.001), "");
-    ContactSet set;
-    Contact contact;
-    contact.kind = ContactKind::kObstacle;
-    contact.state = ContactState::kActive;
-    contact.plane_point_m = Eigen::Vector3d(0, -0.002, 0);
-    set.contacts.push_back(contact);
-    body->set_external_force(static_cast<std::uint32_t>(mesh.nodes_m.size() - 1), Eigen::Vector3d(0, 0.001, 0));
-    for (int k = 0; k < 3; ++k) {
-      set.state_step = body->step_index();
-      body->step(&set, &links);
+    for (const Mode& mode : modes()) {
+      BodySettings settings;
+      settings.solver = mode.solver;
+      settings.material.yeoh_c20_over_c10 = stiffening;
+      // The modes that must not refactorise keep a changed scale from doing so.
+      if (!mode.refactorises) settings.solver.refactor_stiffening_change = 0.0;
+      settings.sleep.enabled = false;
+      auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+      ASSERT_NE(body, nullptr);
+      SphereLinks links;
+      const std::array<double, 4> w = {0.25, 0.25, 0.25, 0.25};
+      ASSERT_EQ(links.add_sphere(mesh.tets.back(), w, 0.001), "");
+      ContactSet set;
+      Contact contact;
+      contact.kind = ContactKind::kObstacle;
+      contact.state = ContactState::kActive;
+      contact.plane_point_m = Eigen::Vector3d(0, -0.002, 0);
+      set.contacts.push_back(contact);
+      body->set_external_force(static_cast<std::uint32_t>(mesh.nodes_m.size() - 1),
+                               Eigen::Vector3d(0, 0.001, 0));
+      for (int k = 0; k < 3; ++k) {
+        set.state_step = body->step_index();
+        body->step(&set, &links);
+      }
+      test::reset_allocation_counts();
+      test::enable_allocation_counting(true);
+      int refactorisations = 0;
+      for (int k = 0; k < 20; ++k) {
+        set.state_step = body->step_index();
+        refactorisations += body->step(&set, &links).refactorised ? 1 : 0;
+      }
+      test::enable_allocation_counting(false);
+      EXPECT_EQ(test::new_count(), 0u) << mode.name << ", stiffening " << stiffening;
+      if (!mode.refactorises) {
+        EXPECT_EQ(refactorisations, 0) << mode.name << ", stiffening " << stiffening;
+        EXPECT_EQ(test::suitesparse_alloc_count(), 0u)
+            << mode.name << ", stiffening " << stiffening;
+      } else {
+        // Reported, not asserted: CHOLMOD's numeric refactorisation mallocs its
+        // permuted copy of A and supernodal workspace.
+        std::printf(
+            "[ info ] %s, stiffening %.2f: %d refactorisations, %zu CHOLMOD mallocs in 20 steps\n",
+            mode.name, stiffening, refactorisations, test::suitesparse_alloc_count());
+      }
     }
-    test::reset_allocation_counts();
-    test::enable_allocation_counting(true);
-    int refactorisations = 0;
-    for (int k = 0; k < 20; ++k) {
-      set.state_step = body->step_index();
-      refactorisations += body->step(&set, &links).refactorised ? 1 : 0;
-    }
-    test::enable_allocation_counting(false);
-    EXPECT_EQ(test::new_count(), 0u) << mode.name << ", stiffening " << stiffening;
-    if (!mode.refactorises) {
-      EXPECT_EQ(refactorisations, 0) << mode.name << ", stiffening " << stiffening;
-      EXPECT_EQ(test::suitesparse_alloc_count(), 0u) << mode.name << ", stiffening " << stiffening;
-    } else {
-      // Reported, not asserted: CHOLMOD's numeric refactorisation mallocs its
-      // permuted copy of A and supernodal workspace.
-      std::printf("[ info ] %s, stiffening %.2f: %d refactorisations, %zu CHOLMOD mallocs in 20 steps\n",
-                  mode.name, stiffening, refactorisations, test::suitesparse_alloc_count());
-    }
-  }
 }
 
 // The compliance block keeps each sphere's solved columns while the

@@ -45,15 +45,18 @@ TEST(Compliance, MatchesTheResponseOfOneStep) {
   const auto nodes = links.nodes(1);
   const auto weights = links.weights(1);
   std::vector<Eigen::Vector3d> before;
-  for (std::uint32_t s = 0; s < 3; ++s) before.push_back(links.centre(s, body->positions_m().data()));
-  for (std::size_t m = 0; m < nodes.size(); ++m) body->set_external_force(nodes[m], weights[m] * force);
+  for (std::uint32_t s = 0; s < 3; ++s)
+    before.push_back(links.centre(s, body->positions_m().data()));
+  for (std::size_t m = 0; m < nodes.size(); ++m)
+    body->set_external_force(nodes[m], weights[m] * force);
   body->step();
   for (std::uint32_t s = 0; s < 3; ++s) {
     const Eigen::Vector3d moved = links.centre(s, body->positions_m().data()) - before[s];
     Eigen::Vector3d predicted = Eigen::Vector3d::Zero();
     for (std::size_t d = 0; d < 3; ++d) {
       for (std::size_t e = 0; e < 3; ++e) {
-        predicted[static_cast<Eigen::Index>(d)] += w[(3 * s + d) * 9 + 3 + e] * force[static_cast<Eigen::Index>(e)];
+        predicted[static_cast<Eigen::Index>(d)] +=
+            w[(3 * s + d) * 9 + 3 + e] * force[static_cast<Eigen::Index>(e)];
       }
     }
     // float storage: 1e-6 relative.
@@ -68,7 +71,8 @@ TEST(Compliance, AlongNormalsIsTheBlocksTimesTheNormals) {
   const BodySettings settings = still_settings();
   const SphereLinks links = tip_spheres(mesh, 3);
   const std::vector<std::uint32_t> spheres = {2, 0, 1};
-  const std::vector<Eigen::Vector3d> normals = {Eigen::Vector3d(0.0, 0.6, 0.8), Eigen::Vector3d(-1.0, 0.0, 0.0),
+  const std::vector<Eigen::Vector3d> normals = {Eigen::Vector3d(0.0, 0.6, 0.8),
+                                                Eigen::Vector3d(-1.0, 0.0, 0.0),
                                                 Eigen::Vector3d(0.0, 0.0, 1.0)};
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
   ASSERT_NE(body, nullptr);
@@ -85,9 +89,11 @@ TEST(Compliance, AlongNormalsIsTheBlocksTimesTheNormals) {
       for (std::size_t d = 0; d < 3; ++d) {
         double expected = 0.0;
         for (std::size_t e = 0; e < 3; ++e) {
-          expected += double{blocks[(3 * s + d) * 9 + 3 * t + e]} * normals[t][static_cast<Eigen::Index>(e)];
+          expected += double{blocks[(3 * s + d) * 9 + 3 * t + e]} *
+                      normals[t][static_cast<Eigen::Index>(e)];
         }
-        EXPECT_NEAR(along[(3 * s + d) * 3 + t], expected, 1e-6 * largest) << s << " " << t << " " << d;
+        EXPECT_NEAR(along[(3 * s + d) * 3 + t], expected, 1e-6 * largest)
+            << s << " " << t << " " << d;
       }
     }
   }
@@ -118,7 +124,8 @@ TEST(Compliance, KeptColumnsGiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
     const std::size_t n = 9 * spheres.size() * spheres.size();
     float largest = 0.0f;
     for (std::size_t i = 0; i < n; ++i) largest = std::max(largest, std::abs(w_fresh[i]));
-    for (std::size_t i = 0; i < n; ++i) EXPECT_NEAR(w_used[i], w_fresh[i], 1e-6f * largest) << when << " entry " << i;
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_NEAR(w_used[i], w_fresh[i], 1e-6f * largest) << when << " entry " << i;
   };
   std::vector<float> scratch(9 * 16);
   ASSERT_TRUE(used->compliance(std::vector<std::uint32_t>{0, 1, 2}, links, scratch));

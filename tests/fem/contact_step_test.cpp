@@ -1,10 +1,11 @@
 // fem::ContactStep: the free-motion centres are the motion without this
 // step's contact forces, W is reused only while it is still exact, a reset
 // body steps as a new one, and a step allocates nothing once sized.
+#include "fahr/fem/contact_step.h"
+
 #include <gtest/gtest.h>
 
 #include "allocation_counter.h"
-#include "fahr/fem/contact_step.h"
 #include "scenes.h"
 
 namespace fahr::fem {
@@ -16,7 +17,8 @@ struct Bar {
   std::vector<std::uint32_t> top;
   SphereLinks links;
   Bar() {
-    top = test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.029 && p.y() > 0.0099; });
+    top = test::nodes_where(
+        mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.029 && p.y() > 0.0099; });
     const double w = 1.0;
     for (const std::uint32_t n : top) EXPECT_EQ(links.add_sphere({&n, 1}, {&w, 1}, 0.001), "");
   }
@@ -106,14 +108,18 @@ TEST(ContactStep, AlongNormalsGivesTheSameFreeCentresAndTheBlocksAlongTheSetsNor
       for (std::size_t d = 0; d < 3; ++d) {
         double expected = 0.0;
         for (std::size_t e = 0; e < 3; ++e) {
-          expected += double{blocks.compliance()[(3 * s + d) * 3 * k + 3 * t + e]} * n[static_cast<Eigen::Index>(e)];
+          expected += double{blocks.compliance()[(3 * s + d) * 3 * k + 3 * t + e]} *
+                      n[static_cast<Eigen::Index>(e)];
         }
-        EXPECT_NEAR(along.compliance()[(3 * s + d) * k + t], expected, 1e-6 * std::abs(blocks.compliance()[0]));
+        EXPECT_NEAR(along.compliance()[(3 * s + d) * k + t], expected,
+                    1e-6 * std::abs(blocks.compliance()[0]));
       }
     }
   }
   // The pushed sphere's free centre differs from where it went: not vacuous.
-  EXPECT_GT((along.free_centres()[0] - bar.links.centre(0, along_body->positions_m().data())).norm(), 1e-7);
+  EXPECT_GT(
+      (along.free_centres()[0] - bar.links.centre(0, along_body->positions_m().data())).norm(),
+      1e-7);
   along.step(&set);
   EXPECT_EQ(along.compliance_reuses(), 1u);
   set.contacts[2].normal = Eigen::Vector3d(1.0, 0.0, 0.0);
@@ -144,7 +150,9 @@ TEST(ContactStep, ADivergedStepResetsTheBodyToRest) {
   set.state_step = unchecked_body->step_index();
   const StepReport far = unchecked.step(&set);
   EXPECT_FALSE(far.diverged_reset);
-  EXPECT_GT((unchecked_body->position(bar.top[0]) - unchecked_body->rest_position(bar.top[0])).norm(), 0.1);
+  EXPECT_GT(
+      (unchecked_body->position(bar.top[0]) - unchecked_body->rest_position(bar.top[0])).norm(),
+      0.1);
   const StepReport reset = checked.step(&set);
   EXPECT_TRUE(reset.diverged_reset);
   for (std::uint32_t n = 0; n < checked_body->node_count(); ++n) {
@@ -194,7 +202,8 @@ TEST(ContactStep, AResetBodyStepsAsANewOne) {
     used_step.step(&a);
     fresh_step.step(&b);
   }
-  for (std::uint32_t n = 0; n < used->node_count(); ++n) EXPECT_EQ(used->position(n), fresh->position(n)) << n;
+  for (std::uint32_t n = 0; n < used->node_count(); ++n)
+    EXPECT_EQ(used->position(n), fresh->position(n)) << n;
   for (std::size_t i = 0; i < used_step.compliance().size(); ++i) {
     EXPECT_EQ(used_step.compliance()[i], fresh_step.compliance()[i]);
   }

@@ -1,9 +1,10 @@
 // Rotation invariance and inversion handling of the corotated element.
+#include "fahr/fem/corotation.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
-#include "fahr/fem/corotation.h"
 #include "scenes.h"
 
 namespace fahr::fem {
@@ -20,8 +21,10 @@ TEST(Corotation, RigidRotationGivesZeroElasticForce) {
   const Eigen::Vector3d translation(0.3, -1.2, 0.7);
   std::vector<double> forces(3 * body->node_count());
   for (const double degrees : {30.0, 90.0, 135.0, 179.0, 180.0, 270.0}) {
-    for (const Eigen::Vector3d& axis : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0.3, -0.8, 0.52).normalized()}) {
-      const Eigen::Matrix3d rotation = Eigen::AngleAxisd(degrees * M_PI / 180.0, axis).toRotationMatrix();
+    for (const Eigen::Vector3d& axis :
+         {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0.3, -0.8, 0.52).normalized()}) {
+      const Eigen::Matrix3d rotation =
+          Eigen::AngleAxisd(degrees * M_PI / 180.0, axis).toRotationMatrix();
       for (std::uint32_t i = 0; i < body->node_count(); ++i) {
         body->set_node_position(i, rotation * mesh.nodes_m[i] + translation);
       }
@@ -39,12 +42,14 @@ TEST(Corotation, InvertedDeformationGivesProperRotation) {
   const Corotation c = rotation_from_deformation(f);
   EXPECT_TRUE(c.inverted);
   EXPECT_NEAR(c.rotation.determinant(), 1.0, 1e-12);
-  EXPECT_NEAR((c.rotation * c.rotation.transpose() - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((c.rotation * c.rotation.transpose() - Eigen::Matrix3d::Identity()).norm(), 0.0,
+              1e-12);
   // A flat element (det 0) still gives a rotation.
   f = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
   EXPECT_NEAR(rotation_from_deformation(f).rotation.determinant(), 1.0, 1e-12);
   // A stretched rotation: Newton's path recovers the rotation.
-  const Eigen::Matrix3d q = Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d q =
+      Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   const Eigen::Matrix3d s = Eigen::Vector3d(1.5, 0.7, 1.1).asDiagonal();
   EXPECT_NEAR((rotation_from_deformation(q * s).rotation - q).norm(), 0.0, 1e-10);
 }

@@ -5,6 +5,8 @@
 // rest on the floor), a node driven into or through a thin plate is put
 // back on its own side, bad input does not spread, far nodes are not
 // sampled every step, and a step allocates nothing once warmed.
+#include "fahr/fem/obstacle_projection.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +14,6 @@
 
 #include "allocation_counter.h"
 #include "fahr/fem/contact_step.h"
-#include "fahr/fem/obstacle_projection.h"
 #include "scenes.h"
 
 namespace fahr::fem {
@@ -41,7 +42,8 @@ class Floor final : public ObstacleField {
 // the mid-plane.
 class Plate final : public ObstacleField {
  public:
-  Plate(double centre_m, double half_thickness_m) : centre_m_(centre_m), half_m_(half_thickness_m) {}
+  Plate(double centre_m, double half_thickness_m)
+      : centre_m_(centre_m), half_m_(half_thickness_m) {}
   ObstacleSample sample(const Eigen::Vector3d& p) const noexcept override {
     const double side = p.y() >= centre_m_ ? 1.0 : -1.0;
     return {std::abs(p.y() - centre_m_) - half_m_, Eigen::Vector3d(0, side, 0)};
@@ -74,7 +76,8 @@ struct PressedBar {
   std::vector<std::uint32_t> top;
   SphereLinks links;
   PressedBar() {
-    top = test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.0149 && p.y() > 0.0099; });
+    top = test::nodes_where(
+        mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.0149 && p.y() > 0.0099; });
     const double w = 1.0;
     for (const std::uint32_t n : top) EXPECT_EQ(links.add_sphere({&n, 1}, {&w, 1}, 0.0), "");
   }
@@ -101,14 +104,14 @@ struct PressedBar {
   }
 };
 
-
 // The pressed bar stepped with a floor 1 mm below it as its anatomy.
 struct BarOverFloor {
   PressedBar bar;
   std::unique_ptr<Body> body;
   Floor floor{-1e-3};
   std::unique_ptr<ContactStep> step;
-  explicit BarOverFloor(const BodySettings& settings) : body(test::make_body(settings, bar.mesh, bar.fixed)) {
+  explicit BarOverFloor(const BodySettings& settings)
+      : body(test::make_body(settings, bar.mesh, bar.fixed)) {
     if (!body) return;
     step = std::make_unique<ContactStep>(*body, bar.links);
     const ObstacleField* fields[] = {&floor};
@@ -126,7 +129,8 @@ TEST(ObstacleProjection, APressedBodyNeverGoesDeeperThanTheMargin) {
   step.set_obstacles(fields);
   int deepest_step = 0;
   double deepest_free = 0.0;
-  for (int k = 0; k < 300; ++k) {  // 1.5 s: pressed 15 mm through the bar and 14 mm into the floor, and 1 N
+  for (int k = 0; k < 300;
+       ++k) {  // 1.5 s: pressed 15 mm through the bar and 14 mm into the floor, and 1 N
     const ContactSet set = bar.press(*body, 0.015, 1.0);
     const StepReport report = step.step(&set);
     ASSERT_FALSE(report.solve_failed) << k;
@@ -159,7 +163,8 @@ TEST(ObstacleProjection, FixedNodesNeverMove) {
     if (k == 0) {
       EXPECT_GT(report.projection.obstacle_nodes, 0);
     }
-    for (const std::uint32_t n : bar.fixed) ASSERT_EQ(body->position(n), body->rest_position(n)) << "node " << n;
+    for (const std::uint32_t n : bar.fixed)
+      ASSERT_EQ(body->position(n), body->rest_position(n)) << "node " << n;
     ASSERT_GE(test::lowest_free_node_height(*body) - 2e-3, kMargin - kTolerance) << "step " << k;
   }
 }
@@ -188,7 +193,8 @@ TEST(ObstacleProjection, TheMovesAreCarriedAsVelocity) {
   double fastest = 0.0;
   for (std::size_t i = 0; i < before.size(); i += 3) {
     const auto x = body->positions_m();
-    const Eigen::Vector3d moved(x[i] - before[i], x[i + 1] - before[i + 1], x[i + 2] - before[i + 2]);
+    const Eigen::Vector3d moved(x[i] - before[i], x[i + 1] - before[i + 1],
+                                x[i + 2] - before[i + 2]);
     fastest = std::max(fastest, moved.norm() / body->time_step_s());
   }
   EXPECT_LT(fastest, 1e-3);  // m/s, after 3 s
@@ -197,9 +203,15 @@ TEST(ObstacleProjection, TheMovesAreCarriedAsVelocity) {
 TEST(ObstacleProjection, NonFiniteNodesAndSamplesDoNotSpread) {
   const Floor floor(0.0);
   const Broken broken;
-  std::vector<double> x = {0.0, -1e-3, 0.0,  // inside the floor: moved out
-                           std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0,
-                           0.0, -2e-3, 0.0};  // fixed: stays
+  std::vector<double> x = {0.0,
+                           -1e-3,
+                           0.0,  // inside the floor: moved out
+                           std::numeric_limits<double>::quiet_NaN(),
+                           0.0,
+                           0.0,
+                           0.0,
+                           -2e-3,
+                           0.0};  // fixed: stays
   const std::vector<double> inverse_mass = {1.0, 1.0, 0.0};
   const ObstacleField* good[] = {&floor};
   ObstacleProjection projection(good, 3);
@@ -262,7 +274,8 @@ TEST(ObstacleProjection, ANodeBeyondAPlateFromItsRestMayCrossBackHome) {
     std::vector<double> x = end;
     projection.begin_step();
     ProjectionReport report;
-    projection.project(x, inverse_mass, report, start, with_rest ? std::span<const double>(rest) : std::span<const double>());
+    projection.project(x, inverse_mass, report, start,
+                       with_rest ? std::span<const double>(rest) : std::span<const double>());
     if (with_rest) {
       EXPECT_EQ(x[1], end[1]);
       EXPECT_EQ(projection.nodes_returned(), 1);

@@ -3,6 +3,8 @@
 // support springs, so the compliance W the haptic solve reads for a point on
 // its top feels the floor (the bar compresses instead of bending through
 // it); the springs do not glue: pulled up, the bar is let go and lifts off.
+#include "fahr/fem/obstacle_support.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -10,7 +12,6 @@
 
 #include "fahr/fem/contact_step.h"
 #include "fahr/fem/obstacle_projection.h"
-#include "fahr/fem/obstacle_support.h"
 #include "scenes.h"
 
 namespace fahr::fem {
@@ -35,7 +36,6 @@ BodySettings tongue_like() {
   return s;
 }
 
-
 // The 30 x 10 x 10 mm bar, its x = 0 face fixed, 1 mm above a floor; one
 // zero-radius sphere on the top node nearest the free end's middle, whose
 // W_yy is read.
@@ -51,8 +51,8 @@ struct BarOnFloor {
   std::vector<double> push;  // extra force, 3 per node, N
 
   explicit BarOnFloor(double support_ratio) {
-    free_half_top =
-        test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.0149 && p.y() > 0.0099; });
+    free_half_top = test::nodes_where(
+        mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.0149 && p.y() > 0.0099; });
     double best = std::numeric_limits<double>::infinity();
     for (const std::uint32_t n : free_half_top) {
       const double d = (mesh.nodes_m[n] - Eigen::Vector3d(0.03, 0.01, 0.005)).norm();
@@ -76,7 +76,8 @@ struct BarOnFloor {
   // A total vertical force on the free half's top nodes, N (< 0 down).
   void set_push(double total_n) {
     std::fill(push.begin(), push.end(), 0.0);
-    for (const std::uint32_t n : free_half_top) push[3 * n + 1] = total_n / static_cast<double>(free_half_top.size());
+    for (const std::uint32_t n : free_half_top)
+      push[3 * n + 1] = total_n / static_cast<double>(free_half_top.size());
   }
   double w_yy() const { return static_cast<double>(step->compliance()[4]); }
 };

@@ -1,15 +1,17 @@
 // Algorithm 1 projection: mass-weighted spread, frozen and active
 // constraints, repeated, dropped and stale ContactSets.
+#include "fahr/fem/projection.h"
+
 #include <gtest/gtest.h>
 
-#include "fahr/fem/projection.h"
 #include "scenes.h"
 
 namespace fahr::fem {
 namespace {
 
 // A sphere tied to the four nodes of tet `e` with equal weights.
-SphereLinks links_for_tets(const TetMesh& mesh, std::initializer_list<std::size_t> tets, double radius_m) {
+SphereLinks links_for_tets(const TetMesh& mesh, std::initializer_list<std::size_t> tets,
+                           double radius_m) {
   SphereLinks links;
   for (const std::size_t e : tets) {
     const std::array<double, 4> w = {0.25, 0.25, 0.25, 0.25};
@@ -41,8 +43,10 @@ TEST(Projection, CentreMovesExactlyByCorrectionAndHeavyNodesMoveLess) {
   const Eigen::Vector3d after = links.centre(0, positions.data());
   EXPECT_NEAR((after - before - dc).norm(), 0.0, 1e-15);
   auto moved = [&](int node) {
-    return Eigen::Vector3d(positions[3 * node] - start[3 * node], positions[3 * node + 1] - start[3 * node + 1],
-                           positions[3 * node + 2] - start[3 * node + 2]).norm();
+    return Eigen::Vector3d(positions[3 * node] - start[3 * node],
+                           positions[3 * node + 1] - start[3 * node + 1],
+                           positions[3 * node + 2] - start[3 * node + 2])
+        .norm();
   };
   EXPECT_EQ(moved(0), 0.0);
   EXPECT_LT(moved(3), moved(2));  // heavier (and larger weight) still moves less
@@ -55,11 +59,13 @@ TEST(Projection, TranslationSpreadMovesEveryFreeNodeAlike) {
   OneSphere one;
   auto& [links, positions, start, inverse_mass, dc] = one;
   const Eigen::Vector3d before = links.centre(0, positions.data());
-  ASSERT_TRUE(move_sphere_centre(0, links, inverse_mass, dc, positions, SphereSpread::kTranslation));
+  ASSERT_TRUE(
+      move_sphere_centre(0, links, inverse_mass, dc, positions, SphereSpread::kTranslation));
   EXPECT_NEAR((links.centre(0, positions.data()) - before - dc).norm(), 0.0, 1e-15);
   const Eigen::Vector3d expected = dc / 0.9;  // the free nodes carry 0.9 of the centre
   for (int node = 1; node < 4; ++node) {
-    const Eigen::Vector3d moved(positions[3 * node] - start[3 * node], positions[3 * node + 1] - start[3 * node + 1],
+    const Eigen::Vector3d moved(positions[3 * node] - start[3 * node],
+                                positions[3 * node + 1] - start[3 * node + 1],
                                 positions[3 * node + 2] - start[3 * node + 2]);
     EXPECT_NEAR((moved - expected).norm(), 0.0, 1e-15) << node;
   }
@@ -76,7 +82,8 @@ TEST(Projection, FrozenConstraintHoldsExactly) {
   ASSERT_NE(body, nullptr);
   const std::size_t tip_tet = mesh.tets.size() - 1;
   const SphereLinks links = links_for_tets(mesh, {tip_tet}, 0.002);
-  const Eigen::Vector3d hold = links.centre(0, body->positions_m().data()) + Eigen::Vector3d(0, 0.002, 0);
+  const Eigen::Vector3d hold =
+      links.centre(0, body->positions_m().data()) + Eigen::Vector3d(0, 0.002, 0);
   ContactSet set;
   Contact frozen;
   frozen.sphere_id = 0;
@@ -112,7 +119,8 @@ TEST(Projection, FrozenSphereStaysWhereTheStepStarted) {
   for (int k = 0; k < 100; ++k) {
     set.state_step = body->step_index();
     body->step(&set, &links);
-    ASSERT_NEAR((links.centre(0, body->positions_m().data()) - where).norm(), 0.0, 1e-12) << "step " << k;
+    ASSERT_NEAR((links.centre(0, body->positions_m().data()) - where).norm(), 0.0, 1e-12)
+        << "step " << k;
   }
 }
 
@@ -141,13 +149,15 @@ TEST(Projection, ContradictoryHoldsDoNotDragTheNodes) {
       Contact frozen;
       frozen.sphere_id = s;
       frozen.state = ContactState::kFrozen;
-      frozen.hold_centre_m = links.centre(s, rest.data()) + Eigen::Vector3d(0, s == 0 ? 0.003 : -0.003, 0);
+      frozen.hold_centre_m =
+          links.centre(s, rest.data()) + Eigen::Vector3d(0, s == 0 ? 0.003 : -0.003, 0);
       set.contacts.push_back(frozen);
     }
     set.state_step = body->step_index();
     body->step(&set, &links);
     double largest = 0.0;
-    for (std::size_t i = 0; i < rest.size(); ++i) largest = std::max(largest, std::abs(body->positions_m()[i] - rest[i]));
+    for (std::size_t i = 0; i < rest.size(); ++i)
+      largest = std::max(largest, std::abs(body->positions_m()[i] - rest[i]));
     moved[target == FrozenTarget::kStepStart ? 0 : 1] = largest;
   }
   EXPECT_LT(moved[0], 1e-9);
@@ -188,7 +198,8 @@ TEST(Projection, ActiveConstraintLeavesNoPenetration) {
     const StepReport report = body->step(&set, &links);
     ASSERT_TRUE(report.projection.converged);
     for (std::uint32_t s = 0; s < links.size(); ++s) {
-      const double gap = links.centre(s, body->positions_m().data()).y() + 0.004 - links.radius_m(s);
+      const double gap =
+          links.centre(s, body->positions_m().data()).y() + 0.004 - links.radius_m(s);
       worst = std::min(worst, gap);
     }
     if (report.projection.last_correction_m > 0.0 || report.projection.sweeps > 1) ++touching_steps;
@@ -232,7 +243,8 @@ TEST(Projection, DroppedSetOnlyAffectsItsOwnStep) {
   // The hold is re-imposed the next step; what remains 29 steps later is the
   // damped echo of one unconstrained step, well below 1 % of the hold offset.
   double largest = 0.0;
-  for (std::size_t i = 0; i < every.size(); ++i) largest = std::max(largest, std::abs(every[i] - dropped[i]));
+  for (std::size_t i = 0; i < every.size(); ++i)
+    largest = std::max(largest, std::abs(every[i] - dropped[i]));
   EXPECT_LT(largest, 3e-5);
 }
 

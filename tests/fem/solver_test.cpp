@@ -33,7 +33,8 @@ double largest_difference(const std::vector<double>& a, const std::vector<double
 TEST(Solvers, CholmodAndCgAgreeStepByStep) {
   SolverSettings direct;
   const auto reference = run(direct, 50);
-  for (const CgPreconditioner preconditioner : {CgPreconditioner::kJacobi, CgPreconditioner::kLaggedCholesky}) {
+  for (const CgPreconditioner preconditioner :
+       {CgPreconditioner::kJacobi, CgPreconditioner::kLaggedCholesky}) {
     SolverSettings cg;
     cg.kind = LinearSolver::kConjugateGradient;
     cg.preconditioner = preconditioner;
@@ -100,8 +101,11 @@ TEST(Solvers, CgRefreshesItsFactorOnlyWhenTheSolveGetsExpensive) {
     auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
     EXPECT_NE(body, nullptr);
     most_iterations = 0;
-    for (int k = 0; k < 100; ++k) most_iterations = std::max(most_iterations, body->step().solver_iterations);
-    EXPECT_LT(largest_difference(reference, {body->positions_m().begin(), body->positions_m().end()}), 1e-8)
+    for (int k = 0; k < 100; ++k)
+      most_iterations = std::max(most_iterations, body->step().solver_iterations);
+    EXPECT_LT(
+        largest_difference(reference, {body->positions_m().begin(), body->positions_m().end()}),
+        1e-8)
         << "refresh after " << refresh_iterations;
     return body->factorisations() - 1;  // less the set-up's
   };
@@ -129,7 +133,8 @@ TEST(Solvers, SetSolverSwitchesARunningBodyAndRejectsBadSettings) {
   bad.refactor_rotation_rad = -0.1;
   EXPECT_NE(body->set_solver(bad).find("refactor_rotation_rad"), std::string::npos);
   settings.solver.cg_refresh_iterations = -2;
-  EXPECT_NE(Body::create(settings, mesh.nodes_m, mesh.tets, test::fixed_x0(mesh)).error.find("cg_refresh_iterations"),
+  EXPECT_NE(Body::create(settings, mesh.nodes_m, mesh.tets, test::fixed_x0(mesh))
+                .error.find("cg_refresh_iterations"),
             std::string::npos);
   // Switched to CG on a fresh factor and back with another ordering: the
   // trajectory stays the exact one.
@@ -148,7 +153,8 @@ TEST(Solvers, SetSolverSwitchesARunningBodyAndRejectsBadSettings) {
   ASSERT_EQ(body->set_solver(amd), "");
   for (int k = 0; k < 20; ++k) body->step();
   const auto reference = run(SolverSettings{}, 60);
-  EXPECT_LT(largest_difference(reference, {body->positions_m().begin(), body->positions_m().end()}), 1e-8);
+  EXPECT_LT(largest_difference(reference, {body->positions_m().begin(), body->positions_m().end()}),
+            1e-8);
 }
 
 TEST(Solvers, RestFactorAloneOscillatesUnderLargeRotation) {

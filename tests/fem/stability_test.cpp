@@ -34,9 +34,11 @@ TEST_P(LoadAbuse, StaysFiniteBoundedAndReturnsToRest) {
   settings.sleep.enabled = false;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
   ASSERT_NE(body, nullptr);
-  const auto tip = test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.03 - 1e-9; });
+  const auto tip =
+      test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.03 - 1e-9; });
   const double weight = body->total_mass_kg() * 9.81;
-  const Eigen::Vector3d per_node(0.0, -abuse.load_in_body_weights * weight / static_cast<double>(tip.size()), 0.0);
+  const Eigen::Vector3d per_node(
+      0.0, -abuse.load_in_body_weights * weight / static_cast<double>(tip.size()), 0.0);
   for (const std::uint32_t node : tip) body->set_external_force(node, per_node);
   const int load_steps = static_cast<int>(std::ceil(1.0 / abuse.step_s));
   double peak_elastic = 0.0;
@@ -60,15 +62,16 @@ TEST_P(LoadAbuse, StaysFiniteBoundedAndReturnsToRest) {
       EXPECT_LT(total, released.total_j());
     }
   }
-  std::printf("[ info ] h %.3f s, load %.0fx weight: energy at release %.3g J, peak after %.3g J\n", abuse.step_s,
-              abuse.load_in_body_weights, released.total_j(), peak_elastic);
+  std::printf("[ info ] h %.3f s, load %.0fx weight: energy at release %.3g J, peak after %.3g J\n",
+              abuse.step_s, abuse.load_in_body_weights, released.total_j(), peak_elastic);
   EXPECT_LE(peak_elastic, kEnergyOvershootBound * released.total_j() + 1e-12);
   EXPECT_LT(test::max_displacement(*body), kRestTolerance_m);
 }
 
 INSTANTIATE_TEST_SUITE_P(StepsAndLoads, LoadAbuse,
-                         ::testing::Values(AbuseCase{0.001, 1.0}, AbuseCase{0.001, 100.0}, AbuseCase{0.01, 100.0},
-                                           AbuseCase{0.05, 1.0}, AbuseCase{0.05, 100.0}));
+                         ::testing::Values(AbuseCase{0.001, 1.0}, AbuseCase{0.001, 100.0},
+                                           AbuseCase{0.01, 100.0}, AbuseCase{0.05, 1.0},
+                                           AbuseCase{0.05, 100.0}));
 
 TEST(Stability, YankedNodeReleased) {
   const TetMesh mesh = test::bar_mesh(2);
@@ -90,7 +93,8 @@ TEST(Stability, YankedNodeReleased) {
       ASSERT_TRUE(test::all_finite(*body)) << step_s << " s, step " << k;
       peak = std::max(peak, body->energy().total_j());
     }
-    std::printf("[ info ] yank, h %.3f s: energy at release %.3g J, peak after %.3g J\n", step_s, yanked.total_j(), peak);
+    std::printf("[ info ] yank, h %.3f s: energy at release %.3g J, peak after %.3g J\n", step_s,
+                yanked.total_j(), peak);
     EXPECT_LE(peak, kEnergyOvershootBound * yanked.total_j()) << step_s;
     EXPECT_LT(test::max_displacement(*body), kRestTolerance_m) << step_s;
   }

@@ -5,8 +5,8 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "scenes.h"
@@ -79,7 +79,9 @@ bool read_tetgen(const std::string& stem, TetMesh& mesh, std::string& error) {
   return true;
 }
 
-std::string tongue_stem() { return std::string(FAHR_TONGUE_DIR) + "/tongue.1"; }
+std::string tongue_stem() {
+  return std::string(FAHR_TONGUE_DIR) + "/tongue.1";
+}
 
 // The lowest 10 mm (+y up) are fixed.
 std::vector<std::uint32_t> tongue_base(const TetMesh& mesh) {
@@ -115,15 +117,17 @@ TEST(Tongue, StepsStablyUnderGravity) {
     ASSERT_TRUE(test::all_finite(body)) << "step " << k;
     EXPECT_EQ(report.inverted_elements, 0);
     if (k >= 100) {
-      for (const double v : body.velocities_m_per_s()) largest_speed = std::max(largest_speed, std::abs(v));
+      for (const double v : body.velocities_m_per_s())
+        largest_speed = std::max(largest_speed, std::abs(v));
     }
   }
   // Linear FEM sags 3.14 mm at E = 10 kPa (dependency-facts.md); at 7.74 kPa
   // about 4 mm. The corotated sag must be of that order, and settling.
   const double sag = test::max_displacement(body);
-  std::printf("[ info ] tongue: %zu fixed nodes, max displacement after 1.5 s %.3f mm, speed %.3f mm/s, "
-              "%d refactorisations in 150 steps\n",
-              fixed.size(), 1e3 * sag, 1e3 * largest_speed, refactorisations);
+  std::printf(
+      "[ info ] tongue: %zu fixed nodes, max displacement after 1.5 s %.3f mm, speed %.3f mm/s, "
+      "%d refactorisations in 150 steps\n",
+      fixed.size(), 1e3 * sag, 1e3 * largest_speed, refactorisations);
   EXPECT_GT(sag, 1e-3);
   EXPECT_LT(sag, 2e-2);
 }
@@ -156,7 +160,8 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
   // dc. With uniform weights the lightest node takes nearly all of it (on
   // this mesh a 0.2 mm press moved one node 5.8 mm and inverted elements).
   std::vector<std::pair<double, std::uint32_t>> heights;
-  for (std::uint32_t i = 0; i < mesh.nodes_m.size(); ++i) heights.emplace_back(mesh.nodes_m[i].y(), i);
+  for (std::uint32_t i = 0; i < mesh.nodes_m.size(); ++i)
+    heights.emplace_back(mesh.nodes_m[i].y(), i);
   std::sort(heights.begin(), heights.end(), std::greater<>());
   std::vector<std::uint32_t> centres;
   for (const auto& [y, node] : heights) {
@@ -188,7 +193,8 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
   int inverted_while_pressed = 0;
   for (int k = 0; k < 100; ++k) {
     const double depth = 0.010 * std::min(1.0, (k + 1) / 50.0);
-    for (std::uint32_t s = 0; s < 8; ++s) set.contacts[s].hold_centre_m = start[s] - Eigen::Vector3d(0, depth, 0);
+    for (std::uint32_t s = 0; s < 8; ++s)
+      set.contacts[s].hold_centre_m = start[s] - Eigen::Vector3d(0, depth, 0);
     set.state_step = body.step_index();
     const StepReport report = body.step(&set, &links);
     refactorisations += report.refactorised ? 1 : 0;
@@ -196,7 +202,8 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
     inverted_while_pressed = std::max(inverted_while_pressed, report.inverted_elements);
   }
   for (std::uint32_t s = 0; s < 8; ++s) {
-    EXPECT_NEAR((links.centre(s, body.positions_m().data()) - set.contacts[s].hold_centre_m).norm(), 0.0, 1e-6);
+    EXPECT_NEAR((links.centre(s, body.positions_m().data()) - set.contacts[s].hold_centre_m).norm(),
+                0.0, 1e-6);
   }
   const double pressed = test::max_displacement(body);
   StepReport last;
@@ -206,9 +213,11 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
     ASSERT_TRUE(test::all_finite(body)) << "release step " << k;
   }
   const double released = test::max_displacement(body);
-  std::printf("[ info ] tongue pressed 10 mm: max displacement %.2f mm (at most %d elements inverted), 1.5 s "
-              "after release %.2f mm, %d refactorisations in 250 steps\n",
-              1e3 * pressed, inverted_while_pressed, 1e3 * released, refactorisations);
+  std::printf(
+      "[ info ] tongue pressed 10 mm: max displacement %.2f mm (at most %d elements inverted), 1.5 "
+      "s "
+      "after release %.2f mm, %d refactorisations in 250 steps\n",
+      1e3 * pressed, inverted_while_pressed, 1e3 * released, refactorisations);
   EXPECT_EQ(last.inverted_elements, 0);
   EXPECT_GT(pressed, 0.009);
   EXPECT_LT(released, 0.008);  // back near its gravity sag (about 5 mm)

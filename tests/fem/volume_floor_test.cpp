@@ -3,6 +3,8 @@
 // back to the floor along its volume gradient, mass-weighted, fixed nodes
 // untouched; a tet above the floor is left exactly as it was; and a soft bar
 // crushed by a large load keeps every tet above the floor through the step.
+#include "fahr/fem/volume_floor.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 
 #include "fahr/fem/contact_step.h"
 #include "fahr/fem/element_rest.h"
-#include "fahr/fem/volume_floor.h"
 #include "scenes.h"
 
 namespace fahr::fem {
@@ -38,7 +39,8 @@ double smallest_volume_ratio(const Body& body) {
   const ElementRest& rest = body.element_rest();
   double smallest = 1e300;
   for (std::size_t e = 0; e < rest.size(); ++e) {
-    smallest = std::min(smallest, signed_volume(body.positions_m(), rest.tets[e]) / rest.volume_m3[e]);
+    smallest =
+        std::min(smallest, signed_volume(body.positions_m(), rest.tets[e]) / rest.volume_m3[e]);
   }
   return smallest;
 }
@@ -114,7 +116,8 @@ CrushedBar crush_bar(double floor_ratio) {
   ContactStepSettings step_settings;
   step_settings.volume_floor.ratio = floor_ratio;
   ContactStep step(*body, links, step_settings);
-  const auto top = test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.0149 && p.y() > 0.0099; });
+  const auto top = test::nodes_where(
+      mesh, [](const Eigen::Vector3d& p) { return p.x() > 0.0149 && p.y() > 0.0099; });
   std::vector<double> push(3 * body->node_count(), 0.0);
   for (const std::uint32_t n : top) push[3 * n + 1] = -3.0 / static_cast<double>(top.size());
   double smallest = 1.0;
@@ -137,7 +140,8 @@ CrushedBar crush_bar(double floor_ratio) {
 TEST(VolumeFloor, ACrushedBarKeepsItsTetsOpen) {
   const CrushedBar without = crush_bar(0.0);
   const CrushedBar with = crush_bar(0.5);
-  EXPECT_LT(without.smallest_ratio, 0.0) << "the load must invert tets for the test to mean anything";
+  EXPECT_LT(without.smallest_ratio, 0.0)
+      << "the load must invert tets for the test to mean anything";
   EXPECT_GT(with.smallest_ratio, 0.0);
   EXPECT_EQ(with.steps_at_floor, 100);
   EXPECT_EQ(with.last_unresolved, 0);

@@ -8,12 +8,12 @@
 #include <numbers>
 
 #include "contact_set.h"
-#include "fahr/device/trajectory.h"
 #include "fahr/collision/surface_samples.h"
-#include "force_command.h"
+#include "fahr/device/trajectory.h"
 #include "fahr/haptic_service/haptic_loop.h"
-#include "scene_fixture.h"
 #include "fahr/haptic_service/tissue_snapshot.h"
+#include "force_command.h"
+#include "scene_fixture.h"
 
 #ifndef FAHR_SANITIZE_BUILD
 #include "allocation_counter.h"
@@ -37,13 +37,14 @@ double script_pitch_deg(const Eigen::Quaterniond& q) {
 
 // Deepest penetration of the tool's samples into `field` with the tool at
 // `tip` (negative: the gap, when within 2 mm).
-double tool_depth(const HapticSetup& setup, const RigidField& field, const Eigen::Vector3d& tip_m, double pitch_deg) {
+double tool_depth(const HapticSetup& setup, const RigidField& field, const Eigen::Vector3d& tip_m,
+                  double pitch_deg) {
   const double half = 0.5 * pitch_deg * std::numbers::pi / 180.0;
   const Eigen::Quaterniond q(std::cos(half), 0.0, 0.0, std::sin(half));
   std::vector<collision::SurfaceContact> contacts(256);
   std::size_t n = 0;
-  collision::query_surface_samples(setup.tool_samples, Eigen::Translation3d(tip_m) * q, rigid_body(field), 2e-3,
-                                contacts, n);
+  collision::query_surface_samples(setup.tool_samples, Eigen::Translation3d(tip_m) * q,
+                                   rigid_body(field), 2e-3, contacts, n);
   double deepest = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) deepest = std::max(deepest, contacts[i].depth_m);
   return deepest;
@@ -52,11 +53,14 @@ double tool_depth(const HapticSetup& setup, const RigidField& field, const Eigen
 // The deepest over every body the tool is tested against.
 double anatomy_depth(const HapticSetup& setup, const Eigen::Vector3d& tip_m, double pitch_deg) {
   double deepest = -std::numeric_limits<double>::infinity();
-  for (const std::size_t a : setup.tool_obstacles) deepest = std::max(deepest, tool_depth(setup, *setup.anatomy[a], tip_m, pitch_deg));
+  for (const std::size_t a : setup.tool_obstacles)
+    deepest = std::max(deepest, tool_depth(setup, *setup.anatomy[a], tip_m, pitch_deg));
   return deepest;
 }
 
-Eigen::Vector3d to_eigen(const msg::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+Eigen::Vector3d to_eigen(const msg::Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 TEST(HapticLoop, BladeStopsAtTheAnatomy) {
   const HapticSetup& setup = neonatal_scene().setup;
@@ -71,7 +75,8 @@ TEST(HapticLoop, BladeStopsAtTheAnatomy) {
     touch_y += 1e-4;
     ASSERT_LT(touch_y, 0.05) << "no anatomy above the inserted blade";
   }
-  std::printf("inserted blade touches the anatomy %.1f mm higher\n", 1e3 * (touch_y - inserted.position_m.y()));
+  std::printf("inserted blade touches the anatomy %.1f mm higher\n",
+              1e3 * (touch_y - inserted.position_m.y()));
 
   TissueDigest digest(setup);
   const TissueSnapshot rest = digest.make_snapshot();
@@ -82,7 +87,8 @@ TEST(HapticLoop, BladeStopsAtTheAnatomy) {
   std::uint64_t tick = 0;
   for (; tick < static_cast<std::uint64_t>(kInsertedS * 1000); ++tick) {
     const auto p = script.at(std::chrono::duration<double>(1e-3 * static_cast<double>(tick)));
-    loop.tick(device_pose(tick, p.position_m, script_pitch_deg(p.orientation)), rest, command, contacts);
+    loop.tick(device_pose(tick, p.position_m, script_pitch_deg(p.orientation)), rest, command,
+              contacts);
   }
   ASSERT_FALSE(command.lost_track());
   // Up to 5 mm into the palate in 0.5 s, then hold 0.5 s.
@@ -95,8 +101,8 @@ TEST(HapticLoop, BladeStopsAtTheAnatomy) {
   const Eigen::Vector3d proxy = to_eigen(command.world_from_proxy().position_m());
   const Eigen::Vector3d force = to_eigen(command.force_n());
   const double depth = anatomy_depth(setup, proxy, pitch_deg);
-  std::printf("hand 5 mm into the anatomy: proxy %.2f mm into it, force (%.2f, %.2f, %.2f) N\n", 1e3 * depth,
-              force.x(), force.y(), force.z());
+  std::printf("hand 5 mm into the anatomy: proxy %.2f mm into it, force (%.2f, %.2f, %.2f) N\n",
+              1e3 * depth, force.x(), force.y(), force.z());
   // The proxy stops at the bone (within a fraction of the field's 1 mm grid)...
   EXPECT_LT(depth, 0.3e-3);
   EXPECT_GT(depth, -0.5e-3);
@@ -133,8 +139,8 @@ TEST(HapticLoop, EmbeddedStartStaysBounded) {
     largest_force = std::max(largest_force, to_eigen(command.force_n()).norm());
     previous_proxy = proxy;
   }
-  std::printf("embedded start: largest proxy step %.2f mm, largest force %.2f N\n", 1e3 * largest_jump,
-              largest_force);
+  std::printf("embedded start: largest proxy step %.2f mm, largest force %.2f N\n",
+              1e3 * largest_jump, largest_force);
   // A tick moves the proxy by the hand's pull plus the deepest row plus
   // 1 mm at most (services/contact); rows here are at most a few mm deep.
   EXPECT_LT(largest_jump, 10e-3);
@@ -159,7 +165,8 @@ TEST(HapticLoop, TickAndDigestAllocateNothing) {
   std::uint64_t tick = 0;
   for (; tick < 400; ++tick) {
     const double s = std::min(1.0, static_cast<double>(tick) / 200.0);
-    loop.tick(device_pose(tick, kPressTipM + s * (deep - kPressTipM), kPressPitchDeg), snapshot, command, contacts);
+    loop.tick(device_pose(tick, kPressTipM + s * (deep - kPressTipM), kPressPitchDeg), snapshot,
+              command, contacts);
   }
   ASSERT_GT(loop.metrics().tool_rows.load(), 0u) << "the blade does not touch the tongue";
   state.step(1);
@@ -187,7 +194,8 @@ TEST(TissueDigest, RefusesStatesThatDoNotFit) {
   for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
     for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
   }
-  state.positions_m().erase(state.positions_m().begin(), state.positions_m().begin() + (3 * setup.mesh.node_count() - 3));
+  state.positions_m().erase(state.positions_m().begin(),
+                            state.positions_m().begin() + (3 * setup.mesh.node_count() - 3));
   ASSERT_EQ(state.positions_m().size(), 3 * setup.mesh.node_count());
   EXPECT_TRUE(digest.digest(state, snapshot));
   state.positions_m()[7] = std::numeric_limits<float>::quiet_NaN();
@@ -241,15 +249,18 @@ TEST_F(TissueDigestAtRest, TakesWAlongTheFemsNormals) {
   // normals present, W is refused (rows then use the fallback).
   state.compliance_sphere_ids({5, 9});
   state.compliance_mpn().assign(12, 0.0f);
-  state.compliance_mpn()[(3 * 1 + 1) * 2 + 0] = 2e-3f;  // sphere 9 moves +y per newton on sphere 5 along its normal
+  state.compliance_mpn()[(3 * 1 + 1) * 2 + 0] =
+      2e-3f;  // sphere 9 moves +y per newton on sphere 5 along its normal
   state.compliance_normals({0.0f, 1.0f, 0.0f, 1.0f, 0.0f, 0.0f});
   ASSERT_TRUE(digest.digest(state, snapshot));
   ASSERT_EQ(snapshot.compliance_count, 2u);
   const contact::TissueCompliance w = snapshot.compliance();
   ASSERT_TRUE(w.valid());
   ASSERT_TRUE(w.along_normals());
-  EXPECT_NEAR(w.normal_compliance(1, Eigen::Vector3d::UnitY(), 0, Eigen::Vector3d::UnitY()), 2e-3, 1e-9);
-  EXPECT_NEAR(w.normal_compliance(1, Eigen::Vector3d::UnitY(), 0, -Eigen::Vector3d::UnitY()), -2e-3, 1e-9);
+  EXPECT_NEAR(w.normal_compliance(1, Eigen::Vector3d::UnitY(), 0, Eigen::Vector3d::UnitY()), 2e-3,
+              1e-9);
+  EXPECT_NEAR(w.normal_compliance(1, Eigen::Vector3d::UnitY(), 0, -Eigen::Vector3d::UnitY()), -2e-3,
+              1e-9);
   state.compliance_normals().pop_back();
   ASSERT_TRUE(digest.digest(state, snapshot));
   EXPECT_EQ(snapshot.compliance_count, 0u);

@@ -46,7 +46,8 @@ collision::RigidBody rigid_body(const RigidField& field) {
   collision::RigidBody body;
   body.id = field.scene_body->id;
   body.sdf = field.sdf.get();
-  body.world_from_body = Eigen::Translation3d(field.scene_body->pose.position_m) * field.scene_body->pose.orientation;
+  body.world_from_body =
+      Eigen::Translation3d(field.scene_body->pose.position_m) * field.scene_body->pose.orientation;
   return body;
 }
 

@@ -6,8 +6,8 @@
 #include <memory>
 
 #include "device_pose.h"
-#include "fahr/scene/load_scene.h"
 #include "fahr/haptic_service/haptic_setup.h"
+#include "fahr/scene/load_scene.h"
 
 namespace fahr::haptic_service::test {
 
@@ -21,8 +21,8 @@ const NeonatalScene& neonatal_scene();
 
 // A DevicePose at servo tick `tick` with the stylus at `position_m`, pitched
 // `pitch_deg` about +z (as the gateway's scripts hold the blade).
-msg::DevicePose device_pose(std::uint64_t tick, const Eigen::Vector3d& position_m, double pitch_deg = 0.0,
-                            double renderable_force_n = 7.9);
+msg::DevicePose device_pose(std::uint64_t tick, const Eigen::Vector3d& position_m,
+                            double pitch_deg = 0.0, double renderable_force_n = 7.9);
 
 // The rigid body of one anatomy field, posed as in the scene.
 collision::RigidBody rigid_body(const RigidField& field);

@@ -8,8 +8,8 @@
 #include <map>
 #include <string>
 
-#include "fahr/device/trajectory.h"
 #include "fahr/collision/surface_samples.h"
+#include "fahr/device/trajectory.h"
 #include "scene_fixture.h"
 
 namespace fahr::haptic_service::test {
@@ -18,17 +18,19 @@ namespace {
 // Grazing the lips is part of an intubation; going into bone is not.
 constexpr double kMaxDepthM = 0.5e-3;
 
-std::map<std::string, double> deepest_along(const HapticSetup& setup, const device::Trajectory& script) {
+std::map<std::string, double> deepest_along(const HapticSetup& setup,
+                                            const device::Trajectory& script) {
   std::map<std::string, double> deepest;
   std::vector<collision::SurfaceContact> contacts(1024);
   const double end_s = script.keyframes().back().time_s;
   for (double t = 0.0; t <= end_s; t += 0.01) {
     const auto point = script.at(std::chrono::duration<double>(t));
-    const Eigen::Isometry3d world_from_tool = Eigen::Translation3d(point.position_m) * point.orientation;
+    const Eigen::Isometry3d world_from_tool =
+        Eigen::Translation3d(point.position_m) * point.orientation;
     for (const std::size_t a : setup.tool_obstacles) {
       std::size_t n = 0;
-      collision::query_surface_samples(setup.tool_samples, world_from_tool, rigid_body(*setup.anatomy[a]), 0.0, contacts,
-                                    n);
+      collision::query_surface_samples(setup.tool_samples, world_from_tool,
+                                       rigid_body(*setup.anatomy[a]), 0.0, contacts, n);
       double& d = deepest[setup.anatomy[a]->scene_body->name];
       for (std::size_t i = 0; i < n; ++i) d = std::max(d, contacts[i].depth_m);
     }

@@ -1,12 +1,12 @@
 // --cpus: the list's grammar, its errors, and pinning to a CPU this process
 // may run on (restored afterwards, so the other tests run as before).
+#include "fahr/runtime/cpu_pinning.h"
+
 #include <gtest/gtest.h>
 #include <sched.h>
 
 #include <stdexcept>
 #include <string>
-
-#include "fahr/runtime/cpu_pinning.h"
 
 namespace fahr::runtime {
 namespace {
@@ -57,7 +57,8 @@ TEST(CpuPinning, PinsToAnAllowedCpuAndRefusesOthers) {
     pin_to_cpus(std::to_string(outside));
     ADD_FAILURE() << "CPU " << outside << " was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("is not one this process may run on"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("is not one this process may run on"), std::string::npos)
+        << e.what();
   }
   pin_to_cpus("");  // no change
   ASSERT_EQ(sched_getaffinity(0, sizeof(now), &now), 0);

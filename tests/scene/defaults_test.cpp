@@ -139,7 +139,8 @@ TEST(SceneDefaults, ExplicitSettingsAreRead) {
             "solver:\n  linear_solver: pcg\n  cg_tolerance: 1e-8\n  cg_max_iterations: 50\n"
             "  compliance: lagged\n  compliance_columns: normals\n  max_contact_age_ms: 2.5\n"
             "  volume_floor_ratio: 0.6\n"
-            "contact:\n  response: penalty\n  coupling_stiffness_npm: 250\n  tool_stops_at_anatomy: false\n"
+            "contact:\n  response: penalty\n  coupling_stiffness_npm: 250\n  "
+            "tool_stops_at_anatomy: false\n"
             "dds:\n  vendor: fastdds\n  domain_id: 42\n"
             "qos:\n  DevicePose: {deadline_ms: 2, reliability: best_effort}\n"
             "  ContactSet:\n    history_depth: 4\n");

@@ -4,24 +4,23 @@
 // volume, that every surface is closed and outward oriented, and that
 // fahr::geometry reads every surface as closed, manifold, fold-free and
 // non-degenerate and builds a signed distance field for it.
-#include "fahr/geometry/signed_distance_field.h"
-#include "fahr/geometry/surface_loader.h"
-#include "fahr/geometry/surface_mesh.h"
-#include "fahr/scenegen/mesh_checks.h"
-#include "fahr/scenegen/mesh_readers.h"
-
 #include <gtest/gtest.h>
-
 #include <stdlib.h>  // mkdtemp (POSIX)
 
 #include <cstdlib>
-#include <filesystem>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "fahr/geometry/signed_distance_field.h"
+#include "fahr/geometry/surface_loader.h"
+#include "fahr/geometry/surface_mesh.h"
+#include "fahr/scenegen/mesh_checks.h"
+#include "fahr/scenegen/mesh_readers.h"
 
 namespace {
 
@@ -34,11 +33,11 @@ using fahr::scenegen::TriangleMesh;
 #endif
 
 const std::vector<std::string> kSceneFiles = {
-    "tongue.node", "tongue.ele", "tongue.face", "tongue_fixed_nodes.txt",
-    "palate.obj",  "jaw.obj",    "lips_face.obj", "larynx_trachea.obj",
+    "tongue.node", "tongue.ele",  "tongue.face",         "tongue_fixed_nodes.txt",
+    "palate.obj",  "jaw.obj",     "lips_face.obj",       "larynx_trachea.obj",
     "miller0.obj", "miller1.obj", "scene_parameters.txt"};
-const std::vector<std::string> kSurfaces = {"palate", "jaw", "lips_face", "larynx_trachea",
-                                            "miller0", "miller1"};
+const std::vector<std::string> kSurfaces = {"palate",         "jaw",     "lips_face",
+                                            "larynx_trachea", "miller0", "miller1"};
 constexpr double kMetresPerMm = 1e-3;
 constexpr double kSdfCellM = 1e-3;  // the 1 mm cell the haptic and AIST code use
 
@@ -162,8 +161,7 @@ TEST_F(SceneGeneratorTest, GeometryLibraryLoadsCleanSurfacesWithSignedFields) {
   for (const auto& name : kSurfaces) {
     const fs::path path = *first_ / (name + ".obj");
     try {
-      const fahr::geometry::SurfaceMesh surface =
-          fahr::geometry::load_surface(path, kMetresPerMm);
+      const fahr::geometry::SurfaceMesh surface = fahr::geometry::load_surface(path, kMetresPerMm);
       EXPECT_GT(surface.triangle_count(), 0u) << name;
       expect_clean_and_signed(surface, name);
     } catch (const std::exception& e) {

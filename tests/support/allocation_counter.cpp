@@ -20,17 +20,33 @@ AllocationCounter::AllocationCounter() {
   allocations = 0;
   counting = true;
 }
-AllocationCounter::~AllocationCounter() { counting = false; }
-long AllocationCounter::count() const { return allocations; }
+AllocationCounter::~AllocationCounter() {
+  counting = false;
+}
+long AllocationCounter::count() const {
+  return allocations;
+}
 }  // namespace fahr::test
 
 // GCC's -Wmismatched-new-delete cannot see that malloc and free pair up here.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t size) { return allocate(size); }
-void* operator new[](std::size_t size) { return allocate(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void* operator new(std::size_t size) {
+  return allocate(size);
+}
+void* operator new[](std::size_t size) {
+  return allocate(size);
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
 #pragma GCC diagnostic pop

@@ -5,7 +5,6 @@
 //   fahr_dds_check [--dds fastdds|cyclonedds|inprocess] [--domain N]
 //                  [--dds-profile FILE] [--listen-s S]
 #include <CLI/CLI.hpp>
-
 #include <chrono>
 #include <cstdio>
 #include <thread>

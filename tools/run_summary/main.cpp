@@ -6,7 +6,6 @@
 //
 //   fahr_run_summary --duration-s S [--dds V] [--domain N] [--dds-profile F]
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -48,7 +47,9 @@ struct Tally {
   std::uint64_t poses = 0;
 };
 
-double norm(const msg::Vec3& v) { return std::sqrt(v.x() * v.x() + v.y() * v.y() + v.z() * v.z()); }
+double norm(const msg::Vec3& v) {
+  return std::sqrt(v.x() * v.x() + v.y() * v.y() + v.z() * v.z());
+}
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -58,7 +59,9 @@ double median(std::vector<double> v) {
 
 void print(const Tally& t, double duration_s) {
   std::printf("\n## fahr run summary (%.1f s)\n\n", duration_s);
-  std::printf("| service | vendor | nominal Hz | measured Hz (median) | ticks | late periods | tick CPU p99 us (worst) | period max ms (worst) | deadline misses |\n");
+  std::printf(
+      "| service | vendor | nominal Hz | measured Hz (median) | ticks | late periods | tick CPU "
+      "p99 us (worst) | period max ms (worst) | deadline misses |\n");
   std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const auto& [name, s] : t.services) {
     long misses = 0;
@@ -66,9 +69,11 @@ void print(const Tally& t, double duration_s) {
       auto it = s.qos_events.find(k);
       if (it != s.qos_events.end()) misses += it->second;
     }
-    std::printf("| %s | %s | %.0f | %.1f | %llu | %llu | %.1f | %.2f | %ld |\n", name.c_str(), s.vendor.c_str(),
-                s.nominal_hz, median(s.measured_hz), static_cast<unsigned long long>(s.ticks),
-                static_cast<unsigned long long>(s.late_periods), static_cast<double>(s.worst_cpu_p99_ns) / 1e3,
+    std::printf("| %s | %s | %.0f | %.1f | %llu | %llu | %.1f | %.2f | %ld |\n", name.c_str(),
+                s.vendor.c_str(), s.nominal_hz, median(s.measured_hz),
+                static_cast<unsigned long long>(s.ticks),
+                static_cast<unsigned long long>(s.late_periods),
+                static_cast<double>(s.worst_cpu_p99_ns) / 1e3,
                 static_cast<double>(s.worst_period_max_ns) / 1e6, misses);
   }
   std::printf("\n| figure | value |\n|---|---:|\n");
@@ -78,11 +83,13 @@ void print(const Tally& t, double duration_s) {
   std::printf("| peak rendered force N | %.2f |\n", t.peak_rendered_n);
   std::printf("| peak commanded force N | %.2f |\n", t.peak_command_n);
   std::printf("| peak tissue reaction N | %.2f |\n", t.peak_reaction_n);
-  std::printf("| lost-track episodes | %llu |\n", static_cast<unsigned long long>(t.lost_track_episodes));
+  std::printf("| lost-track episodes | %llu |\n",
+              static_cast<unsigned long long>(t.lost_track_episodes));
   std::printf("| largest device-proxy gap mm | %.2f |\n", t.max_gap_m * 1e3);
   for (const auto& [name, s] : t.services) {
     for (const auto& [metric, value] : s.metrics) {
-      if (metric.find("latency") != std::string::npos || metric.find("motion_to_force") != std::string::npos) {
+      if (metric.find("latency") != std::string::npos ||
+          metric.find("motion_to_force") != std::string::npos) {
         std::printf("| %s %s | %.3f |\n", name.c_str(), metric.c_str(), value);
       }
     }
@@ -101,7 +108,8 @@ int main(int argc, char** argv) {
   app.add_option("--dds-profile", profile, "vendor XML configuration");
   CLI11_PARSE(app, argc, argv);
   try {
-    common::Participant participant(common::transport_config_from(dds, domain, profile, "fahr_run_summary"));
+    common::Participant participant(
+        common::transport_config_from(dds, domain, profile, "fahr_run_summary"));
     Tally tally;
     common::QosProfile reports = common::QosProfile::for_role(common::TopicRole::kReport);
     common::Subscriber<msg::ServiceStatus> status(
@@ -122,7 +130,9 @@ int main(int argc, char** argv) {
           bool empty_window = false;
           for (const auto& m : s.metrics()) {
             const std::string name = m.name().to_string();
-            if (name.size() > 6 && name.compare(name.size() - 6, 6, "_count") == 0 && m.value() == 0) empty_window = true;
+            if (name.size() > 6 && name.compare(name.size() - 6, 6, "_count") == 0 &&
+                m.value() == 0)
+              empty_window = true;
           }
           if (!empty_window || t.metrics.empty()) {
             for (const auto& m : s.metrics()) t.metrics[m.name().to_string()] = m.value();
@@ -133,11 +143,13 @@ int main(int argc, char** argv) {
         [&](const msg::ServiceEvents& e, const common::SampleInfo&) {
           std::lock_guard lock(tally.mutex);
           auto& t = tally.services[e.service_name().to_string()];
-          for (const auto& q : e.qos_events()) t.qos_events[q.kind()] += std::max(q.total_count_change(), 0);
+          for (const auto& q : e.qos_events())
+            t.qos_events[q.kind()] += std::max(q.total_count_change(), 0);
         });
     common::Subscriber<msg::ForceCommand> commands(
         participant, common::QosProfile::for_role(common::TopicRole::kServoStream),
-        common::TopicTraits<msg::ForceCommand>::kName, [&](const msg::ForceCommand& c, const common::SampleInfo&) {
+        common::TopicTraits<msg::ForceCommand>::kName,
+        [&](const msg::ForceCommand& c, const common::SampleInfo&) {
           std::lock_guard lock(tally.mutex);
           ++tally.commands;
           tally.peak_command_n = std::max(tally.peak_command_n, norm(c.force_n()));
@@ -148,7 +160,8 @@ int main(int argc, char** argv) {
         });
     common::Subscriber<msg::DevicePose> poses(
         participant, common::QosProfile::for_role(common::TopicRole::kServoStream),
-        common::TopicTraits<msg::DevicePose>::kName, [&](const msg::DevicePose& p, const common::SampleInfo&) {
+        common::TopicTraits<msg::DevicePose>::kName,
+        [&](const msg::DevicePose& p, const common::SampleInfo&) {
           std::lock_guard lock(tally.mutex);
           ++tally.poses;
           tally.limit_n = p.renderable_force_n();

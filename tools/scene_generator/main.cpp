@@ -2,6 +2,13 @@
 // rigid anatomy, Miller 0 and 1 blades) into one folder, checks it (closed
 // surfaces, positive tets, nothing intersecting at rest) and prints its
 // statistics. Same parameters, same bytes.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
 #include "fahr/scenegen/anatomy_surfaces.h"
 #include "fahr/scenegen/blade_poses.h"
 #include "fahr/scenegen/laryngoscope_blade.h"
@@ -10,13 +17,6 @@
 #include "fahr/scenegen/scene_parameters.h"
 #include "fahr/scenegen/tet_mesher.h"
 #include "fahr/scenegen/tongue_shape.h"
-
-#include <algorithm>
-#include <cstdio>
-#include <filesystem>
-#include <map>
-#include <string>
-#include <vector>
 
 namespace {
 
@@ -62,8 +62,8 @@ Clearance clearance(const std::vector<Vec3>& points, const TriangleMesh& surface
     const Vec3 outside = (box[0] - p).cwiseMax(p - box[1]).cwiseMax(Vec3::Zero());
     if (outside.norm() > kFarMm) continue;
     if (fahr::scenegen::winding_number(surface, p) > kInsideWinding) ++c.inside;
-    c.min_distance_mm = std::min(c.min_distance_mm,
-                                 fahr::scenegen::distance_to_surface(surface, p));
+    c.min_distance_mm =
+        std::min(c.min_distance_mm, fahr::scenegen::distance_to_surface(surface, p));
   }
   return c;
 }
@@ -98,18 +98,21 @@ int main(int argc, char** argv) {
   const auto tongue_box = bounds(tongue.nodes);
   std::printf("tongue: %zu nodes, %zu tets, %zu boundary triangles, %zu fixed nodes\n",
               tongue.nodes.size(), tongue.tets.size(), tongue.boundary.size(), fixed.size());
-  std::printf("tongue: mid-line length %.2f mm; bounds x [%.2f, %.2f] y [%.2f, %.2f] z [%.2f, %.2f] mm\n",
-              tongue_shape.midline_length_mm(), tongue_box[0].x(), tongue_box[1].x(),
-              tongue_box[0].y(), tongue_box[1].y(), tongue_box[0].z(), tongue_box[1].z());
-  std::printf("tongue quality: min dihedral %.2f deg, max dihedral %.2f deg, tets under 10 deg %d,"
-              " volume min %.4f max %.4f mm^3\n",
-              quality.min_dihedral_deg, quality.max_dihedral_deg, quality.below_10_deg,
-              quality.min_volume_mm3, quality.max_volume_mm3);
-  std::printf("tongue snapping: %d boundary nodes, %d fully, %d partly, %d not moved; max surface"
-              " gap %.3f mm; non-manifold boundary edges %d\n",
-              mesher_report.boundary_nodes, mesher_report.snapped_fully,
-              mesher_report.snapped_partly, mesher_report.not_snapped,
-              mesher_report.max_surface_gap_mm, mesher_report.nonmanifold_boundary_edges);
+  std::printf(
+      "tongue: mid-line length %.2f mm; bounds x [%.2f, %.2f] y [%.2f, %.2f] z [%.2f, %.2f] mm\n",
+      tongue_shape.midline_length_mm(), tongue_box[0].x(), tongue_box[1].x(), tongue_box[0].y(),
+      tongue_box[1].y(), tongue_box[0].z(), tongue_box[1].z());
+  std::printf(
+      "tongue quality: min dihedral %.2f deg, max dihedral %.2f deg, tets under 10 deg %d,"
+      " volume min %.4f max %.4f mm^3\n",
+      quality.min_dihedral_deg, quality.max_dihedral_deg, quality.below_10_deg,
+      quality.min_volume_mm3, quality.max_volume_mm3);
+  std::printf(
+      "tongue snapping: %d boundary nodes, %d fully, %d partly, %d not moved; max surface"
+      " gap %.3f mm; non-manifold boundary edges %d\n",
+      mesher_report.boundary_nodes, mesher_report.snapped_fully, mesher_report.snapped_partly,
+      mesher_report.not_snapped, mesher_report.max_surface_gap_mm,
+      mesher_report.nonmanifold_boundary_edges);
 
   // Rigid bodies, in write order.
   const double res = params.surface_resolution_mm;
@@ -128,13 +131,14 @@ int main(int argc, char** argv) {
     const auto closed = check_closed(m);
     const auto box = bounds(m.vertices);
     const double volume = enclosed_volume(m);
-    std::printf("%s: %zu vertices, %zu triangles, volume %.1f mm^3, bad edges %d, inconsistent %d,"
-                " folded %d, degenerate %d, sharpest edge %.1f deg; bounds x [%.1f, %.1f]"
-                " y [%.1f, %.1f] z [%.1f, %.1f] mm\n",
-                name.c_str(), m.vertices.size(), m.triangles.size(), volume, closed.bad_edges,
-                closed.inconsistent_edges, closed.folded_edges, closed.degenerate_triangles,
-                closed.sharpest_edge_deg, box[0].x(), box[1].x(), box[0].y(), box[1].y(),
-                box[0].z(), box[1].z());
+    std::printf(
+        "%s: %zu vertices, %zu triangles, volume %.1f mm^3, bad edges %d, inconsistent %d,"
+        " folded %d, degenerate %d, sharpest edge %.1f deg; bounds x [%.1f, %.1f]"
+        " y [%.1f, %.1f] z [%.1f, %.1f] mm\n",
+        name.c_str(), m.vertices.size(), m.triangles.size(), volume, closed.bad_edges,
+        closed.inconsistent_edges, closed.folded_edges, closed.degenerate_triangles,
+        closed.sharpest_edge_deg, box[0].x(), box[1].x(), box[0].y(), box[1].y(), box[0].z(),
+        box[1].z());
     ok = ok && closed.clean() && volume > 0.0;
   };
   for (const auto& [name, m] : anatomy) report_surface(name, m);
@@ -143,17 +147,17 @@ int main(int argc, char** argv) {
     // The tongue boundary must be as clean as the rigid surfaces.
     const TriangleMesh boundary = as_written(TriangleMesh{tongue.nodes, tongue.boundary});
     const auto closed = check_closed(boundary);
-    std::printf("tongue boundary: bad edges %d, inconsistent %d, folded %d, degenerate %d,"
-                " sharpest edge %.1f deg\n",
-                closed.bad_edges, closed.inconsistent_edges, closed.folded_edges,
-                closed.degenerate_triangles, closed.sharpest_edge_deg);
+    std::printf(
+        "tongue boundary: bad edges %d, inconsistent %d, folded %d, degenerate %d,"
+        " sharpest edge %.1f deg\n",
+        closed.bad_edges, closed.inconsistent_edges, closed.folded_edges,
+        closed.degenerate_triangles, closed.sharpest_edge_deg);
     ok = ok && closed.clean() && enclosed_volume(boundary) > 0.0;
   }
   // Palate and jaw are images of a box: a map that folds the box over itself
   // gives a surface that overlaps itself (back to back where it is flat).
-  const std::map<std::string, ParamBox> boxes = {
-      {"palate", palate_box(params.palate, res)},
-      {"jaw", jaw_box(params.jaw, params.tongue, res)}};
+  const std::map<std::string, ParamBox> boxes = {{"palate", palate_box(params.palate, res)},
+                                                 {"jaw", jaw_box(params.jaw, params.tongue, res)}};
   for (const auto& [name, box] : boxes) {
     const int folded = folded_box_tets(box);
     std::printf("%s: %d folded or flat tets in its %dx%dx%d parameter lattice\n", name.c_str(),
@@ -203,11 +207,14 @@ int main(int argc, char** argv) {
   bool written =
       write_tetgen(tongue, dir + "tongue",
                    "neonatal tongue, TetGen format, 0-based; tets positive volume;\n"
-                   ".face: outward boundary triangles.\n" + note, error) &&
+                   ".face: outward boundary triangles.\n" +
+                       note,
+                   error) &&
       write_index_list(fixed, dir + "tongue_fixed_nodes.txt",
                        "tongue nodes fixed at the base: 0-based indices into tongue.node.\n"
                        "Rule: boundary nodes within 0.35 x tongue cell of the attachment plane\n"
-                       "(floor of the mouth, genioglossus and hyoid attachment).\n" + note,
+                       "(floor of the mouth, genioglossus and hyoid attachment).\n" +
+                           note,
                        error);
   const std::map<std::string, std::string> what = {
       {"palate", "hard palate (maxilla block, underside = palatal vault and upper gum)"},
@@ -231,7 +238,8 @@ int main(int argc, char** argv) {
                  dir.c_str());
     return 1;
   }
-  std::fprintf(file, "# parameters of the generated scene (mm, deg); flags of fahr_scene_generator\n%s",
+  std::fprintf(file,
+               "# parameters of the generated scene (mm, deg); flags of fahr_scene_generator\n%s",
                describe_parameters(params).c_str());
   std::fclose(file);
   std::printf("written to %s\n", params.out_dir.c_str());

@@ -1,16 +1,15 @@
 // fahr_scene_render: renders the generated neonatal scene with a blade at its
 // suggested poses into PNG pictures (side cutaways, front, oblique), so the
 // scene can be looked at without any viewer.
-#include "png_writer.h"
-#include "rasterizer.h"
-
-#include "fahr/scenegen/blade_poses.h"
-#include "fahr/scenegen/mesh_readers.h"
-
 #include <cstdio>
 #include <map>
 #include <string>
 #include <vector>
+
+#include "fahr/scenegen/blade_poses.h"
+#include "fahr/scenegen/mesh_readers.h"
+#include "png_writer.h"
+#include "rasterizer.h"
 
 namespace {
 
@@ -41,9 +40,16 @@ std::vector<View> views() {
       {"scene_side_closeup.png", "initial", {side, up, Vec3(-18.0, -18.0, 0.0), 100.0}, true, true},
       {"scene_front.png", "none", {Vec3::UnitX(), up, Vec3(0.0, -5.0, 0.0), 110.0}, false, false},
       {"scene_oblique.png", "initial", {oblique, up, Vec3(0.0, -20.0, 0.0), 190.0}, true, true},
-      {"scene_side_pressing.png", "pressing", {side, up, Vec3(-15.0, -18.0, 0.0), 110.0}, true, true},
-      {"scene_oblique_pressing.png", "pressing", {oblique, up, Vec3(-10.0, -20.0, 0.0), 150.0},
-       true, true},
+      {"scene_side_pressing.png",
+       "pressing",
+       {side, up, Vec3(-15.0, -18.0, 0.0), 110.0},
+       true,
+       true},
+      {"scene_oblique_pressing.png",
+       "pressing",
+       {oblique, up, Vec3(-10.0, -20.0, 0.0), 150.0},
+       true,
+       true},
   };
 }
 
@@ -66,7 +72,9 @@ int main(int argc, char** argv) {
     } else if (flag == "--blade") {
       blade = argv[i + 1];
     } else {
-      std::fprintf(stderr, "usage: fahr_scene_render [--meshes DIR] [--out DIR] [--blade miller0|miller1]\n");
+      std::fprintf(
+          stderr,
+          "usage: fahr_scene_render [--meshes DIR] [--out DIR] [--blade miller0|miller1]\n");
       return 2;
     }
   }

@@ -14,10 +14,14 @@ constexpr double kBackFaceShade = 0.6;  // inner faces seen through the cut
 
 }  // namespace
 
-Rasterizer::Rasterizer(int width, int height, int supersample, const Camera& camera,
-                       const Cut& cut)
-    : width_(width), height_(height), ss_(supersample), w_(width * supersample),
-      h_(height * supersample), camera_(camera), cut_(cut) {
+Rasterizer::Rasterizer(int width, int height, int supersample, const Camera& camera, const Cut& cut)
+    : width_(width),
+      height_(height),
+      ss_(supersample),
+      w_(width * supersample),
+      h_(height * supersample),
+      camera_(camera),
+      cut_(cut) {
   forward_ = -camera.eye_direction.normalized();
   right_ = forward_.cross(camera.up).normalized();
   up_ = right_.cross(forward_);

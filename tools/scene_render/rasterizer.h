@@ -3,10 +3,10 @@
 // supersampling. Enough to look at a scene honestly; not a viewer.
 #pragma once
 
-#include "fahr/scenegen/geometry_types.h"
-
 #include <cstdint>
 #include <vector>
+
+#include "fahr/scenegen/geometry_types.h"
 
 namespace fahr::scene_render {
 
@@ -16,7 +16,7 @@ struct Camera {
   Vec3 eye_direction;  // from the scene towards the viewer
   Vec3 up;
   Vec3 centre_mm;
-  double width_mm;     // visible width
+  double width_mm;  // visible width
 };
 
 struct Cut {

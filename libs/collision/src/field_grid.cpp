@@ -30,7 +30,8 @@ FieldGrid::FieldGrid(const geometry::SignedDistanceField& sdf) {
         const auto stored = static_cast<float>(exact);
         values_[static_cast<std::size_t>(i) + stride_y_ * static_cast<std::size_t>(j) +
                 stride_z_ * static_cast<std::size_t>(k)] = stored;
-        storage_error_m_ = std::max(storage_error_m_, std::abs(static_cast<double>(stored) - exact));
+        storage_error_m_ =
+            std::max(storage_error_m_, std::abs(static_cast<double>(stored) - exact));
       }
     }
   }

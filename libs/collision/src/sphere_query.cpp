@@ -52,7 +52,8 @@ struct Grid {
 
 // The sample of the grid at p from its value and gradient there: the
 // nearest point along the gradient.
-geometry::SdfSample from_gradient(const Eigen::Vector3d& p, double distance, const Eigen::Vector3d& gradient) noexcept {
+geometry::SdfSample from_gradient(const Eigen::Vector3d& p, double distance,
+                                  const Eigen::Vector3d& gradient) noexcept {
   geometry::SdfSample s;
   s.distance_m = distance;
   const double norm = gradient.norm();
@@ -90,8 +91,8 @@ geometry::SdfSample grid_sample(const Grid& grid, const Eigen::Vector3d& p, doub
 // queries: the field bounds its search by |grid| + sqrt(3) cells, or not at
 // all beyond its band, and a search ball of 1-2 mm on the finely tessellated
 // blade tests hundreds of triangles.
-geometry::SdfSample bounded_exact(const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& p, double grid,
-                                  double bound) noexcept {
+geometry::SdfSample bounded_exact(const geometry::SignedDistanceField& sdf,
+                                  const Eigen::Vector3d& p, double grid, double bound) noexcept {
   const double reach = bound * (1.0 + kBoundSlack) + kBoundFloorM;
   const geometry::BvhClosestPoint hit = sdf.bvh().closest_point(p, reach * reach);
   if (hit.triangle < 0) return sdf.query_exact(p);  // rounding at the bound: search everything
@@ -100,7 +101,8 @@ geometry::SdfSample bounded_exact(const geometry::SignedDistanceField& sdf, cons
   const double sign = grid < 0.0 ? -1.0 : 1.0;
   s.distance_m = sign * distance;
   s.closest_point_m = hit.point;
-  s.normal = distance > kMinNormalLength ? Eigen::Vector3d(sign * (p - hit.point) / distance) : Eigen::Vector3d::UnitZ();
+  s.normal = distance > kMinNormalLength ? Eigen::Vector3d(sign * (p - hit.point) / distance)
+                                         : Eigen::Vector3d::UnitZ();
   s.exact = true;
   return s;
 }
@@ -129,8 +131,9 @@ geometry::SdfSample sample(const Grid& field, const Eigen::Vector3d& p, double g
 // The contact of a sphere whose centre is outside (s.distance_m > 0): it is
 // its own pre-penetration centre. complete_deferred() calls it too, so a
 // deferred contact gets the same numbers.
-void outside_contact(const Eigen::Vector3d& centre_body, double radius, const geometry::SdfSample& s,
-                     Eigen::Vector3d& q, Eigen::Vector3d& n, double& depth) noexcept {
+void outside_contact(const Eigen::Vector3d& centre_body, double radius,
+                     const geometry::SdfSample& s, Eigen::Vector3d& q, Eigen::Vector3d& n,
+                     double& depth) noexcept {
   q = s.closest_point_m;
   const Eigen::Vector3d d = centre_body - q;
   const double len = d.norm();
@@ -148,19 +151,20 @@ void probe_surface(const SphereTree& tree, std::uint32_t slot, QuerySettings::Su
   const Eigen::Vector3d& anchor = tree.slot_anchors()[slot];
   if (std::isnan(anchor.x())) return;
   const auto& face = tree.slot_faces()[slot];
-  contact.surface_point_m = probe == QuerySettings::SurfaceProbe::kFacePoint
-                                ? geometry::closest_point_on_triangle(contact.point_m, face[0], face[1], face[2]).point
-                                : anchor;
+  contact.surface_point_m =
+      probe == QuerySettings::SurfaceProbe::kFacePoint
+          ? geometry::closest_point_on_triangle(contact.point_m, face[0], face[1], face[2]).point
+          : anchor;
   contact.surface_depth_m = (contact.point_m - contact.surface_point_m).dot(contact.normal);
   contact.has_surface = true;
 }
 
 // The contact of one sphere whose exact sample at its centre is `s`.
 bool narrow_phase(const Grid& field, const Eigen::Vector3d* hint, double margin,
-                  const Eigen::Vector3d& centre_body,
-                  double radius, const geometry::SdfSample& s, const QuerySettings& settings,
-                  const PrePenetrationMemory& memory, std::uint32_t slot, std::uint64_t query,
-                  Eigen::Vector3d& q, Eigen::Vector3d& n, double& depth, bool& no_history) noexcept {
+                  const Eigen::Vector3d& centre_body, double radius, const geometry::SdfSample& s,
+                  const QuerySettings& settings, const PrePenetrationMemory& memory,
+                  std::uint32_t slot, std::uint64_t query, Eigen::Vector3d& q, Eigen::Vector3d& n,
+                  double& depth, bool& no_history) noexcept {
   no_history = false;
   if (s.distance_m > 0.0) {
     outside_contact(centre_body, radius, s, q, n, depth);
@@ -242,7 +246,8 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   // the exact band plus two cells (SignedDistanceField), less one error.
   const Eigen::Vector3d grid_low = sdf.grid_origin_m();
   const Eigen::Vector3d grid_high =
-      grid_low + sdf.cell_size_m() * (sdf.grid_dimensions() - Eigen::Vector3i::Ones()).cast<double>();
+      grid_low +
+      sdf.cell_size_m() * (sdf.grid_dimensions() - Eigen::Vector3i::Ones()).cast<double>();
   const Eigen::Vector3d inset = Eigen::Vector3d::Constant(sdf.band_m() + 2.0 * sdf.cell_size_m());
   const Eigen::Vector3d surface_low = grid_low + inset;
   const Eigen::Vector3d surface_high = grid_high - inset;
@@ -255,10 +260,13 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   auto bound_at = [&](const SphereTreeNode& node, const Eigen::Vector3d& middle) noexcept {
     const double reach = node.reach_m + settings.contact_skin_m + settings.candidate_margin_m;
     if (on_grid(middle)) return field.distance(middle) - 2.0 * grid_error - reach;
-    const double to_surface_box = (middle - middle.cwiseMax(surface_low).cwiseMin(surface_high)).norm();
+    const double to_surface_box =
+        (middle - middle.cwiseMax(surface_low).cwiseMin(surface_high)).norm();
     return to_surface_box - grid_error - reach;  // a NaN pose gives NaN: the caller prunes it
   };
-  auto node_bound = [&](const SphereTreeNode& node) noexcept { return bound_at(node, node_middle(node)); };
+  auto node_bound = [&](const SphereTreeNode& node) noexcept {
+    return bound_at(node, node_middle(node));
+  };
   // The deepest k contacts found so far, as a min-heap of depths (deepest_only).
   const std::size_t keep = std::min(settings.deepest_only, kMaxDeepest);
   std::array<double, kMaxDeepest> kept_depths;
@@ -268,11 +276,14 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     if (keep == 0) return;
     if (kept < keep) {
       kept_depths[kept++] = depth;
-      std::push_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept), deeper_first);
+      std::push_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept),
+                     deeper_first);
     } else if (depth > kept_depths[0]) {
-      std::pop_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept), deeper_first);
+      std::pop_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept),
+                    deeper_first);
       kept_depths[kept - 1] = depth;
-      std::push_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept), deeper_first);
+      std::push_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept),
+                     deeper_first);
     }
   };
   // Every sphere of a leaf in the body frame first, each one's grid cell
@@ -282,7 +293,8 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   // 65536: -25 % median; warm, with the lines in cache, it costs ~10 %).
   std::array<Eigen::Vector3d, SphereTree::kLeafSize> leaf_body;
   auto load_leaf = [&](const SphereTreeNode& node) noexcept {
-    const auto count = static_cast<std::size_t>(std::min<std::int32_t>(node.count, SphereTree::kLeafSize));
+    const auto count =
+        static_cast<std::size_t>(std::min<std::int32_t>(node.count, SphereTree::kLeafSize));
     for (std::size_t k = 0; k < count; ++k) {
       leaf_body[k] = frame.to_body(slots[static_cast<std::size_t>(node.first) + k].head<3>());
     }
@@ -293,12 +305,14 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   // the grid at the centre it last remembered decides that without the
   // read when floor - L |p - centre| is still beyond it. No square root unless
   // the read is skipped: the new floor needs it.
-  std::array<double, SphereTree::kLeafSize> leaf_floor;  // new floor of a sphere whose read is skipped, else NaN
+  std::array<double, SphereTree::kLeafSize>
+      leaf_floor;  // new floor of a sphere whose read is skipped, else NaN
   auto bound_leaf = [&](const SphereTreeNode& node, std::size_t count) noexcept {
     for (std::size_t k = 0; k < count; ++k) {
       const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
       const double r = slots[slot][3] + settings.contact_skin_m;
-      const double spare = memory.grid_floor_m(slot) - decision_error - r - settings.candidate_margin_m;
+      const double spare =
+          memory.grid_floor_m(slot) - decision_error - r - settings.candidate_margin_m;
       const Eigen::Vector3d& last = memory.last_centre_body_m(slot);
       const double moved_squared = (leaf_body[k] - last).squaredNorm();
       const double slope = on_grid(leaf_body[k]) && on_grid(last) ? lipschitz_on_grid : lipschitz;
@@ -332,7 +346,8 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     // per line. (The stack walk asked for them already, when the leaf
     // passed its bound; asking before the bound was read was slower: most
     // leaves whose bound is read are pruned.)
-    memory.prefetch_leaf(static_cast<std::uint32_t>(node.first), static_cast<std::uint32_t>(node.count));
+    memory.prefetch_leaf(static_cast<std::uint32_t>(node.first),
+                         static_cast<std::uint32_t>(node.count));
     const std::size_t count = load_leaf(node);
     bound_leaf(node, count);
     for (std::size_t k = 0; k < count; ++k) {
@@ -359,7 +374,8 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       // outside and the depth r - grid not within the candidate margin, the
       // narrow phase would only remember the centre and report nothing. Its
       // normal (a square root and three divisions) is not worked out for that.
-      if (!settings.exact_narrow_phase && grid > 0.0 && !(r - grid > -settings.candidate_margin_m)) {
+      if (!settings.exact_narrow_phase && grid > 0.0 &&
+          !(r - grid > -settings.candidate_margin_m)) {
         memory.remember(slot, p, query, grid);
         continue;
       }
@@ -384,17 +400,18 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
       Eigen::Vector3d last_nearest;
       // Only the exact search uses the hint: the grid narrow phase does not read it.
       const Eigen::Vector3d* hint =
-          settings.exact_narrow_phase && memory.recall_nearest(slot, last_nearest) ? &last_nearest : nullptr;
-      const geometry::SdfSample s =
-          one_read ? from_gradient(p, grid, copy->gradient(cell)) : sample(field, p, grid, settings, hint);
+          settings.exact_narrow_phase && memory.recall_nearest(slot, last_nearest) ? &last_nearest
+                                                                                   : nullptr;
+      const geometry::SdfSample s = one_read ? from_gradient(p, grid, copy->gradient(cell))
+                                             : sample(field, p, grid, settings, hint);
       if (s.distance_m > 0.0) memory.remember(slot, p, query, grid);
       if (!(s.distance_m > 0.0)) ++stats.spheres_inside;
       if (s.exact) memory.remember_nearest(slot, s.closest_point_m);
       Eigen::Vector3d q, n;
       double depth = 0.0;
       bool no_history = false;
-      if (!narrow_phase(field, hint, settings.candidate_margin_m, p, r, s,
-                        settings, memory, slot, query, q, n, depth, no_history)) {
+      if (!narrow_phase(field, hint, settings.candidate_margin_m, p, r, s, settings, memory, slot,
+                        query, q, n, depth, no_history)) {
         continue;
       }
       ++stats.contacts;
@@ -427,7 +444,9 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     };
     std::array<Pending, SphereTree::kMaxDepth + 1> stack{};
     int top = 0;
-    auto passes = [&](double bound) noexcept { return bound <= settings.approach_margin_m; };  // NaN: pruned
+    auto passes = [&](double bound) noexcept {
+      return bound <= settings.approach_margin_m;
+    };  // NaN: pruned
     auto push = [&](std::int32_t index, double bound) noexcept {
       const SphereTreeNode& node = nodes[static_cast<std::size_t>(index)];
       if (node.count == 0) {
@@ -436,9 +455,11 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
         __builtin_prefetch(&nodes[static_cast<std::size_t>(node.first) + 1]);
       } else {
         const auto first = static_cast<std::size_t>(node.first);
-        const std::size_t end = std::min(slots.size(), first + static_cast<std::size_t>(node.count));
+        const std::size_t end =
+            std::min(slots.size(), first + static_cast<std::size_t>(node.count));
         for (std::size_t slot = first; slot < end; slot += 2) __builtin_prefetch(&slots[slot]);
-        memory.prefetch_leaf(static_cast<std::uint32_t>(node.first), static_cast<std::uint32_t>(node.count));
+        memory.prefetch_leaf(static_cast<std::uint32_t>(node.first),
+                             static_cast<std::uint32_t>(node.count));
       }
       stack[top++] = {index, bound};
     };
@@ -486,11 +507,13 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
   // reach + skin - grid(middle) + 2 grid error, as |c - middle| + r <= reach.
   std::vector<PrePenetrationMemory::Frontier>& frontier = memory.frontier();
   frontier.clear();
-  if (frontier.capacity() < nodes.size()) {  // a memory of another tree (or a copy): never allocate here
+  if (frontier.capacity() <
+      nodes.size()) {  // a memory of another tree (or a copy): never allocate here
     stats.overflowed = true;
     return stats;
   }
-  const auto nearer_first = [](const PrePenetrationMemory::Frontier& a, const PrePenetrationMemory::Frontier& b) {
+  const auto nearer_first = [](const PrePenetrationMemory::Frontier& a,
+                               const PrePenetrationMemory::Frontier& b) {
     return a.bound_m > b.bound_m;
   };
   auto offer_node = [&](std::int32_t index) noexcept {
@@ -524,7 +547,8 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
 }
 
 void complete_deferred(const SphereTree& tree, const RigidBody& body, const QuerySettings& settings,
-                       ContactBuffer& contacts, const std::uint32_t* indices, std::size_t count) noexcept {
+                       ContactBuffer& contacts, const std::uint32_t* indices,
+                       std::size_t count) noexcept {
   if (body.grid == nullptr || body.grid->empty()) return;  // the query defers nothing without one
   const FieldGrid& copy = *body.grid;
   // The query's own frame and reads, step for step: the same numbers.

@@ -42,11 +42,13 @@ double smallest_singular_value(const Eigen::Matrix3d& f) {
 
 }  // namespace
 
-SphereState::SphereState(const sphere_layout::SphereLayout& layout, std::span<const double> rest_positions_m)
+SphereState::SphereState(const sphere_layout::SphereLayout& layout,
+                         std::span<const double> rest_positions_m)
     : SphereState(layout) {
   if (rest_positions_m.size() < 3 * layout.node_count()) {
-    throw std::invalid_argument("sphere state: " + std::to_string(rest_positions_m.size()) + " rest coordinates for " +
-                                std::to_string(layout.node_count()) + " nodes");
+    throw std::invalid_argument("sphere state: " + std::to_string(rest_positions_m.size()) +
+                                " rest coordinates for " + std::to_string(layout.node_count()) +
+                                " nodes");
   }
   const std::vector<geometry::Tet>& tets = layout.tets();
   rest_inverse_.assign(tets.size(), Eigen::Matrix3d::Identity());
@@ -64,8 +66,9 @@ SphereState::SphereState(const sphere_layout::SphereLayout& layout)
     : centres_m_(layout.size(), Eigen::Vector3d::Zero()),
       radii_m_(layout.size(), 0.0),
       anchors_m_(layout.size(), Eigen::Vector3d::Constant(kNaN)),
-      anchor_faces_m_(layout.size(), {Eigen::Vector3d::Constant(kNaN), Eigen::Vector3d::Constant(kNaN),
-                                      Eigen::Vector3d::Constant(kNaN)}),
+      anchor_faces_m_(layout.size(),
+                      {Eigen::Vector3d::Constant(kNaN), Eigen::Vector3d::Constant(kNaN),
+                       Eigen::Vector3d::Constant(kNaN)}),
       six_volume_m3_(layout.tets().size(), 0.0) {
   reset_to_rest(layout);
 }
@@ -83,7 +86,8 @@ void SphereState::reset_to_rest(const sphere_layout::SphereLayout& layout) {
   ++version_;
 }
 
-bool SphereState::update(const sphere_layout::SphereLayout& layout, std::span<const double> positions_m) {
+bool SphereState::update(const sphere_layout::SphereLayout& layout,
+                         std::span<const double> positions_m) {
   if (positions_m.size() < 3 * layout.node_count()) return false;
   const double* x = positions_m.data();
   const std::vector<geometry::Tet>& tets = layout.tets();
@@ -107,7 +111,8 @@ bool SphereState::update(const sphere_layout::SphereLayout& layout, std::span<co
     double scale = 1.0;
     if (stretch_rule) {
       double smallest = kMaxVolumeScale;
-      for (const std::uint32_t t : layout.tets_of(i)) smallest = std::min(smallest, smallest_stretch_[t]);
+      for (const std::uint32_t t : layout.tets_of(i))
+        smallest = std::min(smallest, smallest_stretch_[t]);
       // An inverted tet has a singular value near 0 on the way through: the
       // floor keeps the sphere colliding, as in the volume rule.
       scale = std::max(smallest, kMinVolumeScale);
@@ -116,8 +121,9 @@ bool SphereState::update(const sphere_layout::SphereLayout& layout, std::span<co
       for (const std::uint32_t t : layout.tets_of(i)) six_v += six_volume_m3_[t];
       const double ratio = six_v / (6.0 * s.rest_linked_volume_m3);
       // cbrt keeps the sphere's volume proportional to its tets' volume.
-      scale = ratio > kMinVolumeScale * kMinVolumeScale * kMinVolumeScale ? std::min(std::cbrt(ratio), kMaxVolumeScale)
-                                                                            : kMinVolumeScale;
+      scale = ratio > kMinVolumeScale * kMinVolumeScale * kMinVolumeScale
+                  ? std::min(std::cbrt(ratio), kMaxVolumeScale)
+                  : kMinVolumeScale;
     }
     if (const sphere_layout::SurfaceAnchor* anchor = layout.anchor(i); anchor != nullptr) {
       Eigen::Vector3d a = Eigen::Vector3d::Zero();

@@ -18,7 +18,8 @@ SphereTree::SphereTree(const sphere_layout::SphereLayout& layout) {
   // Without anchors the slot copies stay as set here (never read: every
   // contact then reports has_surface false) and the refit skips them.
   anchored_ = layout.anchor_count() > 0;
-  slot_anchors_.assign(layout.size(), Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  slot_anchors_.assign(layout.size(),
+                       Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   slot_faces_.assign(layout.size(), {});
   if (n > 0) build(0, 0, n, 1, layout);
   SphereState rest(layout);
@@ -26,7 +27,8 @@ SphereTree::SphereTree(const sphere_layout::SphereLayout& layout) {
   refits_ = 0;
 }
 
-std::int32_t SphereTree::split(std::int32_t begin, std::int32_t end, const sphere_layout::SphereLayout& layout) {
+std::int32_t SphereTree::split(std::int32_t begin, std::int32_t end,
+                               const sphere_layout::SphereLayout& layout) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300);
   Eigen::Vector3d hi = Eigen::Vector3d::Constant(-1e300);
   for (std::int32_t i = begin; i < end; ++i) {
@@ -47,7 +49,8 @@ std::int32_t SphereTree::split(std::int32_t begin, std::int32_t end, const spher
   return mid;
 }
 
-void SphereTree::arrange_leaf(std::int32_t begin, std::int32_t end, const sphere_layout::SphereLayout& layout,
+void SphereTree::arrange_leaf(std::int32_t begin, std::int32_t end,
+                              const sphere_layout::SphereLayout& layout,
                               std::vector<std::uint32_t>& out) {
   if (end - begin <= kBlockSize) {
     out.insert(out.end(), order_.begin() + begin, order_.begin() + end);

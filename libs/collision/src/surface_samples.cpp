@@ -24,7 +24,8 @@ struct CubeKey {
 };
 struct CubeKeyHash {
   std::size_t operator()(const CubeKey& c) const noexcept {
-    const auto u = static_cast<std::uint64_t>(c.i) * 73856093u ^ static_cast<std::uint64_t>(c.j) * 19349663u ^
+    const auto u = static_cast<std::uint64_t>(c.i) * 73856093u ^
+                   static_cast<std::uint64_t>(c.j) * 19349663u ^
                    static_cast<std::uint64_t>(c.k) * 83492791u;
     return static_cast<std::size_t>(u);
   }
@@ -32,14 +33,17 @@ struct CubeKeyHash {
 
 }  // namespace
 
-SurfaceSamples::SurfaceSamples(const geometry::SurfaceMesh& surface, const SurfaceSampleSettings& settings) {
-  if (surface.triangle_count() == 0) throw std::invalid_argument("surface samples: the surface has no triangles");
+SurfaceSamples::SurfaceSamples(const geometry::SurfaceMesh& surface,
+                               const SurfaceSampleSettings& settings) {
+  if (surface.triangle_count() == 0)
+    throw std::invalid_argument("surface samples: the surface has no triangles");
   if (!(settings.spacing_m > 0.0) || !std::isfinite(settings.spacing_m)) {
     throw std::invalid_argument("surface samples: spacing_m must be finite and > 0, got " +
                                 std::to_string(settings.spacing_m));
   }
   if (settings.leaf_size < 1) {
-    throw std::invalid_argument("surface samples: leaf_size must be >= 1, got " + std::to_string(settings.leaf_size));
+    throw std::invalid_argument("surface samples: leaf_size must be >= 1, got " +
+                                std::to_string(settings.leaf_size));
   }
   const double h = settings.spacing_m;
   // Per cube, the candidate nearest its centre: deterministic whatever the
@@ -47,17 +51,20 @@ SurfaceSamples::SurfaceSamples(const geometry::SurfaceMesh& surface, const Surfa
   std::unordered_map<CubeKey, Eigen::Vector3d, CubeKeyHash> best;
   const auto offer = [&](const Eigen::Vector3d& p) {
     const Eigen::Vector3d u = p / h;
-    const CubeKey key{static_cast<std::int64_t>(std::floor(u.x())), static_cast<std::int64_t>(std::floor(u.y())),
+    const CubeKey key{static_cast<std::int64_t>(std::floor(u.x())),
+                      static_cast<std::int64_t>(std::floor(u.y())),
                       static_cast<std::int64_t>(std::floor(u.z()))};
-    const Eigen::Vector3d centre = h * (Eigen::Vector3d(static_cast<double>(key.i), static_cast<double>(key.j),
-                                                        static_cast<double>(key.k)) +
-                                        Eigen::Vector3d::Constant(0.5));
+    const Eigen::Vector3d centre =
+        h * (Eigen::Vector3d(static_cast<double>(key.i), static_cast<double>(key.j),
+                             static_cast<double>(key.k)) +
+             Eigen::Vector3d::Constant(0.5));
     auto [it, inserted] = best.try_emplace(key, p);
     if (inserted) return;
     const double d_new = (p - centre).squaredNorm();
     const double d_old = (it->second - centre).squaredNorm();
-    if (d_new < d_old || (d_new == d_old && std::tie(p.x(), p.y(), p.z()) <
-                                                std::tie(it->second.x(), it->second.y(), it->second.z()))) {
+    if (d_new < d_old ||
+        (d_new == d_old && std::tie(p.x(), p.y(), p.z()) <
+                               std::tie(it->second.x(), it->second.y(), it->second.z()))) {
       it->second = p;
     }
   };
@@ -70,7 +77,8 @@ SurfaceSamples::SurfaceSamples(const geometry::SurfaceMesh& surface, const Surfa
     const int n = std::max(1, static_cast<int>(std::ceil(longest / h)));
     if (static_cast<std::size_t>(n) * static_cast<std::size_t>(n) > settings.max_samples) {
       throw std::invalid_argument("surface samples: a triangle of " + std::to_string(longest) +
-                                  " m would need more than max_samples samples at spacing_m " + std::to_string(h));
+                                  " m would need more than max_samples samples at spacing_m " +
+                                  std::to_string(h));
     }
     for (int i = 0; i <= n; ++i) {
       for (int j = 0; i + j <= n; ++j) {
@@ -78,22 +86,25 @@ SurfaceSamples::SurfaceSamples(const geometry::SurfaceMesh& surface, const Surfa
       }
     }
     if (best.size() > settings.max_samples) {
-      throw std::invalid_argument("surface samples: more than max_samples (" + std::to_string(settings.max_samples) +
-                                  ") samples at spacing_m " + std::to_string(h));
+      throw std::invalid_argument("surface samples: more than max_samples (" +
+                                  std::to_string(settings.max_samples) + ") samples at spacing_m " +
+                                  std::to_string(h));
     }
   }
   points_m_.reserve(best.size());
   for (const auto& [key, p] : best) points_m_.push_back(p);
   // Hash order is not portable: sort so the tree (and the leaf ids) are.
-  std::sort(points_m_.begin(), points_m_.end(), [](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
-    return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
-  });
+  std::sort(points_m_.begin(), points_m_.end(),
+            [](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+              return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
+            });
   nodes_.reserve(2 * (points_m_.size() / static_cast<std::size_t>(settings.leaf_size) + 1));
   nodes_.emplace_back();
   build(0, 0, static_cast<std::int32_t>(points_m_.size()), 1, settings.leaf_size);
 }
 
-void SurfaceSamples::build(std::int32_t node, std::int32_t begin, std::int32_t end, int depth, int leaf_size) {
+void SurfaceSamples::build(std::int32_t node, std::int32_t begin, std::int32_t end, int depth,
+                           int leaf_size) {
   depth_ = std::max(depth_, depth);
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
@@ -103,7 +114,8 @@ void SurfaceSamples::build(std::int32_t node, std::int32_t begin, std::int32_t e
   }
   const Eigen::Vector3d centre = 0.5 * (lo + hi);
   double radius = 0.0;
-  for (std::int32_t i = begin; i < end; ++i) radius = std::max(radius, (points_m_[i] - centre).norm());
+  for (std::int32_t i = begin; i < end; ++i)
+    radius = std::max(radius, (points_m_[i] - centre).norm());
   nodes_[node].centre_m = centre;
   nodes_[node].radius_m = radius;
   if (end - begin <= leaf_size || depth >= kMaxDepth - 1) {
@@ -117,7 +129,8 @@ void SurfaceSamples::build(std::int32_t node, std::int32_t begin, std::int32_t e
   const std::int32_t mid = begin + (end - begin) / 2;
   std::nth_element(points_m_.begin() + begin, points_m_.begin() + mid, points_m_.begin() + end,
                    [axis](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
-                     return std::tie(p[axis], p.x(), p.y(), p.z()) < std::tie(q[axis], q.x(), q.y(), q.z());
+                     return std::tie(p[axis], p.x(), p.y(), p.z()) <
+                            std::tie(q[axis], q.x(), q.y(), q.z());
                    });
   const auto left = static_cast<std::int32_t>(nodes_.size());
   nodes_.emplace_back();
@@ -128,8 +141,10 @@ void SurfaceSamples::build(std::int32_t node, std::int32_t begin, std::int32_t e
   build(left + 1, mid, end, depth + 1, leaf_size);
 }
 
-SurfaceQueryStats query_surface_samples(const SurfaceSamples& samples, const Eigen::Isometry3d& world_from_tool,
-                                        const RigidBody& body, double margin_m, std::span<SurfaceContact> out,
+SurfaceQueryStats query_surface_samples(const SurfaceSamples& samples,
+                                        const Eigen::Isometry3d& world_from_tool,
+                                        const RigidBody& body, double margin_m,
+                                        std::span<SurfaceContact> out,
                                         std::size_t& count) noexcept {
   SurfaceQueryStats stats;
   const auto& nodes = samples.nodes();

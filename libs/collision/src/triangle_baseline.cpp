@@ -14,7 +14,9 @@
 namespace fahr::collision {
 namespace {
 
-btVector3 to_bt(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+btVector3 to_bt(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 // Bullet reads triangles through this interface; the vertices are ours, so
 // moving them and calling the tree's update() refits without a rebuild.
@@ -30,8 +32,10 @@ class MeshPrimitives final : public btPrimitiveManagerBase {
   int get_primitive_count() const override { return static_cast<int>(triangles.size()); }
   void get_primitive_box(int index, btAABB& box) const override {
     const auto& t = triangles[static_cast<std::size_t>(index)];
-    const Eigen::Vector3d lo = vertices_m[t[0]].cwiseMin(vertices_m[t[1]]).cwiseMin(vertices_m[t[2]]);
-    const Eigen::Vector3d hi = vertices_m[t[0]].cwiseMax(vertices_m[t[1]]).cwiseMax(vertices_m[t[2]]);
+    const Eigen::Vector3d lo =
+        vertices_m[t[0]].cwiseMin(vertices_m[t[1]]).cwiseMin(vertices_m[t[2]]);
+    const Eigen::Vector3d hi =
+        vertices_m[t[0]].cwiseMax(vertices_m[t[1]]).cwiseMax(vertices_m[t[2]]);
     box.m_min = to_bt(lo - Eigen::Vector3d::Constant(box_margin_m));
     box.m_max = to_bt(hi + Eigen::Vector3d::Constant(box_margin_m));
   }
@@ -79,11 +83,13 @@ TriangleBaseline::TriangleBaseline(const geometry::SurfaceMesh& tissue,
                                    const geometry::SurfaceMesh& tool)
     : impl_(std::make_unique<Impl>()) {
   if (tissue.triangle_count() == 0 || tool.triangle_count() == 0) {
-    throw std::invalid_argument("triangle baseline: the tissue or the tool surface has no triangles");
+    throw std::invalid_argument(
+        "triangle baseline: the tissue or the tool surface has no triangles");
   }
   if (surface_to_node.size() != tissue.vertex_count()) {
-    throw std::invalid_argument("triangle baseline: surface_to_node has " + std::to_string(surface_to_node.size()) +
-                                " entries for " + std::to_string(tissue.vertex_count()) + " tissue vertices");
+    throw std::invalid_argument("triangle baseline: surface_to_node has " +
+                                std::to_string(surface_to_node.size()) + " entries for " +
+                                std::to_string(tissue.vertex_count()) + " tissue vertices");
   }
   Impl& m = *impl_;
   m.tissue.vertices_m = tissue.vertices();
@@ -111,24 +117,27 @@ void TriangleBaseline::update(std::span<const double> positions_m) {
   Impl& m = *impl_;
   for (std::size_t i = 0; i < m.tissue.vertices_m.size(); ++i) {
     const auto node = static_cast<std::size_t>(m.surface_to_node[i]);
-    m.tissue.vertices_m[i] = Eigen::Vector3d(positions_m[3 * node], positions_m[3 * node + 1], positions_m[3 * node + 2]);
+    m.tissue.vertices_m[i] = Eigen::Vector3d(positions_m[3 * node], positions_m[3 * node + 1],
+                                             positions_m[3 * node + 2]);
   }
   m.tissue_tree.update();  // refit: same topology, new boxes
   ++m.refits;
 }
 
-void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::vector<TriangleContact>& out,
-                               double candidate_margin_m) {
+void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool,
+                               std::vector<TriangleContact>& out, double candidate_margin_m) {
   Impl& m = *impl_;
   // Beyond the tool boxes' growth a candidate's pair would not be found.
   // (A NaN margin is none.)
-  const double margin =
-      std::isfinite(candidate_margin_m) ? std::clamp(candidate_margin_m, 0.0, 0.99 * kMaxFaceDepthM) : 0.0;
+  const double margin = std::isfinite(candidate_margin_m)
+                            ? std::clamp(candidate_margin_m, 0.0, 0.99 * kMaxFaceDepthM)
+                            : 0.0;
   out.clear();
   m.pairs.resizeNoInitialize(0);  // keeps the capacity; resize() would copy an uninitialised pair
   btTransform tool_pose;
   const Eigen::Matrix3d r = world_from_tool.linear();
-  tool_pose.setBasis(btMatrix3x3(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)));
+  tool_pose.setBasis(
+      btMatrix3x3(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)));
   tool_pose.setOrigin(to_bt(world_from_tool.translation()));
   btTransform identity;
   identity.setIdentity();
@@ -141,8 +150,9 @@ void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::ve
   // holds it: behind it, inside the other body. Behind a farther face is not
   // enough: 0.5 mm above a 1.2 mm blade, a tongue vertex is 1.7 mm behind the
   // blade's underside but in front of its top face.
-  auto offer = [&](std::vector<Best>& best, std::vector<std::uint32_t>& stamp, std::vector<std::uint32_t>& touched,
-                   std::uint32_t vertex, double distance, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+  auto offer = [&](std::vector<Best>& best, std::vector<std::uint32_t>& stamp,
+                   std::vector<std::uint32_t>& touched, std::uint32_t vertex, double distance,
+                   const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
                    std::int32_t acting_tissue_vertex) {
     if (stamp[vertex] != m.stamp) {
       stamp[vertex] = m.stamp;
@@ -156,17 +166,19 @@ void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::ve
   for (int k = 0; k < m.pairs.size(); ++k) {
     const auto& tt = m.tissue.triangles[static_cast<std::size_t>(m.pairs[k].m_index1)];
     const auto& st = m.tool.triangles[static_cast<std::size_t>(m.pairs[k].m_index2)];
-    const Eigen::Vector3d s[3] = {world_from_tool * m.tool.vertices_m[st[0]], world_from_tool * m.tool.vertices_m[st[1]],
+    const Eigen::Vector3d s[3] = {world_from_tool * m.tool.vertices_m[st[0]],
+                                  world_from_tool * m.tool.vertices_m[st[1]],
                                   world_from_tool * m.tool.vertices_m[st[2]]};
     const Eigen::Vector3d sn = r * m.tool_normals[static_cast<std::size_t>(m.pairs[k].m_index2)];
-    const Eigen::Vector3d t[3] = {m.tissue.vertices_m[tt[0]], m.tissue.vertices_m[tt[1]], m.tissue.vertices_m[tt[2]]};
+    const Eigen::Vector3d t[3] = {m.tissue.vertices_m[tt[0]], m.tissue.vertices_m[tt[1]],
+                                  m.tissue.vertices_m[tt[2]]};
     const Eigen::Vector3d tn_raw = (t[1] - t[0]).cross(t[2] - t[0]);
     const double tn_len = tn_raw.norm();
     for (int v = 0; v < 3; ++v) {  // tissue vertices behind the tool face
       const double d = sn.dot(t[v] - s[0]);
       if (std::abs(d) < kMaxFaceDepthM && in_prism(t[v], s[0], s[1], s[2], sn)) {
-        offer(m.tissue_best, m.tissue_stamp, m.touched_tissue, static_cast<std::uint32_t>(tt[v]), d, t[v] - d * sn, sn,
-              static_cast<std::int32_t>(tt[v]));
+        offer(m.tissue_best, m.tissue_stamp, m.touched_tissue, static_cast<std::uint32_t>(tt[v]), d,
+              t[v] - d * sn, sn, static_cast<std::int32_t>(tt[v]));
       }
     }
     if (tn_len <= 0.0) continue;  // a collapsed tissue triangle has no side
@@ -178,8 +190,8 @@ void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::ve
         for (int c = 1; c < 3; ++c) {
           if ((t[c] - s[v]).squaredNorm() < (t[nearest] - s[v]).squaredNorm()) nearest = c;
         }
-        offer(m.tool_best, m.tool_stamp, m.touched_tool, static_cast<std::uint32_t>(st[v]), d, s[v], -tn,
-              static_cast<std::int32_t>(tt[nearest]));
+        offer(m.tool_best, m.tool_stamp, m.touched_tool, static_cast<std::uint32_t>(st[v]), d, s[v],
+              -tn, static_cast<std::int32_t>(tt[nearest]));
       }
     }
   }
@@ -188,19 +200,27 @@ void TriangleBaseline::collide(const Eigen::Isometry3d& world_from_tool, std::ve
   for (const std::uint32_t v : m.touched_tissue) {
     const Best& b = m.tissue_best[v];
     if (b.distance < margin) {
-      out.push_back({b.point, b.normal, -b.distance, static_cast<std::int32_t>(v), -1, b.acting_tissue_vertex});
+      out.push_back({b.point, b.normal, -b.distance, static_cast<std::int32_t>(v), -1,
+                     b.acting_tissue_vertex});
     }
   }
   for (const std::uint32_t v : m.touched_tool) {
     const Best& b = m.tool_best[v];
     if (b.distance < margin) {
-      out.push_back({b.point, b.normal, -b.distance, -1, static_cast<std::int32_t>(v), b.acting_tissue_vertex});
+      out.push_back({b.point, b.normal, -b.distance, -1, static_cast<std::int32_t>(v),
+                     b.acting_tissue_vertex});
     }
   }
 }
 
-std::uint64_t TriangleBaseline::refit_count() const { return impl_->refits; }
-std::uint64_t TriangleBaseline::rebuild_count() const { return impl_->builds - 1; }
-std::size_t TriangleBaseline::last_pair_count() const { return static_cast<std::size_t>(impl_->pairs.size()); }
+std::uint64_t TriangleBaseline::refit_count() const {
+  return impl_->refits;
+}
+std::uint64_t TriangleBaseline::rebuild_count() const {
+  return impl_->builds - 1;
+}
+std::size_t TriangleBaseline::last_pair_count() const {
+  return static_cast<std::size_t>(impl_->pairs.size());
+}
 
 }  // namespace fahr::collision

@@ -9,9 +9,12 @@
 
 namespace fahr::common::detail {
 
-std::unique_ptr<ParticipantBackend> make_fast_backend(const TransportConfig& config, EventLog& events);
-std::unique_ptr<ParticipantBackend> make_cyclone_backend(const TransportConfig& config, EventLog& events);
-std::unique_ptr<ParticipantBackend> make_inprocess_backend(const TransportConfig& config, EventLog& events);
+std::unique_ptr<ParticipantBackend> make_fast_backend(const TransportConfig& config,
+                                                      EventLog& events);
+std::unique_ptr<ParticipantBackend> make_cyclone_backend(const TransportConfig& config,
+                                                         EventLog& events);
+std::unique_ptr<ParticipantBackend> make_inprocess_backend(const TransportConfig& config,
+                                                           EventLog& events);
 
 // Copies a topic name into an event, truncating it.
 void set_event_topic(TransportEvent& event, std::string_view topic);

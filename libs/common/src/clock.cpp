@@ -12,8 +12,14 @@ std::int64_t read_ns(clockid_t clock) {
 }
 }  // namespace
 
-std::int64_t wall_now_ns() { return read_ns(CLOCK_REALTIME); }
-std::int64_t monotonic_now_ns() { return read_ns(CLOCK_MONOTONIC); }
-std::int64_t thread_cpu_now_ns() { return read_ns(CLOCK_THREAD_CPUTIME_ID); }
+std::int64_t wall_now_ns() {
+  return read_ns(CLOCK_REALTIME);
+}
+std::int64_t monotonic_now_ns() {
+  return read_ns(CLOCK_MONOTONIC);
+}
+std::int64_t thread_cpu_now_ns() {
+  return read_ns(CLOCK_THREAD_CPUTIME_ID);
+}
 
 }  // namespace fahr::common

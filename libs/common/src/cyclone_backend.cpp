@@ -35,15 +35,19 @@ using eprosima::fastrtps::rtps::SerializedPayload_t;
 // ever uses it, so they match nothing outside this participant.
 constexpr const char* kProbePartition = "__fahr_sertype_probe";
 
-std::string retcode_text(dds_return_t rc) { return dds_strretcode(rc); }
+std::string retcode_text(dds_return_t rc) {
+  return dds_strretcode(rc);
+}
 
 dds_qos_t* make_qos(const QosProfile& profile) {
   dds_qos_t* qos = dds_create_qos();
-  dds_qset_reliability(qos, profile.reliability == Reliability::kReliable ? DDS_RELIABILITY_RELIABLE
-                                                                          : DDS_RELIABILITY_BEST_EFFORT,
+  dds_qset_reliability(qos,
+                       profile.reliability == Reliability::kReliable ? DDS_RELIABILITY_RELIABLE
+                                                                     : DDS_RELIABILITY_BEST_EFFORT,
                        DDS_MSECS(100));
-  dds_qset_durability(qos, profile.durability == Durability::kTransientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL
-                                                                              : DDS_DURABILITY_VOLATILE);
+  dds_qset_durability(qos, profile.durability == Durability::kTransientLocal
+                               ? DDS_DURABILITY_TRANSIENT_LOCAL
+                               : DDS_DURABILITY_VOLATILE);
   if (profile.history_depth == 0) {
     dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
   } else {
@@ -96,24 +100,25 @@ void on_subscription_matched(dds_entity_t, const dds_subscription_matched_status
   event.current_count = static_cast<std::int32_t>(s.current_count);
   ctx->events->record(event);
 }
-void on_offered_deadline_missed(dds_entity_t, const dds_offered_deadline_missed_status_t s, void* arg) {
+void on_offered_deadline_missed(dds_entity_t, const dds_offered_deadline_missed_status_t s,
+                                void* arg) {
   auto* ctx = static_cast<EndpointContext*>(arg);
   ctx->events->record(make_event(EventKind::kOfferedDeadlineMissed, *ctx, s.total_count));
 }
-void on_requested_deadline_missed(dds_entity_t, const dds_requested_deadline_missed_status_t s, void* arg) {
+void on_requested_deadline_missed(dds_entity_t, const dds_requested_deadline_missed_status_t s,
+                                  void* arg) {
   auto* ctx = static_cast<EndpointContext*>(arg);
-  ctx->events->record(
-      make_event(EventKind::kRequestedDeadlineMissed, *ctx, s.total_count));
+  ctx->events->record(make_event(EventKind::kRequestedDeadlineMissed, *ctx, s.total_count));
 }
-void on_offered_incompatible_qos(dds_entity_t, const dds_offered_incompatible_qos_status_t s, void* arg) {
+void on_offered_incompatible_qos(dds_entity_t, const dds_offered_incompatible_qos_status_t s,
+                                 void* arg) {
   auto* ctx = static_cast<EndpointContext*>(arg);
-  ctx->events->record(
-      make_event(EventKind::kOfferedIncompatibleQos, *ctx, s.total_count));
+  ctx->events->record(make_event(EventKind::kOfferedIncompatibleQos, *ctx, s.total_count));
 }
-void on_requested_incompatible_qos(dds_entity_t, const dds_requested_incompatible_qos_status_t s, void* arg) {
+void on_requested_incompatible_qos(dds_entity_t, const dds_requested_incompatible_qos_status_t s,
+                                   void* arg) {
   auto* ctx = static_cast<EndpointContext*>(arg);
-  ctx->events->record(
-      make_event(EventKind::kRequestedIncompatibleQos, *ctx, s.total_count));
+  ctx->events->record(make_event(EventKind::kRequestedIncompatibleQos, *ctx, s.total_count));
 }
 void on_liveliness_lost(dds_entity_t, const dds_liveliness_lost_status_t s, void* arg) {
   auto* ctx = static_cast<EndpointContext*>(arg);
@@ -138,7 +143,8 @@ void on_sample_rejected(dds_entity_t, const dds_sample_rejected_status_t s, void
 class CycloneWriter final : public WriterBackend {
  public:
   CycloneWriter(dds_entity_t publisher, dds_entity_t topic, const std::string& topic_name,
-                const ddsi_sertype* sertype, const TypeSupport& type, const QosProfile& profile, EventLog& events)
+                const ddsi_sertype* sertype, const TypeSupport& type, const QosProfile& profile,
+                EventLog& events)
       : sertype_(sertype), fast_type_(static_cast<TopicDataType*>(type.make_fast_type())) {
     ctx_.topic = topic_name;
     ctx_.events = &events;
@@ -151,7 +157,9 @@ class CycloneWriter final : public WriterBackend {
     writer_ = dds_create_writer(publisher, topic, qos, listener);
     dds_delete_qos(qos);
     dds_delete_listener(listener);
-    if (writer_ < 0) throw std::runtime_error("Cyclone DDS refused a writer on " + topic_name + ": " + retcode_text(writer_));
+    if (writer_ < 0)
+      throw std::runtime_error("Cyclone DDS refused a writer on " + topic_name + ": " +
+                               retcode_text(writer_));
   }
   ~CycloneWriter() override { dds_delete(writer_); }
 
@@ -179,9 +187,12 @@ class CycloneWriter final : public WriterBackend {
 
 class CycloneReader final : public ReaderBackend {
  public:
-  CycloneReader(dds_entity_t subscriber, dds_entity_t topic, const std::string& topic_name, const TypeSupport& type,
-                const QosProfile& profile, SampleSink* sink, EventLog& events)
-      : type_(type), fast_type_(static_cast<TopicDataType*>(type.make_fast_type())), sink_(sink),
+  CycloneReader(dds_entity_t subscriber, dds_entity_t topic, const std::string& topic_name,
+                const TypeSupport& type, const QosProfile& profile, SampleSink* sink,
+                EventLog& events)
+      : type_(type),
+        fast_type_(static_cast<TopicDataType*>(type.make_fast_type())),
+        sink_(sink),
         scratch_(type.new_sample()) {
     ctx_.topic = topic_name;
     ctx_.events = &events;
@@ -197,7 +208,9 @@ class CycloneReader final : public ReaderBackend {
     reader_ = dds_create_reader(subscriber, topic, qos, listener);
     dds_delete_qos(qos);
     dds_delete_listener(listener);
-    if (reader_ < 0) throw std::runtime_error("Cyclone DDS refused a reader on " + topic_name + ": " + retcode_text(reader_));
+    if (reader_ < 0)
+      throw std::runtime_error("Cyclone DDS refused a reader on " + topic_name + ": " +
+                               retcode_text(reader_));
   }
   ~CycloneReader() override {
     dds_delete(reader_);  // waits for a running listener to return
@@ -206,7 +219,9 @@ class CycloneReader final : public ReaderBackend {
   int matched_writers() const override { return ctx_.matched.load(); }
 
  private:
-  static void on_data_available(dds_entity_t reader, void* arg) { static_cast<CycloneReader*>(arg)->take_all(reader); }
+  static void on_data_available(dds_entity_t reader, void* arg) {
+    static_cast<CycloneReader*>(arg)->take_all(reader);
+  }
 
   void take_all(dds_entity_t reader) {
     ddsi_serdata* serdata = nullptr;
@@ -249,8 +264,9 @@ class CycloneParticipant final : public ParticipantBackend {
     participant_ = dds_create_participant(config.domain_id, qos, nullptr);
     dds_delete_qos(qos);
     if (participant_ < 0) {
-      throw ConfigError("Cyclone DDS could not create a participant in domain " + std::to_string(config.domain_id) +
-                        ": " + retcode_text(participant_) + " (check CYCLONEDDS_URI or the DDS profile)");
+      throw ConfigError("Cyclone DDS could not create a participant in domain " +
+                        std::to_string(config.domain_id) + ": " + retcode_text(participant_) +
+                        " (check CYCLONEDDS_URI or the DDS profile)");
     }
     dds_qos_t* group_qos = dds_create_qos();
     if (!config.partition.empty()) dds_qset_partition1(group_qos, config.partition.c_str());
@@ -267,14 +283,16 @@ class CycloneParticipant final : public ParticipantBackend {
   std::unique_ptr<WriterBackend> create_writer(const EndpointSpec& spec) override {
     std::lock_guard lock(mutex_);
     const dds_entity_t topic = topic_for(spec);
-    return std::make_unique<CycloneWriter>(publisher_, topic, spec.topic_name, sertype_for(spec, topic), *spec.type,
-                                           spec.qos, events_);
+    return std::make_unique<CycloneWriter>(publisher_, topic, spec.topic_name,
+                                           sertype_for(spec, topic), *spec.type, spec.qos, events_);
   }
 
-  std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec, SampleSink* sink) override {
+  std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec,
+                                               SampleSink* sink) override {
     std::lock_guard lock(mutex_);
     const dds_entity_t topic = topic_for(spec);
-    return std::make_unique<CycloneReader>(subscriber_, topic, spec.topic_name, *spec.type, spec.qos, sink, events_);
+    return std::make_unique<CycloneReader>(subscriber_, topic, spec.topic_name, *spec.type,
+                                           spec.qos, sink, events_);
   }
 
  private:
@@ -294,9 +312,13 @@ class CycloneParticipant final : public ParticipantBackend {
   dds_entity_t topic_for(const EndpointSpec& spec) {
     auto it = topics_.find(spec.topic_name);
     if (it != topics_.end()) return it->second;
-    const auto* descriptor = static_cast<const dds_topic_descriptor_t*>(spec.type->cyclone_descriptor);
-    const dds_entity_t topic = dds_create_topic(participant_, descriptor, spec.topic_name.c_str(), nullptr, nullptr);
-    if (topic < 0) throw std::runtime_error("Cyclone DDS refused topic " + spec.topic_name + ": " + retcode_text(topic));
+    const auto* descriptor =
+        static_cast<const dds_topic_descriptor_t*>(spec.type->cyclone_descriptor);
+    const dds_entity_t topic =
+        dds_create_topic(participant_, descriptor, spec.topic_name.c_str(), nullptr, nullptr);
+    if (topic < 0)
+      throw std::runtime_error("Cyclone DDS refused topic " + spec.topic_name + ": " +
+                               retcode_text(topic));
     topics_.emplace(spec.topic_name, topic);
     return topic;
   }
@@ -319,7 +341,8 @@ class CycloneParticipant final : public ParticipantBackend {
     const dds_entity_t reader = dds_create_reader(probe_subscriber, topic, qos, nullptr);
     const dds_entity_t writer = dds_create_writer(probe_publisher, topic, qos, nullptr);
     dds_delete_qos(qos);
-    const auto* descriptor = static_cast<const dds_topic_descriptor_t*>(spec.type->cyclone_descriptor);
+    const auto* descriptor =
+        static_cast<const dds_topic_descriptor_t*>(spec.type->cyclone_descriptor);
     void* zero = std::calloc(1, descriptor->m_size);
     dds_write(writer, zero);
     std::free(zero);
@@ -336,7 +359,8 @@ class CycloneParticipant final : public ParticipantBackend {
     }
     dds_delete(probe_publisher);
     dds_delete(probe_subscriber);
-    if (sertype == nullptr) throw std::runtime_error("Cyclone DDS: could not obtain the sertype of " + spec.topic_name);
+    if (sertype == nullptr)
+      throw std::runtime_error("Cyclone DDS: could not obtain the sertype of " + spec.topic_name);
     sertypes_.emplace(spec.topic_name, sertype);
     return sertype;
   }
@@ -353,7 +377,8 @@ class CycloneParticipant final : public ParticipantBackend {
 
 }  // namespace
 
-std::unique_ptr<ParticipantBackend> make_cyclone_backend(const TransportConfig& config, EventLog& events) {
+std::unique_ptr<ParticipantBackend> make_cyclone_backend(const TransportConfig& config,
+                                                         EventLog& events) {
   return std::make_unique<CycloneParticipant>(config, events);
 }
 

@@ -1,5 +1,7 @@
 // Fast DDS 2.9 backend: the fastddsgen TopicDataTypes go straight to the
 // vendor; listeners turn its statuses into TransportEvents.
+#include <atomic>
+#include <cstdlib>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -11,9 +13,6 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-
-#include <atomic>
-#include <cstdlib>
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -34,15 +33,18 @@ constexpr std::uint32_t kPreallocateLimitBytes = 64 * 1024;
 
 Duration_t to_duration(std::chrono::nanoseconds d) {
   const auto ns = d.count();
-  return Duration_t(static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000));
+  return Duration_t(static_cast<std::int32_t>(ns / 1'000'000'000),
+                    static_cast<std::uint32_t>(ns % 1'000'000'000));
 }
 
 template <class Qos>
 void apply_profile(const QosProfile& profile, std::uint32_t max_sample_bytes, Qos& qos) {
-  qos.reliability().kind = profile.reliability == Reliability::kReliable ? dds::RELIABLE_RELIABILITY_QOS
-                                                                          : dds::BEST_EFFORT_RELIABILITY_QOS;
-  qos.durability().kind = profile.durability == Durability::kTransientLocal ? dds::TRANSIENT_LOCAL_DURABILITY_QOS
-                                                                             : dds::VOLATILE_DURABILITY_QOS;
+  qos.reliability().kind = profile.reliability == Reliability::kReliable
+                               ? dds::RELIABLE_RELIABILITY_QOS
+                               : dds::BEST_EFFORT_RELIABILITY_QOS;
+  qos.durability().kind = profile.durability == Durability::kTransientLocal
+                              ? dds::TRANSIENT_LOCAL_DURABILITY_QOS
+                              : dds::VOLATILE_DURABILITY_QOS;
   if (profile.history_depth == 0) {
     qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
   } else {
@@ -66,7 +68,8 @@ void apply_profile(const QosProfile& profile, std::uint32_t max_sample_bytes, Qo
   }
 }
 
-TransportEvent make_event(EventKind kind, std::string_view topic, std::int32_t total, std::int32_t change) {
+TransportEvent make_event(EventKind kind, std::string_view topic, std::int32_t total,
+                          std::int32_t change) {
   TransportEvent event;
   event.time_ns = wall_now_ns();
   event.kind = kind;
@@ -78,8 +81,8 @@ TransportEvent make_event(EventKind kind, std::string_view topic, std::int32_t t
 
 class FastWriter final : public WriterBackend, private dds::DataWriterListener {
  public:
-  FastWriter(dds::Publisher& publisher, dds::Topic& topic, const QosProfile& profile, std::uint32_t max_bytes,
-             EventLog& events)
+  FastWriter(dds::Publisher& publisher, dds::Topic& topic, const QosProfile& profile,
+             std::uint32_t max_bytes, EventLog& events)
       : publisher_(publisher), topic_name_(topic.get_name()), events_(events) {
     dds::DataWriterQos qos = publisher.get_default_datawriter_qos();
     apply_profile(profile, max_bytes, qos);
@@ -92,9 +95,11 @@ class FastWriter final : public WriterBackend, private dds::DataWriterListener {
   }
 
   bool write(const void* sample, std::int64_t source_time_ns) override {
-    const eprosima::fastrtps::Time_t stamp(static_cast<std::int32_t>(source_time_ns / 1'000'000'000),
-                                           static_cast<std::uint32_t>(source_time_ns % 1'000'000'000));
-    return writer_->write_w_timestamp(const_cast<void*>(sample), dds::HANDLE_NIL, stamp) == ReturnCode_t::RETCODE_OK;
+    const eprosima::fastrtps::Time_t stamp(
+        static_cast<std::int32_t>(source_time_ns / 1'000'000'000),
+        static_cast<std::uint32_t>(source_time_ns % 1'000'000'000));
+    return writer_->write_w_timestamp(const_cast<void*>(sample), dds::HANDLE_NIL, stamp) ==
+           ReturnCode_t::RETCODE_OK;
   }
   void assert_liveliness() override { writer_->assert_liveliness(); }
   int matched_readers() const override { return matched_.load(); }
@@ -102,18 +107,24 @@ class FastWriter final : public WriterBackend, private dds::DataWriterListener {
  private:
   void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& s) override {
     matched_.store(s.current_count);
-    auto event = make_event(EventKind::kPublicationMatched, topic_name_, s.total_count, s.current_count_change);
+    auto event = make_event(EventKind::kPublicationMatched, topic_name_, s.total_count,
+                            s.current_count_change);
     event.current_count = s.current_count;
     events_.record(event);
   }
-  void on_offered_deadline_missed(dds::DataWriter*, const dds::OfferedDeadlineMissedStatus& s) override {
-    events_.record(make_event(EventKind::kOfferedDeadlineMissed, topic_name_, s.total_count, s.total_count_change));
+  void on_offered_deadline_missed(dds::DataWriter*,
+                                  const dds::OfferedDeadlineMissedStatus& s) override {
+    events_.record(make_event(EventKind::kOfferedDeadlineMissed, topic_name_, s.total_count,
+                              s.total_count_change));
   }
-  void on_offered_incompatible_qos(dds::DataWriter*, const dds::OfferedIncompatibleQosStatus& s) override {
-    events_.record(make_event(EventKind::kOfferedIncompatibleQos, topic_name_, s.total_count, s.total_count_change));
+  void on_offered_incompatible_qos(dds::DataWriter*,
+                                   const dds::OfferedIncompatibleQosStatus& s) override {
+    events_.record(make_event(EventKind::kOfferedIncompatibleQos, topic_name_, s.total_count,
+                              s.total_count_change));
   }
   void on_liveliness_lost(dds::DataWriter*, const dds::LivelinessLostStatus& s) override {
-    events_.record(make_event(EventKind::kLivelinessLost, topic_name_, s.total_count, s.total_count_change));
+    events_.record(
+        make_event(EventKind::kLivelinessLost, topic_name_, s.total_count, s.total_count_change));
   }
 
   dds::Publisher& publisher_;
@@ -125,9 +136,13 @@ class FastWriter final : public WriterBackend, private dds::DataWriterListener {
 
 class FastReader final : public ReaderBackend, private dds::DataReaderListener {
  public:
-  FastReader(dds::Subscriber& subscriber, dds::Topic& topic, const TypeSupport& type, const QosProfile& profile,
-             std::uint32_t max_bytes, SampleSink* sink, EventLog& events)
-      : subscriber_(subscriber), topic_name_(topic.get_name()), type_(type), sink_(sink), events_(events),
+  FastReader(dds::Subscriber& subscriber, dds::Topic& topic, const TypeSupport& type,
+             const QosProfile& profile, std::uint32_t max_bytes, SampleSink* sink, EventLog& events)
+      : subscriber_(subscriber),
+        topic_name_(topic.get_name()),
+        type_(type),
+        sink_(sink),
+        events_(events),
         scratch_(type.new_sample()) {
     dds::DataReaderQos qos = subscriber.get_default_datareader_qos();
     apply_profile(profile, max_bytes, qos);
@@ -150,27 +165,35 @@ class FastReader final : public ReaderBackend, private dds::DataReaderListener {
   }
   void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& s) override {
     matched_.store(s.current_count);
-    auto event = make_event(EventKind::kSubscriptionMatched, topic_name_, s.total_count, s.current_count_change);
+    auto event = make_event(EventKind::kSubscriptionMatched, topic_name_, s.total_count,
+                            s.current_count_change);
     event.current_count = s.current_count;
     events_.record(event);
   }
-  void on_requested_deadline_missed(dds::DataReader*, const dds::RequestedDeadlineMissedStatus& s) override {
-    events_.record(make_event(EventKind::kRequestedDeadlineMissed, topic_name_, s.total_count, s.total_count_change));
+  void on_requested_deadline_missed(dds::DataReader*,
+                                    const dds::RequestedDeadlineMissedStatus& s) override {
+    events_.record(make_event(EventKind::kRequestedDeadlineMissed, topic_name_, s.total_count,
+                              s.total_count_change));
   }
   void on_liveliness_changed(dds::DataReader*, const dds::LivelinessChangedStatus& s) override {
-    auto event = make_event(EventKind::kLivelinessChanged, topic_name_, s.alive_count + s.not_alive_count, 1);
+    auto event = make_event(EventKind::kLivelinessChanged, topic_name_,
+                            s.alive_count + s.not_alive_count, 1);
     event.current_count = s.alive_count;
     event.not_alive_count = s.not_alive_count;
     events_.record(event);
   }
   void on_sample_rejected(dds::DataReader*, const dds::SampleRejectedStatus& s) override {
-    events_.record(make_event(EventKind::kSampleRejected, topic_name_, s.total_count, s.total_count_change));
+    events_.record(
+        make_event(EventKind::kSampleRejected, topic_name_, s.total_count, s.total_count_change));
   }
-  void on_requested_incompatible_qos(dds::DataReader*, const dds::RequestedIncompatibleQosStatus& s) override {
-    events_.record(make_event(EventKind::kRequestedIncompatibleQos, topic_name_, s.total_count, s.total_count_change));
+  void on_requested_incompatible_qos(dds::DataReader*,
+                                     const dds::RequestedIncompatibleQosStatus& s) override {
+    events_.record(make_event(EventKind::kRequestedIncompatibleQos, topic_name_, s.total_count,
+                              s.total_count_change));
   }
   void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& s) override {
-    events_.record(make_event(EventKind::kSampleLost, topic_name_, s.total_count, s.total_count_change));
+    events_.record(
+        make_event(EventKind::kSampleLost, topic_name_, s.total_count, s.total_count_change));
   }
 
   dds::Subscriber& subscriber_;
@@ -198,7 +221,8 @@ class FastParticipant final : public ParticipantBackend {
       }
     }
     if (!profile.empty() && factory->load_XML_profiles_file(profile) != ReturnCode_t::RETCODE_OK) {
-      throw ConfigError("DDS profile '" + profile + "': Fast DDS could not parse it (malformed XML profile)");
+      throw ConfigError("DDS profile '" + profile +
+                        "': Fast DDS could not parse it (malformed XML profile)");
     }
     // The factory's default QoS carries an XML default profile, if any.
     dds::DomainParticipantQos qos = factory->get_default_participant_qos();
@@ -228,9 +252,11 @@ class FastParticipant final : public ParticipantBackend {
     return std::make_unique<FastWriter>(*publisher_, *topic, spec.qos, max_bytes, events_);
   }
 
-  std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec, SampleSink* sink) override {
+  std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec,
+                                               SampleSink* sink) override {
     auto [topic, max_bytes] = topic_for(spec);
-    return std::make_unique<FastReader>(*subscriber_, *topic, *spec.type, spec.qos, max_bytes, sink, events_);
+    return std::make_unique<FastReader>(*subscriber_, *topic, *spec.type, spec.qos, max_bytes, sink,
+                                        events_);
   }
 
  private:
@@ -246,7 +272,8 @@ class FastParticipant final : public ParticipantBackend {
     }
     auto topic_it = topics_.find(spec.topic_name);
     if (topic_it == topics_.end()) {
-      dds::Topic* topic = participant_->create_topic(spec.topic_name, spec.type->type_name, dds::TOPIC_QOS_DEFAULT);
+      dds::Topic* topic =
+          participant_->create_topic(spec.topic_name, spec.type->type_name, dds::TOPIC_QOS_DEFAULT);
       if (topic == nullptr) throw std::runtime_error("Fast DDS refused topic " + spec.topic_name);
       topic_it = topics_.emplace(spec.topic_name, topic).first;
     }
@@ -264,7 +291,8 @@ class FastParticipant final : public ParticipantBackend {
 
 }  // namespace
 
-std::unique_ptr<ParticipantBackend> make_fast_backend(const TransportConfig& config, EventLog& events) {
+std::unique_ptr<ParticipantBackend> make_fast_backend(const TransportConfig& config,
+                                                      EventLog& events) {
   return std::make_unique<FastParticipant>(config, events);
 }
 

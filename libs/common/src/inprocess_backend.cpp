@@ -40,7 +40,8 @@ class Bus {
     static Bus bus;
     return bus;
   }
-  std::shared_ptr<BusTopic> topic(std::uint32_t domain, const std::string& partition, const std::string& name) {
+  std::shared_ptr<BusTopic> topic(std::uint32_t domain, const std::string& partition,
+                                  const std::string& name) {
     std::lock_guard lock(mutex_);
     auto& slot = topics_[Key{domain, partition, name}];
     if (!slot) slot = std::make_shared<BusTopic>();
@@ -53,7 +54,8 @@ class Bus {
     std::string partition;
     std::string name;
     bool operator<(const Key& other) const {
-      return std::tie(domain, partition, name) < std::tie(other.domain, other.partition, other.name);
+      return std::tie(domain, partition, name) <
+             std::tie(other.domain, other.partition, other.name);
     }
   };
   std::mutex mutex_;
@@ -61,8 +63,12 @@ class Bus {
 };
 
 bool compatible(const QosProfile& writer, const QosProfile& reader) {
-  if (reader.reliability == Reliability::kReliable && writer.reliability == Reliability::kBestEffort) return false;
-  if (reader.durability == Durability::kTransientLocal && writer.durability == Durability::kVolatile) return false;
+  if (reader.reliability == Reliability::kReliable &&
+      writer.reliability == Reliability::kBestEffort)
+    return false;
+  if (reader.durability == Durability::kTransientLocal &&
+      writer.durability == Durability::kVolatile)
+    return false;
   return true;
 }
 
@@ -78,7 +84,11 @@ void record_match(EventLog& events, EventKind kind, const std::string& topic, in
 class InProcessWriter final : public WriterBackend {
  public:
   InProcessWriter(std::shared_ptr<BusTopic> topic, const EndpointSpec& spec, EventLog& events)
-      : topic_(std::move(topic)), type_(*spec.type), qos_(spec.qos), name_(spec.topic_name), events_(events) {
+      : topic_(std::move(topic)),
+        type_(*spec.type),
+        qos_(spec.qos),
+        name_(spec.topic_name),
+        events_(events) {
     if (qos_.durability == Durability::kTransientLocal) latched_ = type_.new_sample();
     std::unique_lock lock(topic_->mutex);
     topic_->writers.push_back(this);
@@ -141,7 +151,8 @@ class InProcessWriter final : public WriterBackend {
 
 class InProcessReader final : public ReaderBackend {
  public:
-  InProcessReader(std::shared_ptr<BusTopic> topic, const EndpointSpec& spec, SampleSink* sink, EventLog& events)
+  InProcessReader(std::shared_ptr<BusTopic> topic, const EndpointSpec& spec, SampleSink* sink,
+                  EventLog& events)
       : topic_(std::move(topic)), entry_{sink, spec.qos, &events} {
     std::unique_lock lock(topic_->mutex);
     topic_->readers.push_back(&entry_);
@@ -154,8 +165,9 @@ class InProcessReader final : public ReaderBackend {
   }
   int matched_writers() const override {
     std::shared_lock lock(topic_->mutex);
-    return static_cast<int>(std::count_if(topic_->writers.begin(), topic_->writers.end(),
-                                          [&](const auto* w) { return compatible(w->qos(), entry_.qos); }));
+    return static_cast<int>(
+        std::count_if(topic_->writers.begin(), topic_->writers.end(),
+                      [&](const auto* w) { return compatible(w->qos(), entry_.qos); }));
   }
 
  private:
@@ -165,12 +177,14 @@ class InProcessReader final : public ReaderBackend {
 
 class InProcessParticipant final : public ParticipantBackend {
  public:
-  InProcessParticipant(const TransportConfig& config, EventLog& events) : config_(config), events_(events) {}
+  InProcessParticipant(const TransportConfig& config, EventLog& events)
+      : config_(config), events_(events) {}
 
   std::unique_ptr<WriterBackend> create_writer(const EndpointSpec& spec) override {
     return std::make_unique<InProcessWriter>(topic(spec), spec, events_);
   }
-  std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec, SampleSink* sink) override {
+  std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec,
+                                               SampleSink* sink) override {
     return std::make_unique<InProcessReader>(topic(spec), spec, sink, events_);
   }
 
@@ -184,7 +198,8 @@ class InProcessParticipant final : public ParticipantBackend {
 
 }  // namespace
 
-std::unique_ptr<ParticipantBackend> make_inprocess_backend(const TransportConfig& config, EventLog& events) {
+std::unique_ptr<ParticipantBackend> make_inprocess_backend(const TransportConfig& config,
+                                                           EventLog& events) {
   return std::make_unique<InProcessParticipant>(config, events);
 }
 

@@ -15,7 +15,8 @@
 
 namespace fahr::common {
 
-std::optional<std::uint64_t> producer_step_for(std::uint64_t consumer_step, std::uint64_t producer_period) {
+std::optional<std::uint64_t> producer_step_for(std::uint64_t consumer_step,
+                                               std::uint64_t producer_period) {
   if (consumer_step == 0 || producer_period == 0) return std::nullopt;
   return (consumer_step - 1) / producer_period * producer_period;
 }
@@ -61,7 +62,8 @@ QosProfile ack_qos() {
 }
 }  // namespace
 
-LockstepCoordinator::LockstepCoordinator(Participant& participant, std::chrono::nanoseconds base_period)
+LockstepCoordinator::LockstepCoordinator(Participant& participant,
+                                         std::chrono::nanoseconds base_period)
     : base_period_(base_period),
       clock_(participant),
       acks_(participant, ack_qos(), TopicTraits<msg::StepAck>::kName,
@@ -105,7 +107,8 @@ LockstepCoordinator::Result LockstepCoordinator::run(const std::vector<std::stri
     lock.unlock();
     grant(step, false);
     lock.lock();
-    if (!changed_.wait_for(lock, stall_timeout, [&] { return all_through(static_cast<std::int64_t>(step)); })) {
+    if (!changed_.wait_for(lock, stall_timeout,
+                           [&] { return all_through(static_cast<std::int64_t>(step)); })) {
       result.steps = step;
       return result;
     }
@@ -122,7 +125,8 @@ LockstepClient::LockstepClient(Participant& participant, std::string name)
     : name_(std::move(name)),
       id_(participant.writer_id()),
       acks_(participant, ack_qos()),
-      clock_(participant, QosProfile::for_role(TopicRole::kLockstep), TopicTraits<msg::SimClock>::kName,
+      clock_(participant, QosProfile::for_role(TopicRole::kLockstep),
+             TopicTraits<msg::SimClock>::kName,
              [this](const msg::SimClock& clock, const SampleInfo&) { on_clock(clock); }) {}
 
 void LockstepClient::on_clock(const msg::SimClock& clock) {
@@ -134,7 +138,9 @@ void LockstepClient::on_clock(const msg::SimClock& clock) {
   changed_.notify_all();
 }
 
-void LockstepClient::join() { complete_through(static_cast<std::uint64_t>(-1), 0); }
+void LockstepClient::join() {
+  complete_through(static_cast<std::uint64_t>(-1), 0);
+}
 
 bool LockstepClient::wait_for_grant(std::uint64_t step, std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);

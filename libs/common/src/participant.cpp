@@ -28,9 +28,15 @@ Participant::Participant(const TransportConfig& config)
     : config_(config), writer_id_(random_writer_id()), events_(std::make_unique<EventLog>()) {
   validate(config_);
   switch (config_.vendor) {
-    case Vendor::kFastDds: backend_ = detail::make_fast_backend(config_, *events_); break;
-    case Vendor::kCyclone: backend_ = detail::make_cyclone_backend(config_, *events_); break;
-    case Vendor::kInProcess: backend_ = detail::make_inprocess_backend(config_, *events_); break;
+    case Vendor::kFastDds:
+      backend_ = detail::make_fast_backend(config_, *events_);
+      break;
+    case Vendor::kCyclone:
+      backend_ = detail::make_cyclone_backend(config_, *events_);
+      break;
+    case Vendor::kInProcess:
+      backend_ = detail::make_inprocess_backend(config_, *events_);
+      break;
   }
 }
 
@@ -44,5 +50,7 @@ Participant::~Participant() = default;
 // RTPSReader::~RTPSReader): AddressSanitizer's new-delete-type-mismatch
 // fires inside the vendor at every participant deletion. The check stays on
 // for everything else.
-extern "C" const char* __asan_default_options() { return "new_delete_type_mismatch=0"; }
+extern "C" const char* __asan_default_options() {
+  return "new_delete_type_mismatch=0";
+}
 #endif

@@ -44,11 +44,16 @@ QosProfile QosProfile::for_role(TopicRole role) {
 
 std::string_view topic_role_name(TopicRole role) {
   switch (role) {
-    case TopicRole::kServoStream: return "servo_stream";
-    case TopicRole::kStateStream: return "state_stream";
-    case TopicRole::kLatched: return "latched";
-    case TopicRole::kReport: return "report";
-    case TopicRole::kLockstep: return "lockstep";
+    case TopicRole::kServoStream:
+      return "servo_stream";
+    case TopicRole::kStateStream:
+      return "state_stream";
+    case TopicRole::kLatched:
+      return "latched";
+    case TopicRole::kReport:
+      return "report";
+    case TopicRole::kLockstep:
+      return "lockstep";
   }
   return "unknown";
 }

@@ -12,8 +12,8 @@ std::string request_realtime_priority(int priority) {
   const int lowest = sched_get_priority_min(SCHED_FIFO);
   const int highest = sched_get_priority_max(SCHED_FIFO);
   if (priority < lowest || priority > highest) {
-    return "priority " + std::to_string(priority) + " is outside SCHED_FIFO's [" + std::to_string(lowest) + ", " +
-           std::to_string(highest) + "]";
+    return "priority " + std::to_string(priority) + " is outside SCHED_FIFO's [" +
+           std::to_string(lowest) + ", " + std::to_string(highest) + "]";
   }
   sched_param param{};
   param.sched_priority = priority;

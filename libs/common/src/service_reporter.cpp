@@ -14,7 +14,9 @@ msg::DurationStats duration_stats(std::vector<std::int64_t>& values_ns) {
   msg::DurationStats stats;
   if (values_ns.empty()) return stats;
   std::sort(values_ns.begin(), values_ns.end());
-  auto at = [&](double q) { return values_ns[static_cast<std::size_t>(q * static_cast<double>(values_ns.size() - 1))]; };
+  auto at = [&](double q) {
+    return values_ns[static_cast<std::size_t>(q * static_cast<double>(values_ns.size() - 1))];
+  };
   stats.count(values_ns.size());
   stats.mean_ns(std::accumulate(values_ns.begin(), values_ns.end(), std::int64_t{0}) /
                 static_cast<std::int64_t>(values_ns.size()));
@@ -31,7 +33,9 @@ constexpr std::size_t kMaxSpansPerReport = 1024;
 constexpr std::size_t kMaxQosEventsPerReport = 128;
 constexpr std::size_t kMaxMetrics = 32;
 
-msg::QosEventKind to_msg(EventKind kind) { return static_cast<msg::QosEventKind>(static_cast<int>(kind)); }
+msg::QosEventKind to_msg(EventKind kind) {
+  return static_cast<msg::QosEventKind>(static_cast<int>(kind));
+}
 
 std::string host_name() {
   char name[256] = {};
@@ -40,8 +44,8 @@ std::string host_name() {
 }
 }  // namespace
 
-ServiceReporter::ServiceReporter(Participant& participant, ReporterSettings settings, TickRecorder& ticks,
-                                 MetricsSource metrics)
+ServiceReporter::ServiceReporter(Participant& participant, ReporterSettings settings,
+                                 TickRecorder& ticks, MetricsSource metrics)
     : participant_(participant),
       settings_(std::move(settings)),
       recorder_(ticks),
@@ -137,21 +141,22 @@ void ServiceReporter::report() {
   events.service_id(participant_.writer_id());
   events.service_name(settings_.service_name);
   std::uint32_t dropped_events = 0;
-  dropped_events += static_cast<std::uint32_t>(participant_.events().drain([&](const TransportEvent& e) {
-    if (events.qos_events().size() >= kMaxQosEventsPerReport) {
-      ++dropped_events;
-      return;
-    }
-    msg::QosEvent q;
-    q.time_ns(e.time_ns);
-    q.kind(to_msg(e.kind));
-    q.topic(std::string(e.topic_name()));
-    q.total_count(e.total_count);
-    q.total_count_change(e.total_count_change);
-    q.current_count(e.current_count);
-    q.not_alive_count(e.not_alive_count);
-    events.qos_events().push_back(q);
-  }));
+  dropped_events +=
+      static_cast<std::uint32_t>(participant_.events().drain([&](const TransportEvent& e) {
+        if (events.qos_events().size() >= kMaxQosEventsPerReport) {
+          ++dropped_events;
+          return;
+        }
+        msg::QosEvent q;
+        q.time_ns(e.time_ns);
+        q.kind(to_msg(e.kind));
+        q.topic(std::string(e.topic_name()));
+        q.total_count(e.total_count);
+        q.total_count_change(e.total_count_change);
+        q.current_count(e.current_count);
+        q.not_alive_count(e.not_alive_count);
+        events.qos_events().push_back(q);
+      }));
   events.dropped_events(dropped_events);
   events.dropped_spans(dropped_spans);
   events.tick_spans(spans_);

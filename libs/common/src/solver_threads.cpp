@@ -12,15 +12,18 @@ namespace fahr::common {
 
 void run_solver_libraries_on_one_thread(char** argv) {
   const char* choice = std::getenv("FAHR_SOLVER_THREADS");
-  if (std::getenv("OMP_THREAD_LIMIT") != nullptr || (choice != nullptr && std::strcmp(choice, "any") == 0)) return;
+  if (std::getenv("OMP_THREAD_LIMIT") != nullptr ||
+      (choice != nullptr && std::strcmp(choice, "any") == 0))
+    return;
   // The program's own path, not /proc/self/exe: exec'ing that link would
   // rename the process "exe" for ps, pgrep and killall.
   char path[PATH_MAX];
   const ssize_t length = readlink("/proc/self/exe", path, sizeof(path) - 1);
   // FAHR_SOLVER_THREADS=any in the child as well: should the environment
   // not take the limits, the child runs as is instead of re-executing again.
-  if (length <= 0 || setenv("OMP_THREAD_LIMIT", "1", 1) != 0 || setenv("OMP_WAIT_POLICY", "passive", 1) != 0 ||
-      setenv("OPENBLAS_NUM_THREADS", "1", 1) != 0 || setenv("FAHR_SOLVER_THREADS", "any", 1) != 0) {
+  if (length <= 0 || setenv("OMP_THREAD_LIMIT", "1", 1) != 0 ||
+      setenv("OMP_WAIT_POLICY", "passive", 1) != 0 || setenv("OPENBLAS_NUM_THREADS", "1", 1) != 0 ||
+      setenv("FAHR_SOLVER_THREADS", "any", 1) != 0) {
     std::fprintf(stderr, "fahr: cannot hold the solver libraries to one thread; running as is\n");
     return;
   }

@@ -6,7 +6,9 @@
 namespace fahr::common {
 namespace {
 volatile std::sig_atomic_t g_stop_requested = 0;
-extern "C" void on_stop_signal(int) { g_stop_requested = 1; }
+extern "C" void on_stop_signal(int) {
+  g_stop_requested = 1;
+}
 }  // namespace
 
 void install_stop_handlers() {
@@ -14,6 +16,8 @@ void install_stop_handlers() {
   std::signal(SIGTERM, on_stop_signal);
 }
 
-bool stop_requested() { return g_stop_requested != 0; }
+bool stop_requested() {
+  return g_stop_requested != 0;
+}
 
 }  // namespace fahr::common

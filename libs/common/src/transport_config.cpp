@@ -21,11 +21,12 @@ std::uint32_t parse_domain(std::string_view text, std::string_view source) {
   const auto* end = text.data() + text.size();
   const auto result = std::from_chars(text.data(), end, value);
   if (result.ec != std::errc() || result.ptr != end) {
-    throw ConfigError(std::string(source) + ": domain id '" + std::string(text) + "' is not an integer");
+    throw ConfigError(std::string(source) + ": domain id '" + std::string(text) +
+                      "' is not an integer");
   }
   if (value < 0 || value > kMaxDomainId) {
-    throw ConfigError(std::string(source) + ": domain id " + std::to_string(value) + " is out of range [0, " +
-                      std::to_string(kMaxDomainId) + "]");
+    throw ConfigError(std::string(source) + ": domain id " + std::to_string(value) +
+                      " is out of range [0, " + std::to_string(kMaxDomainId) + "]");
   }
   return static_cast<std::uint32_t>(value);
 }
@@ -39,19 +40,23 @@ void validate(const TransportConfig& config) {
   }
   if (config.profile_file.empty()) return;
   std::ifstream in(config.profile_file);
-  if (!in) throw ConfigError("DDS profile '" + config.profile_file + "': cannot be read (missing file?)");
+  if (!in)
+    throw ConfigError("DDS profile '" + config.profile_file + "': cannot be read (missing file?)");
   std::stringstream text;
   text << in.rdbuf();
   const std::string xml = text.str();
   const bool cyclone_xml = xml.find("<CycloneDDS") != std::string::npos;
-  const bool fast_xml = xml.find("<profiles") != std::string::npos || xml.find("<dds") != std::string::npos;
+  const bool fast_xml =
+      xml.find("<profiles") != std::string::npos || xml.find("<dds") != std::string::npos;
   if (config.vendor == Vendor::kCyclone && !cyclone_xml) {
-    throw ConfigError("DDS profile '" + config.profile_file +
-                      "': not a Cyclone DDS configuration (no <CycloneDDS> element) but vendor is cyclonedds");
+    throw ConfigError(
+        "DDS profile '" + config.profile_file +
+        "': not a Cyclone DDS configuration (no <CycloneDDS> element) but vendor is cyclonedds");
   }
   if (config.vendor == Vendor::kFastDds && !fast_xml) {
-    throw ConfigError("DDS profile '" + config.profile_file +
-                      "': not a Fast DDS profile file (no <profiles> or <dds> element) but vendor is fastdds");
+    throw ConfigError(
+        "DDS profile '" + config.profile_file +
+        "': not a Fast DDS profile file (no <profiles> or <dds> element) but vendor is fastdds");
   }
 }
 
@@ -65,7 +70,8 @@ TransportConfig transport_config_from(std::string_view vendor_flag, std::string_
   } else if (auto env = env_or_empty("FAHR_DOMAIN_ID"); !env.empty()) {
     config.domain_id = parse_domain(env, "FAHR_DOMAIN_ID");
   }
-  config.profile_file = profile_flag.empty() ? env_or_empty("FAHR_DDS_PROFILE") : std::string(profile_flag);
+  config.profile_file =
+      profile_flag.empty() ? env_or_empty("FAHR_DDS_PROFILE") : std::string(profile_flag);
   validate(config);
   return config;
 }

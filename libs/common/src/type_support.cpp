@@ -39,18 +39,20 @@ TypeSupport make_support(const char* name, const dds_topic_descriptor_t& descrip
       &descriptor,
       []() -> void* { return new T(); },
       [](void* sample) { delete static_cast<T*>(sample); },
-      [](void* destination, const void* source) { *static_cast<T*>(destination) = *static_cast<const T*>(source); },
+      [](void* destination, const void* source) {
+        *static_cast<T*>(destination) = *static_cast<const T*>(source);
+      },
   };
 }
 
 }  // namespace
 
-#define FAHR_TYPE_SUPPORT(Type)                                                                        \
-  template <>                                                                                         \
-  const TypeSupport& type_support<msg::Type>() {                                                      \
-    static const TypeSupport support =                                                                \
-        make_support<msg::Type, msg::Type##PubSubType>("fahr::msg::" #Type, fahr_msg_##Type##_desc); \
-    return support;                                                                                   \
+#define FAHR_TYPE_SUPPORT(Type)                                                        \
+  template <>                                                                          \
+  const TypeSupport& type_support<msg::Type>() {                                       \
+    static const TypeSupport support = make_support<msg::Type, msg::Type##PubSubType>( \
+        "fahr::msg::" #Type, fahr_msg_##Type##_desc);                                  \
+    return support;                                                                    \
   }
 
 FAHR_TYPE_SUPPORT(DevicePose)

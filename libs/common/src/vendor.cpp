@@ -9,9 +9,12 @@ namespace fahr::common {
 
 std::string_view vendor_name(Vendor vendor) {
   switch (vendor) {
-    case Vendor::kFastDds: return "fastdds";
-    case Vendor::kCyclone: return "cyclonedds";
-    case Vendor::kInProcess: return "inprocess";
+    case Vendor::kFastDds:
+      return "fastdds";
+    case Vendor::kCyclone:
+      return "cyclonedds";
+    case Vendor::kInProcess:
+      return "inprocess";
   }
   return "unknown";
 }
@@ -23,7 +26,9 @@ std::optional<Vendor> parse_vendor(std::string_view name) {
   return std::nullopt;
 }
 
-std::string valid_vendor_names() { return "fastdds, cyclonedds, inprocess"; }
+std::string valid_vendor_names() {
+  return "fastdds, cyclonedds, inprocess";
+}
 
 Vendor resolve_vendor(std::string_view flag_value, Vendor fallback) {
   std::string_view source = "--dds";

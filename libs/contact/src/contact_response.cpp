@@ -48,7 +48,8 @@ ContactResponse::ContactResponse(const ResponseSettings& settings)
   if (settings_.mode == ResponseMode::kNaive) settings_.force_aware.enabled = false;
 }
 
-void ContactResponse::reset(const Eigen::Vector3d& position_m, const Eigen::Quaterniond& orientation) {
+void ContactResponse::reset(const Eigen::Vector3d& position_m,
+                            const Eigen::Quaterniond& orientation) {
   proxy_ = ToolProxy{position_m, orientation, Eigen::Vector3d::Zero()};
   state_ = TrackingState::kTracking;
   previous_reaction_n_ = 0.0;
@@ -75,13 +76,15 @@ void ContactResponse::capture_holds(const TissueCompliance& compliance) {
   report_.holds_overflow = false;
   for (std::size_t i = 0; i < solver_.size(); ++i) {
     const ContactRow& row = solver_.row(i);
-    if (row.kind != RowKind::kTissue || !(solver_.lambda(i) > 0.0 || solver_.penetration(i) > 0.0)) continue;
+    if (row.kind != RowKind::kTissue || !(solver_.lambda(i) > 0.0 || solver_.penetration(i) > 0.0))
+      continue;
     if (hold_count_ == holds_.size()) {
       report_.holds_overflow = true;
       break;
     }
-    holds_[hold_count_++] = Hold{row.id, row.other_point_m + solver_.predicted_motion(i, compliance),
-                                 row.tool_point_m, row.normal};
+    holds_[hold_count_++] =
+        Hold{row.id, row.other_point_m + solver_.predicted_motion(i, compliance), row.tool_point_m,
+             row.normal};
   }
 }
 
@@ -120,7 +123,7 @@ Eigen::Vector3d ContactResponse::yield_to_limit(const Eigen::Vector3d& offset_m,
   double hi = kMaxYieldStepM;
   double f_hi = excess(hi);
   if (f_hi > 0.0) return offset_m + hi * out;  // the most one tick allows
-  int stale_side = 0;  // Illinois: halve the value kept twice in a row
+  int stale_side = 0;                          // Illinois: halve the value kept twice in a row
   for (int iteration = 0; iteration < kMaxYieldIterations; ++iteration) {
     const double s = hi - f_hi * (hi - lo) / (f_hi - f_lo);
     const double f = excess(s);
@@ -146,16 +149,19 @@ Eigen::Vector3d ContactResponse::yield_to_limit(const Eigen::Vector3d& offset_m,
 // than the hand's pull plus the deepest row plus a margin: no equilibrium
 // lies beyond that, so an unconverged or infeasible solve (the tool pinched
 // between bone and tissue) produced it.
-bool ContactResponse::plausible_step(const Eigen::Vector3d& step_m, const Eigen::Vector3d& target_offset_m) const {
+bool ContactResponse::plausible_step(const Eigen::Vector3d& step_m,
+                                     const Eigen::Vector3d& target_offset_m) const {
   double deepest = 0.0;
-  for (std::size_t i = 0; i < solver_.size(); ++i) deepest = std::max(deepest, solver_.penetration(i));
+  for (std::size_t i = 0; i < solver_.size(); ++i)
+    deepest = std::max(deepest, solver_.penetration(i));
   return step_m.allFinite() && step_m.norm() <= target_offset_m.norm() + deepest + kYieldCapMarginM;
 }
 
 // A catch-up step toward `toward` (the coupled equilibrium's offset): at
 // most max_step long, and differing from the proxy's last step by at most
 // the catch-up acceleration times dt^2.
-Eigen::Vector3d ContactResponse::catch_up_step(const Eigen::Vector3d& toward, double max_step, double dt_s) const {
+Eigen::Vector3d ContactResponse::catch_up_step(const Eigen::Vector3d& toward, double max_step,
+                                               double dt_s) const {
   const Eigen::Vector3d last = proxy_.velocity_mps * dt_s;
   Eigen::Vector3d turn = toward * (max_step / toward.norm()) - last;
   const double max_turn = settings_.force_aware.catch_up_acceleration_mps2 * dt_s * dt_s;
@@ -165,7 +171,8 @@ Eigen::Vector3d ContactResponse::catch_up_step(const Eigen::Vector3d& toward, do
   return step;
 }
 
-Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const EffectiveCoupling& coupling) {
+Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input,
+                                            const EffectiveCoupling& coupling) {
   const DeviceSample& device = input.device;
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   const double limit = device.renderable_force_n;
@@ -176,7 +183,8 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
   // it, and one that presses past the limit again while the proxy catches up
   // holds it again. No solve decides it, so the state does not flicker with
   // the rows or with a tissue still relaxing under the released tool.
-  const double pull = coupling.stiffness_npm * (device.position_m - proxy_.position_m).dot(held_push_direction_);
+  const double pull =
+      coupling.stiffness_npm * (device.position_m - proxy_.position_m).dot(held_push_direction_);
   if (state_ == TrackingState::kLostTrack && hold_load) {
     if (!should_release(settings_.force_aware, pull, limit)) {
       solver_.solve_pinned(zero, settings_.pgs);
@@ -190,8 +198,10 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
       // The spring alone cannot tell a hand still pushing in from one that
       // has drawn back out of the tissue (or the mouth): both stretch it.
       // Release when tracking again would load the tissue within the band.
-      solver_.solve_coupled(coupling.effective_stiffness_npm, coupling.target_m - proxy_.position_m, settings_.pgs);
-      release = should_release(settings_.force_aware, solver_.resultant(RowKind::kTissue).norm(), limit);
+      solver_.solve_coupled(coupling.effective_stiffness_npm, coupling.target_m - proxy_.position_m,
+                            settings_.pgs);
+      release =
+          should_release(settings_.force_aware, solver_.resultant(RowKind::kTissue).norm(), limit);
     }
     if (!release) {
       solver_.solve_pinned(zero, settings_.pgs);
@@ -203,7 +213,8 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
     state_ = TrackingState::kCatchingUp;
   }
   const Eigen::Vector3d target_offset = coupling.target_m - proxy_.position_m;
-  Eigen::Vector3d step = solver_.solve_coupled(coupling.effective_stiffness_npm, target_offset, settings_.pgs);
+  Eigen::Vector3d step =
+      solver_.solve_coupled(coupling.effective_stiffness_npm, target_offset, settings_.pgs);
   if (!plausible_step(step, target_offset)) {
     // Hold the tool this tick (the pinned solve is well posed: no coupling
     // term) rather than jump; the next tick's warm start solves from here.
@@ -234,18 +245,21 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input, const Effect
   // if the hand's pull passes the limit again).
   const bool catching_up = state_ == TrackingState::kCatchingUp;
   const bool growing = !catching_up || reaction > previous_reaction_n_;
-  const bool freeze = hold_load && catching_up ? should_freeze(settings_.force_aware, pull, limit)
-                                               : should_freeze(settings_.force_aware, reaction, limit) && growing;
+  const bool freeze = hold_load && catching_up
+                          ? should_freeze(settings_.force_aware, pull, limit)
+                          : should_freeze(settings_.force_aware, reaction, limit) && growing;
   if (freeze) {
     // The proxy stops where it was (the last tick's pose, whose reaction was
     // within the limit) and the loaded spheres are held there.
     state_ = TrackingState::kLostTrack;
     solver_.solve_pinned(zero, settings_.pgs);
     const Eigen::Vector3d push = solver_.resultant(RowKind::kTissue);
-    held_push_direction_ = push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
+    held_push_direction_ =
+        push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
     const HeldProxy held = settings_.force_aware.held_proxy;
-    const Eigen::Vector3d back =
-        held == HeldProxy::kStay || held == HeldProxy::kHoldLoad ? zero : yield_to_limit(zero, limit);
+    const Eigen::Vector3d back = held == HeldProxy::kStay || held == HeldProxy::kHoldLoad
+                                     ? zero
+                                     : yield_to_limit(zero, limit);
     if (!hold_load) capture_holds(input.compliance);  // kHoldLoad holds no sphere
     return back;
   }
@@ -298,7 +312,8 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
     for (std::size_t h = 0; h < hold_count_; ++h) {
       bool listed = false;
       for (std::size_t i = 0; i < solver_.size() && !listed; ++i) {
-        listed = solver_.row(i).kind == RowKind::kTissue && solver_.row(i).id == holds_[h].sphere_id;
+        listed =
+            solver_.row(i).kind == RowKind::kTissue && solver_.row(i).id == holds_[h].sphere_id;
       }
       if (listed) continue;
       fem::Contact c;
@@ -318,12 +333,14 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   report_ = TickReport{};
   solver_.reset_work();
   const Eigen::Vector3d p0 = proxy_.position_m;
-  const EffectiveCoupling coupling = effective_coupling(settings_.coupling, device.max_stiffness_npm, device.dt_s,
-                                                        device.position_m, device.velocity_mps, p0);
+  const EffectiveCoupling coupling =
+      effective_coupling(settings_.coupling, device.max_stiffness_npm, device.dt_s,
+                         device.position_m, device.velocity_mps, p0);
   report_.load = solver_.load(input.rows, input.compliance, settings_.fallback_compliance_mpn);
   if (settings_.mode == ResponseMode::kNaive) solver_.make_rigid();
   Eigen::Vector3d step = move_proxy(input, coupling);
-  if (solver_.has_obstacle_rows() && (state_ != TrackingState::kTracking || report_.implausible_step)) {
+  if (solver_.has_obstacle_rows() &&
+      (state_ != TrackingState::kTracking || report_.implausible_step)) {
     // A held, backing-off or catching-up proxy was placed by the pinned
     // solve, which gives bone no force: keep it out of the bone, and
     // re-solve the tissue where it ends up.
@@ -377,8 +394,9 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
     }
     // kHoldLoad: held, the tissue carries the load alone; catching up, it
     // does once the load had to be scaled.
-    report_.tissue_held_by_load = held == HeldProxy::kHoldLoad &&
-                                  (state_ == TrackingState::kLostTrack || report_.tissue_force_scaled_held);
+    report_.tissue_held_by_load =
+        held == HeldProxy::kHoldLoad &&
+        (state_ == TrackingState::kLostTrack || report_.tissue_force_scaled_held);
   } else if (settings_.mode != ResponseMode::kNaive && held != HeldProxy::kUnclamped &&
              solved_reaction > kWedgeBand * device.renderable_force_n) {
     tissue_force_scale_ = device.renderable_force_n / solved_reaction;
@@ -387,7 +405,8 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   out.tissue_reaction_n = tissue_force_scale_ * solved_reaction;
   report_.obstacle_reaction_n = solver_.resultant(RowKind::kObstacle).norm();
   out.active_contacts = 0;
-  for (std::size_t i = 0; i < solver_.size(); ++i) out.active_contacts += solver_.lambda(i) > 0.0 ? 1u : 0u;
+  for (std::size_t i = 0; i < solver_.size(); ++i)
+    out.active_contacts += solver_.lambda(i) > 0.0 ? 1u : 0u;
   out.fem_step = input.compliance.fem_step;
   report_.pgs_work = solver_.work();
   previous_reaction_n_ = solved_reaction;

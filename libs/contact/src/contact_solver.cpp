@@ -50,13 +50,15 @@ ContactSolver::ContactSolver(std::size_t capacity)
       projection_b_(capacity, 0.0),
       projection_mu_(capacity, 0.0) {}
 
-SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows, const TissueCompliance& compliance,
+SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows,
+                                     const TissueCompliance& compliance,
                                      double fallback_compliance_mpn) {
   SolverLoadReport report;
   k_ = 0;
   const bool have_w = compliance.valid();
   for (const ContactRow& row : rows) {
-    if (std::abs(row.normal.squaredNorm() - 1.0) > kUnitNormalTolerance || !row.normal.allFinite()) {
+    if (std::abs(row.normal.squaredNorm() - 1.0) > kUnitNormalTolerance ||
+        !row.normal.allFinite()) {
       ++report.degenerate_normals;
       continue;
     }
@@ -83,8 +85,9 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows, const Tis
       const ContactRow& rj = rows_[j];
       double value = 0.0;
       if (ri.compliance_index != kNoCompliance && rj.compliance_index != kNoCompliance) {
-        value = compliance.normal_compliance(static_cast<std::size_t>(ri.compliance_index), ri.normal,
-                                             static_cast<std::size_t>(rj.compliance_index), rj.normal);
+        value =
+            compliance.normal_compliance(static_cast<std::size_t>(ri.compliance_index), ri.normal,
+                                         static_cast<std::size_t>(rj.compliance_index), rj.normal);
       } else if (i == j && ri.kind == RowKind::kTissue) {
         value = fallback_compliance_mpn;
         fallback_diagonal_[i] = 1.0;
@@ -114,7 +117,8 @@ void ContactSolver::make_rigid() {
   }
 }
 
-Eigen::Vector3d ContactSolver::solve_coupled(double k_eff_npm, const Eigen::Vector3d& target_offset_m,
+Eigen::Vector3d ContactSolver::solve_coupled(double k_eff_npm,
+                                             const Eigen::Vector3d& target_offset_m,
                                              const PgsSettings& settings) {
   const double inverse_k = 1.0 / k_eff_npm;
   for (std::size_t i = 0; i < k_; ++i) {
@@ -124,19 +128,22 @@ Eigen::Vector3d ContactSolver::solve_coupled(double k_eff_npm, const Eigen::Vect
     }
     b_[i] = depth_[i] + ni.dot(target_offset_m);
   }
-  report_ = solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), residual_.data(), settings);
+  report_ =
+      solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), residual_.data(), settings);
   work_.add(report_, k_);
   Eigen::Vector3d push = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < k_; ++i) push += rows_[i].normal * lambda_[i];
   return target_offset_m - push * inverse_k;
 }
 
-void ContactSolver::solve_pinned(const Eigen::Vector3d& proxy_offset_m, const PgsSettings& settings) {
+void ContactSolver::solve_pinned(const Eigen::Vector3d& proxy_offset_m,
+                                 const PgsSettings& settings) {
   for (std::size_t i = 0; i < k_; ++i) {
     for (std::size_t j = 0; j < k_; ++j) s_[i * capacity_ + j] = a_[i * capacity_ + j];
     b_[i] = depth_[i] + rows_[i].normal.dot(proxy_offset_m);
   }
-  report_ = solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), residual_.data(), settings);
+  report_ =
+      solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), residual_.data(), settings);
   work_.add(report_, k_);
 }
 
@@ -147,7 +154,8 @@ bool ContactSolver::has_obstacle_rows() const {
   return false;
 }
 
-Eigen::Vector3d ContactSolver::project_on_obstacles(const Eigen::Vector3d& step_m, const PgsSettings& settings) {
+Eigen::Vector3d ContactSolver::project_on_obstacles(const Eigen::Vector3d& step_m,
+                                                    const PgsSettings& settings) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < k_; ++i) {
     if (rows_[i].kind == RowKind::kObstacle) obstacle_rows_[n++] = static_cast<std::uint32_t>(i);
@@ -155,13 +163,16 @@ Eigen::Vector3d ContactSolver::project_on_obstacles(const Eigen::Vector3d& step_
   if (n == 0) return step_m;
   for (std::size_t a = 0; a < n; ++a) {
     const Eigen::Vector3d& na = rows_[obstacle_rows_[a]].normal;
-    for (std::size_t b = 0; b < n; ++b) projection_s_[a * capacity_ + b] = na.dot(rows_[obstacle_rows_[b]].normal);
+    for (std::size_t b = 0; b < n; ++b)
+      projection_s_[a * capacity_ + b] = na.dot(rows_[obstacle_rows_[b]].normal);
     projection_b_[a] = depth_[obstacle_rows_[a]] + na.dot(step_m);
     projection_mu_[a] = 0.0;
   }
   double deepest = 0.0;
   for (std::size_t a = 0; a < n; ++a) deepest = std::max(deepest, projection_b_[a]);
-  work_.add(solve_pgs(projection_s_.data(), capacity_, n, projection_b_.data(), projection_mu_.data(), residual_.data(), settings), n);
+  work_.add(solve_pgs(projection_s_.data(), capacity_, n, projection_b_.data(),
+                      projection_mu_.data(), residual_.data(), settings),
+            n);
   Eigen::Vector3d push = Eigen::Vector3d::Zero();
   for (std::size_t a = 0; a < n; ++a) push += rows_[obstacle_rows_[a]].normal * projection_mu_[a];
   // Rows pinching the tool from opposite sides have no common solution and
@@ -183,7 +194,8 @@ Eigen::Matrix3d ContactSolver::local_stiffness(double k_c_npm) {
     const ContactRow& ra = rows_[active_[a]];
     for (std::size_t b = 0; b <= a; ++b) {
       const ContactRow& rb = rows_[active_[b]];
-      factor_[a * capacity_ + b] = a_[active_[a] * capacity_ + active_[b]] + ra.normal.dot(rb.normal) * inverse_k;
+      factor_[a * capacity_ + b] =
+          a_[active_[a] * capacity_ + active_[b]] + ra.normal.dot(rb.normal) * inverse_k;
     }
   }
   cholesky_in_place(factor_.data(), capacity_, n, kMinPivotMpn);
@@ -219,12 +231,15 @@ Eigen::Vector3d ContactSolver::resultant(RowKind kind) const {
   return sum;
 }
 
-Eigen::Vector3d ContactSolver::predicted_motion(std::size_t i, const TissueCompliance& compliance) const {
+Eigen::Vector3d ContactSolver::predicted_motion(std::size_t i,
+                                                const TissueCompliance& compliance) const {
   Eigen::Vector3d motion = Eigen::Vector3d::Zero();
   const ContactRow& ri = rows_[i];
   if (ri.compliance_index == kNoCompliance) {
     // Fallback rows move along their own normal only.
-    return fallback_diagonal_[i] > 0.0 ? Eigen::Vector3d(ri.normal * a_[i * capacity_ + i] * lambda_[i]) : motion;
+    return fallback_diagonal_[i] > 0.0
+               ? Eigen::Vector3d(ri.normal * a_[i * capacity_ + i] * lambda_[i])
+               : motion;
   }
   for (std::size_t j = 0; j < k_; ++j) {
     const ContactRow& rj = rows_[j];

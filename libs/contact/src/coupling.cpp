@@ -5,8 +5,9 @@
 
 namespace fahr::contact {
 
-EffectiveCoupling effective_coupling(const CouplingSettings& settings, double max_stiffness_npm, double dt_s,
-                                     const Eigen::Vector3d& device_m, const Eigen::Vector3d& device_velocity_mps,
+EffectiveCoupling effective_coupling(const CouplingSettings& settings, double max_stiffness_npm,
+                                     double dt_s, const Eigen::Vector3d& device_m,
+                                     const Eigen::Vector3d& device_velocity_mps,
                                      const Eigen::Vector3d& previous_proxy_m) {
   EffectiveCoupling c;
   // The rendered stiffness is at most K_c (README): clamping K_c to the
@@ -15,7 +16,8 @@ EffectiveCoupling effective_coupling(const CouplingSettings& settings, double ma
   c.damping_nspm = std::clamp(settings.damping_nspm, 0.0, settings.max_damping_nspm);
   const double damping_per_tick = c.damping_nspm / dt_s;  // B/dt, N/m
   c.effective_stiffness_npm = c.stiffness_npm + damping_per_tick;
-  c.target_m = (c.stiffness_npm * device_m + c.damping_nspm * device_velocity_mps + damping_per_tick * previous_proxy_m) /
+  c.target_m = (c.stiffness_npm * device_m + c.damping_nspm * device_velocity_mps +
+                damping_per_tick * previous_proxy_m) /
                c.effective_stiffness_npm;
   return c;
 }

@@ -8,8 +8,8 @@ namespace fahr::contact {
 PenaltyResponse::PenaltyResponse(const PenaltySettings& settings)
     : settings_(settings), forces_(settings.max_rows) {}
 
-const ForceOutput& PenaltyResponse::tick(const DeviceSample& device, std::span<const ContactRow> rows,
-                                         std::uint64_t fem_step) {
+const ForceOutput& PenaltyResponse::tick(const DeviceSample& device,
+                                         std::span<const ContactRow> rows, std::uint64_t fem_step) {
   force_count_ = 0;
   overflow_ = false;
   Eigen::Vector3d on_tool = Eigen::Vector3d::Zero();    // sum of row forces on the tool, N
@@ -39,8 +39,9 @@ const ForceOutput& PenaltyResponse::tick(const DeviceSample& device, std::span<c
   // Many rows add up to k_p each; the device renders at most its stable
   // stiffness, so the reported local stiffness is scaled down to it.
   const double largest = stiffness.norm();
-  out.stiffness_npm = largest > device.max_stiffness_npm ? Eigen::Matrix3d(stiffness * (device.max_stiffness_npm / largest))
-                                                          : stiffness;
+  out.stiffness_npm = largest > device.max_stiffness_npm
+                          ? Eigen::Matrix3d(stiffness * (device.max_stiffness_npm / largest))
+                          : stiffness;
   out.proxy_position_m = device.position_m;  // the tool follows the device rigidly
   out.proxy_orientation = device.orientation;
   out.lost_track = on_tool.norm() > device.renderable_force_n;  // reported: nothing reacts to it
@@ -59,7 +60,8 @@ void spread_sphere_forces(std::span<const SphereForce> forces, const fem::Sphere
     const auto weights = links.weights(f.sphere_id);
     for (std::size_t m = 0; m < nodes.size(); ++m) {
       for (std::size_t d = 0; d < 3; ++d) {
-        nodal_forces_n[3 * std::size_t{nodes[m]} + d] += weights[m] * f.force_n[static_cast<Eigen::Index>(d)];
+        nodal_forces_n[3 * std::size_t{nodes[m]} + d] +=
+            weights[m] * f.force_n[static_cast<Eigen::Index>(d)];
       }
     }
   }

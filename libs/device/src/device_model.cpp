@@ -6,7 +6,9 @@
 
 namespace fahr::device {
 
-DeviceModel touch_x_model() { return DeviceModel{}; }
+DeviceModel touch_x_model() {
+  return DeviceModel{};
+}
 
 DeviceModel touch_model() {
   DeviceModel model;
@@ -31,10 +33,13 @@ std::string validate(const DeviceModel& model) {
     return "continuous_force_n must be in (0, peak_force_n] N";
   }
   for (int axis = 0; axis < 3; ++axis) {
-    if (!in_range(model.workspace_m[axis], 0.0, 2.0)) return "workspace_m edges must be in (0, 2] m";
+    if (!in_range(model.workspace_m[axis], 0.0, 2.0))
+      return "workspace_m edges must be in (0, 2] m";
   }
-  if (!in_range(model.position_resolution_m, 0.0, 1e-3)) return "position_resolution_m must be in (0, 1e-3] m";
-  if (!in_range(model.max_stiffness_npm, 0.0, 1e5)) return "max_stiffness_npm must be in (0, 1e5] N/m";
+  if (!in_range(model.position_resolution_m, 0.0, 1e-3))
+    return "position_resolution_m must be in (0, 1e-3] m";
+  if (!in_range(model.max_stiffness_npm, 0.0, 1e5))
+    return "max_stiffness_npm must be in (0, 1e5] N/m";
   if (!in_range(model.thermal_time_constant.count(), 0.0, 3600.0)) {
     return "thermal_time_constant must be in (0, 3600] s";
   }

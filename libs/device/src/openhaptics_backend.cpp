@@ -42,8 +42,10 @@ std::string OpenHapticsBackend::open() {
   if (calibration == HD_CALIBRATION_NEEDS_UPDATE) {
     HDint styles = 0;
     hdGetIntegerv(HD_CALIBRATION_STYLE, &styles);
-    if (styles & HD_CALIBRATION_AUTO) hdUpdateCalibration(HD_CALIBRATION_AUTO);
-    else if (styles & HD_CALIBRATION_INKWELL) hdUpdateCalibration(HD_CALIBRATION_INKWELL);
+    if (styles & HD_CALIBRATION_AUTO)
+      hdUpdateCalibration(HD_CALIBRATION_AUTO);
+    else if (styles & HD_CALIBRATION_INKWELL)
+      hdUpdateCalibration(HD_CALIBRATION_INKWELL);
   } else if (calibration == HD_CALIBRATION_NEEDS_MANUAL_INPUT) {
     return "calibration needs manual input: put the stylus in the inkwell and restart";
   }
@@ -53,7 +55,8 @@ std::string OpenHapticsBackend::open() {
 
 std::string OpenHapticsBackend::run(Tick tick) {
   tick_ = std::move(tick);
-  const HDSchedulerHandle handle = hdScheduleAsynchronous(servo_callback, &tick_, HD_MAX_SCHEDULER_PRIORITY);
+  const HDSchedulerHandle handle =
+      hdScheduleAsynchronous(servo_callback, &tick_, HD_MAX_SCHEDULER_PRIORITY);
   hdStartScheduler();
   if (auto error = hd_error_text("hdStartScheduler"); !error.empty()) return error;
   hdWaitForCompletion(handle, HD_WAIT_INFINITE);

@@ -5,14 +5,16 @@
 
 namespace fahr::device {
 
-Vec3 PassivityController::apply(const Vec3& force_n, const Vec3& velocity_mps, std::chrono::duration<double> dt) {
+Vec3 PassivityController::apply(const Vec3& force_n, const Vec3& velocity_mps,
+                                std::chrono::duration<double> dt) {
   last_beta_ = 0.0;
   if (!config_.enabled) return force_n;
   const double h = dt.count();
   // Energy left if this force were rendered as is.
   const double predicted_j = energy_j_ - force_n.dot(velocity_mps) * h;
   const double speed_squared = velocity_mps.squaredNorm();
-  if (predicted_j >= 0.0 || speed_squared < config_.min_speed_mps * config_.min_speed_mps) return force_n;
+  if (predicted_j >= 0.0 || speed_squared < config_.min_speed_mps * config_.min_speed_mps)
+    return force_n;
   // beta |v|^2 h = -predicted brings the account back to zero.
   const double beta = std::min(-predicted_j / (speed_squared * h), config_.max_damping_nspm);
   last_beta_ = beta;

@@ -13,12 +13,30 @@ namespace {
 
 constexpr const char* kMagic = "# fahr device recording v1";
 constexpr const char* kColumns =
-    "servo_tick,device_time_ns,px_m,py_m,pz_m,qw,qx,qy,qz,vx_mps,vy_mps,vz_mps,wx_radps,wy_radps,wz_radps,"
+    "servo_tick,device_time_ns,px_m,py_m,pz_m,qw,qx,qy,qz,vx_mps,vy_mps,vz_mps,wx_radps,wy_radps,"
+    "wz_radps,"
     "buttons,renderable_force_n,fx_n,fy_n,fz_n,safety_state";
-constexpr const char* kFieldNames[] = {
-    "servo_tick", "device_time_ns", "px_m",     "py_m",     "pz_m",     "qw",    "qx",
-    "qy",         "qz",             "vx_mps",   "vy_mps",   "vz_mps",   "wx_radps", "wy_radps",
-    "wz_radps",   "buttons",        "renderable_force_n", "fx_n", "fy_n", "fz_n", "safety_state"};
+constexpr const char* kFieldNames[] = {"servo_tick",
+                                       "device_time_ns",
+                                       "px_m",
+                                       "py_m",
+                                       "pz_m",
+                                       "qw",
+                                       "qx",
+                                       "qy",
+                                       "qz",
+                                       "vx_mps",
+                                       "vy_mps",
+                                       "vz_mps",
+                                       "wx_radps",
+                                       "wy_radps",
+                                       "wz_radps",
+                                       "buttons",
+                                       "renderable_force_n",
+                                       "fx_n",
+                                       "fy_n",
+                                       "fz_n",
+                                       "safety_state"};
 constexpr int kFieldCount = 21;
 
 }  // namespace
@@ -39,16 +57,17 @@ RecordingWriter::~RecordingWriter() {
 void RecordingWriter::write(const DevicePoseSample& s) {
   if (file_ == nullptr) return;
   // %.17g round-trips every double exactly.
-  std::fprintf(file_,
-               "%" PRIu64 ",%" PRId64
-               ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%" PRIu32
-               ",%.17g,%.17g,%.17g,%.17g,%u\n",
-               s.servo_tick, s.device_time_ns, s.position_m.x(), s.position_m.y(), s.position_m.z(),
-               s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z(), s.linear_velocity_mps.x(),
-               s.linear_velocity_mps.y(), s.linear_velocity_mps.z(), s.angular_velocity_radps.x(),
-               s.angular_velocity_radps.y(), s.angular_velocity_radps.z(), s.buttons, s.renderable_force_n,
-               s.rendered_force_n.x(), s.rendered_force_n.y(), s.rendered_force_n.z(),
-               static_cast<unsigned>(s.safety_state));
+  std::fprintf(
+      file_,
+      "%" PRIu64 ",%" PRId64
+      ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%" PRIu32
+      ",%.17g,%.17g,%.17g,%.17g,%u\n",
+      s.servo_tick, s.device_time_ns, s.position_m.x(), s.position_m.y(), s.position_m.z(),
+      s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z(),
+      s.linear_velocity_mps.x(), s.linear_velocity_mps.y(), s.linear_velocity_mps.z(),
+      s.angular_velocity_radps.x(), s.angular_velocity_radps.y(), s.angular_velocity_radps.z(),
+      s.buttons, s.renderable_force_n, s.rendered_force_n.x(), s.rendered_force_n.y(),
+      s.rendered_force_n.z(), static_cast<unsigned>(s.safety_state));
 }
 
 std::string read_recording(const std::filesystem::path& path, Recording& out) {
@@ -56,8 +75,10 @@ std::string read_recording(const std::filesystem::path& path, Recording& out) {
   std::ifstream in(path);
   if (!in) return path.string() + ": cannot open for reading";
   std::string line;
-  if (!std::getline(in, line) || line != kMagic) return path.string() + ":1: not a fahr device recording v1";
-  if (!std::getline(in, line) || line != kColumns) return path.string() + ":2: unexpected column header";
+  if (!std::getline(in, line) || line != kMagic)
+    return path.string() + ":1: not a fahr device recording v1";
+  if (!std::getline(in, line) || line != kColumns)
+    return path.string() + ":2: unexpected column header";
   int line_number = 2;
   while (std::getline(in, line)) {
     ++line_number;
@@ -89,7 +110,8 @@ std::string read_recording(const std::filesystem::path& path, Recording& out) {
     s.rendered_force_n = Vec3(values[17], values[18], values[19]);
     const int state = static_cast<int>(values[20]);
     if (state < 0 || state > static_cast<int>(SafetyState::kFault)) {
-      return path.string() + ":" + std::to_string(line_number) + ": field safety_state out of range [0, 4]";
+      return path.string() + ":" + std::to_string(line_number) +
+             ": field safety_state out of range [0, 4]";
     }
     s.safety_state = static_cast<SafetyState>(state);
     out.samples.push_back(s);

@@ -5,11 +5,13 @@
 
 namespace fahr::device {
 
-RemoteInputBackend::RemoteInputBackend(const DeviceModel& model) : half_workspace_m_(0.5 * model.workspace_m) {}
+RemoteInputBackend::RemoteInputBackend(const DeviceModel& model)
+    : half_workspace_m_(0.5 * model.workspace_m) {}
 
 bool RemoteInputBackend::push(const DeviceReading& reading) {
   const bool finite = reading.position_m.allFinite() && reading.orientation.coeffs().allFinite() &&
-                      reading.linear_velocity_mps.allFinite() && reading.angular_velocity_radps.allFinite();
+                      reading.linear_velocity_mps.allFinite() &&
+                      reading.angular_velocity_radps.allFinite();
   // A zero quaternion is finite but no rotation; 1e-6 is far below any rounding of a unit one.
   constexpr double kMinQuaternionNorm = 1e-6;
   if (!finite || reading.orientation.norm() < kMinQuaternionNorm) {
@@ -26,6 +28,8 @@ bool RemoteInputBackend::push(const DeviceReading& reading) {
   return true;
 }
 
-DeviceReading RemoteInputBackend::read(std::chrono::nanoseconds) { return newest_; }
+DeviceReading RemoteInputBackend::read(std::chrono::nanoseconds) {
+  return newest_;
+}
 
 }  // namespace fahr::device

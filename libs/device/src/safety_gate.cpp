@@ -91,8 +91,8 @@ Vec3 SafetyGate::rate_limit(const Vec3& target_n) {
   return last_output_n_ + step * (max_step_n_ / size);
 }
 
-Vec3 SafetyGate::limit(const Vec3& candidate_n, const Vec3& commanded_n, bool accepted_now, bool fault,
-                       double renderable_n) {
+Vec3 SafetyGate::limit(const Vec3& candidate_n, const Vec3& commanded_n, bool accepted_now,
+                       bool fault, double renderable_n) {
   ticks_since_command_ = accepted_now ? 0 : ticks_since_command_ + 1;
   if (fault) {
     // A faulted device gets no force at all, not even a ramp.

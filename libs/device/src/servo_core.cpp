@@ -12,14 +12,19 @@ void check(const GatewayConfig& config) {
   if (const std::string error = validate(config.model); !error.empty()) {
     throw std::invalid_argument("device model " + config.model.name + ": " + error);
   }
-  if (config.period <= std::chrono::nanoseconds(0)) throw std::invalid_argument("period must be > 0");
+  if (config.period <= std::chrono::nanoseconds(0))
+    throw std::invalid_argument("period must be > 0");
   const SafetyConfig& s = config.safety;
   if (s.silence_periods < 1) throw std::invalid_argument("safety.silence_periods must be >= 1");
-  if (!(s.ramp_down_time.count() > 0.0)) throw std::invalid_argument("safety.ramp_down_time must be > 0");
+  if (!(s.ramp_down_time.count() > 0.0))
+    throw std::invalid_argument("safety.ramp_down_time must be > 0");
   if (s.engage_cycles < 1) throw std::invalid_argument("safety.engage_cycles must be >= 1");
-  if (s.max_answer_age_ticks < 1) throw std::invalid_argument("safety.max_answer_age_ticks must be >= 1");
-  if (!(s.max_force_rate_nps > 0.0)) throw std::invalid_argument("safety.max_force_rate_nps must be > 0");
-  if (!(s.engage_threshold_n >= 0.0)) throw std::invalid_argument("safety.engage_threshold_n must be >= 0");
+  if (s.max_answer_age_ticks < 1)
+    throw std::invalid_argument("safety.max_answer_age_ticks must be >= 1");
+  if (!(s.max_force_rate_nps > 0.0))
+    throw std::invalid_argument("safety.max_force_rate_nps must be > 0");
+  if (!(s.engage_threshold_n >= 0.0))
+    throw std::invalid_argument("safety.engage_threshold_n must be >= 0");
   if (!(config.render.max_correction_m > 0.0 && config.render.max_correction_m <= 0.1)) {
     throw std::invalid_argument("render.max_correction_m must be in (0, 0.1] m");
   }
@@ -27,7 +32,8 @@ void check(const GatewayConfig& config) {
     throw std::invalid_argument("mapping.motion_scale must be in (0, 100]");
   }
   if (!(config.passivity.max_damping_nspm >= 0.0 && config.passivity.max_stored_energy_j > 0.0)) {
-    throw std::invalid_argument("passivity: max_damping_nspm must be >= 0, max_stored_energy_j > 0");
+    throw std::invalid_argument(
+        "passivity: max_damping_nspm must be >= 0, max_stored_energy_j > 0");
   }
 }
 
@@ -50,7 +56,8 @@ ServoCore::ServoCore(const GatewayConfig& config, Backend& backend)
   pose_.renderable_force_n = thermal_.renderable_force_n();
 }
 
-const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now, const ForceCommandSample* incoming) {
+const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now,
+                                        const ForceCommandSample* incoming) {
   const DeviceReading reading = backend_.read(now);
   pose_.servo_tick = tick_;
   pose_.seq = tick_ + 1;
@@ -61,12 +68,14 @@ const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now, const Forc
   bool accepted = false;
   if (incoming != nullptr) {
     // Only poses of earlier ticks have been published: seq <= tick_.
-    const Verdict verdict = safety_.screen(*incoming, tick_, renderer_.has_command() ? renderer_.answered_pose_seq() : 0);
+    const Verdict verdict = safety_.screen(
+        *incoming, tick_, renderer_.has_command() ? renderer_.answered_pose_seq() : 0);
     if (verdict == Verdict::kAccepted) {
       accepted = true;
       renderer_.set_command(*incoming);
       std::chrono::nanoseconds published{0};
-      if (pose_times_.find(incoming->answered_pose_seq, published)) latency_.record(now - published);
+      if (pose_times_.find(incoming->answered_pose_seq, published))
+        latency_.record(now - published);
     }
   }
 

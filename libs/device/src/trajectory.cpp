@@ -14,15 +14,19 @@ Quat pitch_about_z(double pitch_deg) {
   return Quat(Eigen::AngleAxisd(pitch_deg * std::numbers::pi / 180.0, Vec3::UnitZ()));
 }
 
-Vec3 mm(double x, double y, double z) { return Vec3(x, y, z) * 1e-3; }
+Vec3 mm(double x, double y, double z) {
+  return Vec3(x, y, z) * 1e-3;
+}
 
 }  // namespace
 
 Trajectory::Trajectory(std::vector<Keyframe> keyframes) : keyframes_(std::move(keyframes)) {
-  if (keyframes_.empty()) throw std::invalid_argument("Trajectory: at least one keyframe is needed");
+  if (keyframes_.empty())
+    throw std::invalid_argument("Trajectory: at least one keyframe is needed");
   for (std::size_t i = 1; i < keyframes_.size(); ++i) {
     if (!(keyframes_[i].time_s > keyframes_[i - 1].time_s)) {
-      throw std::invalid_argument("Trajectory: keyframe " + std::to_string(i) + " time_s must increase");
+      throw std::invalid_argument("Trajectory: keyframe " + std::to_string(i) +
+                                  " time_s must increase");
     }
   }
 }
@@ -79,21 +83,23 @@ bool script_by_name(std::string_view name, Script& out) {
 // continuous force, and the tissue decides where the blade stops.
 Trajectory intubation_script() {
   return Trajectory({
-      {0.0, mm(12.0, 0.5, 0.0), 0.0},    // initial pose: level on the oral axis, 3 mm before the lips
-      {1.0, mm(12.0, 0.5, 0.0), 0.0},    // settle
-      {2.0, mm(8.0, 0.5, 0.0), 0.0},     // approach the lips
+      {0.0, mm(12.0, 0.5, 0.0), 0.0},  // initial pose: level on the oral axis, 3 mm before the lips
+      {1.0, mm(12.0, 0.5, 0.0), 0.0},  // settle
+      {2.0, mm(8.0, 0.5, 0.0), 0.0},   // approach the lips
       {3.5, mm(-15.0, 0.0, 0.0), 4.0},   // insert between the lips, tip over the tongue
       {5.0, mm(-33.0, -0.5, 0.0), 8.0},  // pressing pose (meshes/neonatal/README.md)
       {6.0, mm(-34.0, -4.5, 0.0), 8.0},  // press the tongue down
-      {7.5, mm(-35.0, -6.5, 0.0), 14.0}, // lever: pitch up to lift the tongue and expose the glottis
-      {9.5, mm(-35.0, -6.5, 0.0), 14.0}, // hold the view
-      {11.0, mm(-15.0, 0.0, 0.0), 4.0},  // withdraw
-      {12.5, mm(12.0, 0.5, 0.0), 0.0},   // back out of the mouth
+      {7.5, mm(-35.0, -6.5, 0.0),
+       14.0},  // lever: pitch up to lift the tongue and expose the glottis
+      {9.5, mm(-35.0, -6.5, 0.0), 14.0},  // hold the view
+      {11.0, mm(-15.0, 0.0, 0.0), 4.0},   // withdraw
+      {12.5, mm(12.0, 0.5, 0.0), 0.0},    // back out of the mouth
       {13.0, mm(12.0, 0.5, 0.0), 0.0},
   });
 }
 
-Trajectory overshoot_script(double peak_force_n, double hand_stiffness_npm, double overshoot_factor) {
+Trajectory overshoot_script(double peak_force_n, double hand_stiffness_npm,
+                            double overshoot_factor) {
   // Depth below the pressing pose at which the hand spring pulls with
   // overshoot_factor * peak force against a blade held at the pressing pose.
   const double depth_m = overshoot_factor * peak_force_n / hand_stiffness_npm;
@@ -104,9 +110,9 @@ Trajectory overshoot_script(double peak_force_n, double hand_stiffness_npm, doub
       {1.0, mm(12.0, 0.5, 0.0), 0.0},
       {3.0, mm(-15.0, 0.0, 0.0), 4.0},
       {4.5, press, 8.0},
-      {5.5, deep, 8.0},   // push past the limit
-      {10.5, deep, 8.0},  // hold 5 s
-      {11.5, press, 8.0}, // release
+      {5.5, deep, 8.0},    // push past the limit
+      {10.5, deep, 8.0},   // hold 5 s
+      {11.5, press, 8.0},  // release
       {13.0, mm(-15.0, 0.0, 0.0), 4.0},
       {14.5, mm(12.0, 0.5, 0.0), 0.0},
   });

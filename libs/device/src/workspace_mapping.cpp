@@ -4,7 +4,8 @@
 namespace fahr::device {
 
 bool WorkspaceMapping::is_identity() const {
-  return translation_m.isZero(0.0) && rotation.w() == 1.0 && rotation.vec().isZero(0.0) && motion_scale == 1.0;
+  return translation_m.isZero(0.0) && rotation.w() == 1.0 && rotation.vec().isZero(0.0) &&
+         motion_scale == 1.0;
 }
 
 void WorkspaceMapping::to_world(const DeviceReading& reading, DevicePoseSample& pose) const {

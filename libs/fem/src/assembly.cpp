@@ -7,9 +7,11 @@
 namespace fahr::fem {
 namespace {
 
-std::vector<std::vector<std::uint32_t>> node_neighbours(std::size_t node_count, const ElementRest& rest) {
+std::vector<std::vector<std::uint32_t>> node_neighbours(std::size_t node_count,
+                                                        const ElementRest& rest) {
   std::vector<std::vector<std::uint32_t>> neighbours(node_count);
-  for (std::size_t i = 0; i < node_count; ++i) neighbours[i].push_back(static_cast<std::uint32_t>(i));
+  for (std::size_t i = 0; i < node_count; ++i)
+    neighbours[i].push_back(static_cast<std::uint32_t>(i));
   for (const Tet& tet : rest.tets) {
     for (const std::uint32_t a : tet) {
       for (const std::uint32_t b : tet) neighbours[a].push_back(b);
@@ -53,7 +55,8 @@ void SystemAssembly::build(std::size_t node_count, const ElementRest& rest,
 
   auto rank_of = [&](std::uint32_t column_node, std::uint32_t row_node) {
     const auto& list = neighbours[column_node];
-    return static_cast<std::size_t>(std::lower_bound(list.begin(), list.end(), row_node) - list.begin());
+    return static_cast<std::size_t>(std::lower_bound(list.begin(), list.end(), row_node) -
+                                    list.begin());
   };
   block_column_start_.resize(48 * rest.size());
   for (std::size_t e = 0; e < rest.size(); ++e) {
@@ -62,8 +65,8 @@ void SystemAssembly::build(std::size_t node_count, const ElementRest& rest,
       for (std::size_t b = 0; b < 4; ++b) {
         const std::size_t rank = rank_of(tet[b], tet[a]);
         for (std::size_t c = 0; c < 3; ++c) {
-          block_column_start_[48 * e + 12 * a + 3 * b + c] =
-              static_cast<std::uint32_t>(static_cast<std::size_t>(outer[3 * tet[b] + c]) + 3 * rank);
+          block_column_start_[48 * e + 12 * a + 3 * b + c] = static_cast<std::uint32_t>(
+              static_cast<std::size_t>(outer[3 * tet[b] + c]) + 3 * rank);
         }
       }
     }
@@ -81,14 +84,16 @@ void SystemAssembly::build(std::size_t node_count, const ElementRest& rest,
     if (fixed_dof[col] != 0) fixed_diagonal_dof_.push_back(static_cast<int>(col));
     for (int k = outer[col]; k < outer[col + 1]; ++k) {
       const auto row = static_cast<std::size_t>(inner[static_cast<std::size_t>(k)]);
-      if (row != col && (fixed_dof[row] != 0 || fixed_dof[col] != 0)) fixed_off_diagonal_.push_back(k);
+      if (row != col && (fixed_dof[row] != 0 || fixed_dof[col] != 0))
+        fixed_off_diagonal_.push_back(k);
     }
   }
 }
 
 void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Matrix3d> rotations,
                               const LameParameters& lame, std::span<const double> mass_per_dof_kg,
-                              double mass_scale, double stiffness_scale, std::span<const double> element_scales) {
+                              double mass_scale, double stiffness_scale,
+                              std::span<const double> element_scales) {
   double* values = a_.valuePtr();
   std::memset(values, 0, sizeof(double) * static_cast<std::size_t>(a_.nonZeros()));
   for (std::size_t e = 0; e < rest.size(); ++e) {
@@ -133,12 +138,15 @@ void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Ma
 // Within column 3 node + c the node's own three rows are contiguous (rows
 // are sorted and the node's DOFs are consecutive), so the block's column c
 // starts c entries above the diagonal.
-void SystemAssembly::add_normal_stiffness(std::uint32_t node, const Eigen::Vector3d& unit_normal, double ratio) {
+void SystemAssembly::add_normal_stiffness(std::uint32_t node, const Eigen::Vector3d& unit_normal,
+                                          double ratio) {
   const std::size_t first = 3 * std::size_t{node};
   if (first + 2 >= diagonal_index_.size()) return;
   double* values = a_.valuePtr();
   const double mean_diagonal =
-      (values[diagonal_index_[first]] + values[diagonal_index_[first + 1]] + values[diagonal_index_[first + 2]]) / 3.0;
+      (values[diagonal_index_[first]] + values[diagonal_index_[first + 1]] +
+       values[diagonal_index_[first + 2]]) /
+      3.0;
   const double k = ratio * mean_diagonal;
   for (int c = 0; c < 3; ++c) {
     double* column = values + diagonal_index_[first + static_cast<std::size_t>(c)] - c;

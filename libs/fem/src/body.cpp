@@ -15,9 +15,12 @@ namespace {
 std::string validate(const SolverSettings& solver) {
   if (solver.refactor_period < 0) return "solver settings: refactor_period must be >= 0";
   if (solver.cg_max_iterations < 0) return "solver settings: cg_max_iterations must be >= 0";
-  if (!(solver.cg_relative_tolerance >= 0.0)) return "solver settings: cg_relative_tolerance must be >= 0";
-  if (!(solver.refactor_rotation_rad >= 0.0)) return "solver settings: refactor_rotation_rad must be >= 0";
-  if (solver.cg_refresh_iterations < 0) return "solver settings: cg_refresh_iterations must be >= 0";
+  if (!(solver.cg_relative_tolerance >= 0.0))
+    return "solver settings: cg_relative_tolerance must be >= 0";
+  if (!(solver.refactor_rotation_rad >= 0.0))
+    return "solver settings: refactor_rotation_rad must be >= 0";
+  if (solver.cg_refresh_iterations < 0)
+    return "solver settings: cg_refresh_iterations must be >= 0";
   if (!(solver.refactor_stiffening_change >= 0.0)) {
     return "solver settings: refactor_stiffening_change must be >= 0";
   }
@@ -26,7 +29,8 @@ std::string validate(const SolverSettings& solver) {
 
 }  // namespace
 
-BodyOrError Body::create(const BodySettings& settings, std::span<const Eigen::Vector3d> rest_positions_m,
+BodyOrError Body::create(const BodySettings& settings,
+                         std::span<const Eigen::Vector3d> rest_positions_m,
                          std::span<const Tet> tets, std::span<const std::uint32_t> fixed_nodes) {
   BodyOrError result;
   const std::string material_error = validate(settings.material);
@@ -54,7 +58,8 @@ BodyOrError Body::create(const BodySettings& settings, std::span<const Eigen::Ve
   return result;
 }
 
-std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m, std::span<const Tet> tets,
+std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
+                             std::span<const Tet> tets,
                              std::span<const std::uint32_t> fixed_nodes) {
   if (rest_positions_m.empty() || tets.empty()) return "mesh has no nodes or no tets";
   std::string error = build_element_rest(rest_positions_m, tets, rest_);
@@ -81,10 +86,12 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m, 
       for (std::size_t d = 0; d < 3; ++d) fixed_dof_[3 * i + d] = 1;
     }
     if (fixed_dof_[3 * i] == 0) inverse_mass_[i] = 1.0 / mass_kg_[i];
-    for (std::size_t d = 0; d < 3; ++d) mass_per_dof_[3 * i + d] = mass_kg_[i] > 0.0 ? mass_kg_[i] : mean_mass;
+    for (std::size_t d = 0; d < 3; ++d)
+      mass_per_dof_[3 * i + d] = mass_kg_[i] > 0.0 ? mass_kg_[i] : mean_mass;
   }
   rest_x_.resize(dofs);
-  for (std::size_t i = 0; i < n; ++i) rest_x_.segment<3>(3 * static_cast<Eigen::Index>(i)) = rest_positions_m[i];
+  for (std::size_t i = 0; i < n; ++i)
+    rest_x_.segment<3>(3 * static_cast<Eigen::Index>(i)) = rest_positions_m[i];
   x_ = rest_x_;
   v_.setZero(dofs);
   x_start_.setZero(dofs);
@@ -94,7 +101,8 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m, 
   v_next_.setZero(dofs);
   gravity_force_.setZero(dofs);
   for (std::size_t i = 0; i < n; ++i) {
-    gravity_force_.segment<3>(3 * static_cast<Eigen::Index>(i)) = mass_kg_[i] * settings_.gravity_m_per_s2;
+    gravity_force_.segment<3>(3 * static_cast<Eigen::Index>(i)) =
+        mass_kg_[i] * settings_.gravity_m_per_s2;
   }
   supports_.assign(n, NodeSupport{});
   rotations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
@@ -109,7 +117,8 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m, 
   compliance_.reserve(3 * n, settings_.max_compliance_spheres);
   warp_.resize(n);
   warp_.set_enabled(settings_.solver.warp_lagged_factor);
-  if (!cholmod_.analyze(assembly_.matrix(), settings_.solver.cholmod)) return "CHOLMOD symbolic analysis failed";
+  if (!cholmod_.analyze(assembly_.matrix(), settings_.solver.cholmod))
+    return "CHOLMOD symbolic analysis failed";
   assemble_system();
   if (!refactorise()) return "the rest system matrix is not positive definite";
   return {};
@@ -130,7 +139,8 @@ void Body::set_supports(std::span<const NodeSupport> supports, double stiffness_
   support_ratio_ = stiffness_ratio > 0.0 ? stiffness_ratio : 0.0;
   if (support_ratio_ > 0.0) {
     for (const NodeSupport& s : supports) {
-      if (s.node >= node_count() || fixed(s.node) || !s.normal.allFinite() || support_count_ == supports_.size()) {
+      if (s.node >= node_count() || fixed(s.node) || !s.normal.allFinite() ||
+          support_count_ == supports_.size()) {
         continue;
       }
       supports_[support_count_++] = s;
@@ -146,7 +156,8 @@ std::string Body::set_solver(const SolverSettings& solver) {
                          solver.cholmod.ordering != settings_.solver.cholmod.ordering;
   settings_.solver = solver;
   warp_.set_enabled(solver.warp_lagged_factor);
-  if (reanalyse && !cholmod_.analyze(assembly_.matrix(), solver.cholmod)) return "CHOLMOD symbolic analysis failed";
+  if (reanalyse && !cholmod_.analyze(assembly_.matrix(), solver.cholmod))
+    return "CHOLMOD symbolic analysis failed";
   warp_.update_rotations(rest_, rotations_);
   assemble_system();
   if (!refactorise()) return "the system matrix is not positive definite";
@@ -158,7 +169,8 @@ bool Body::refactorise() {
   refresh_due_ = false;
   supports_changed_ = false;
   std::copy(rotations_.begin(), rotations_.end(), rotations_at_factor_.begin());
-  std::copy(stiffening_scales_.begin(), stiffening_scales_.end(), stiffening_scales_at_factor_.begin());
+  std::copy(stiffening_scales_.begin(), stiffening_scales_.end(),
+            stiffening_scales_at_factor_.begin());
   warp_.mark_factorised();
   return cholmod_.factorize();
 }
@@ -189,7 +201,8 @@ int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_en
     // Small strain in the rotated frame, linear stress, rotated back:
     // f = -s R K0 (R^T x - X) written per element as -s V P Dm^-T.
     const Eigen::Matrix3d unrotated = r.transpose() * deformation;
-    const Eigen::Matrix3d strain = 0.5 * (unrotated + unrotated.transpose()) - Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d strain =
+        0.5 * (unrotated + unrotated.transpose()) - Eigen::Matrix3d::Identity();
     const double trace = strain.trace();
     Eigen::Matrix3d stress = 2.0 * lame_.mu_pa * strain;
     stress.diagonal().array() += lame_.lambda_pa * trace;
@@ -197,10 +210,12 @@ int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_en
     const Eigen::Matrix3d h = -volume * (r * stress) * rest_.dm_inv[e].transpose();
     Eigen::Map<Eigen::Vector3d>(f + 3 * std::size_t{tet[0]}) -= h.col(0) + h.col(1) + h.col(2);
     for (Eigen::Index a = 0; a < 3; ++a) {
-      Eigen::Map<Eigen::Vector3d>(f + 3 * std::size_t{tet[static_cast<std::size_t>(a + 1)]}) += h.col(a);
+      Eigen::Map<Eigen::Vector3d>(f + 3 * std::size_t{tet[static_cast<std::size_t>(a + 1)]}) +=
+          h.col(a);
     }
     if (accumulate_energy) {
-      *elastic_energy_j += volume * (lame_.mu_pa * strain.squaredNorm() + 0.5 * lame_.lambda_pa * trace * trace);
+      *elastic_energy_j +=
+          volume * (lame_.mu_pa * strain.squaredNorm() + 0.5 * lame_.lambda_pa * trace * trace);
     }
   }
   return inverted;
@@ -238,7 +253,8 @@ bool Body::stiffened_since_factor() const {
   return false;
 }
 
-bool Body::accept_contacts(const ContactSet* contacts, const SphereLinks* links, StepReport& report) {
+bool Body::accept_contacts(const ContactSet* contacts, const SphereLinks* links,
+                           StepReport& report) {
   if (contacts == nullptr || links == nullptr || contacts->contacts.empty()) return false;
   if (links->node_bound() > node_count()) {
     // Links built for another mesh: using them would index past the arrays.
@@ -285,10 +301,11 @@ void Body::prepare_system(StepReport& report) {
   const SolverSettings& solver = settings_.solver;
   const bool cg = solver.kind == LinearSolver::kConjugateGradient;
   const bool factor_needed = !cg || solver.preconditioner == CgPreconditioner::kLaggedCholesky;
-  const bool factor_due = (solver.refactor_period > 0 && steps_since_factor_ + 1 >= solver.refactor_period) ||
-                          (factor_needed && refresh_due_) ||
-                          (factor_needed && solver.refactor_period != 1 &&
-                           (support_changed_factor_due(cg) || rotated_since_factor() || stiffened_since_factor()));
+  const bool factor_due =
+      (solver.refactor_period > 0 && steps_since_factor_ + 1 >= solver.refactor_period) ||
+      (factor_needed && refresh_due_) ||
+      (factor_needed && solver.refactor_period != 1 &&
+       (support_changed_factor_due(cg) || rotated_since_factor() || stiffened_since_factor()));
   if (factor_needed) warp_.update_rotations(rest_, rotations_);
   // CG multiplies with the current A; the direct solve only needs A when it
   // refactorises.
@@ -309,20 +326,23 @@ void Body::solve_velocity(StepReport& report) {
   const auto dofs = static_cast<std::size_t>(rhs_.size());
   if (solver.kind == LinearSolver::kConjugateGradient) {
     v_next_ = v_;  // warm start from the previous velocity
-    const CgResult result = cg_.solve(assembly_.matrix(), assembly_.diagonal_index(), {rhs_.data(), dofs},
-                                      {v_next_.data(), dofs}, solver.cg_relative_tolerance,
-                                      solver.cg_max_iterations, solver.preconditioner, &cholmod_, &warp_);
+    const CgResult result =
+        cg_.solve(assembly_.matrix(), assembly_.diagonal_index(), {rhs_.data(), dofs},
+                  {v_next_.data(), dofs}, solver.cg_relative_tolerance, solver.cg_max_iterations,
+                  solver.preconditioner, &cholmod_, &warp_);
     report.solver_iterations = result.iterations;
     report.solver_relative_residual = result.relative_residual;
     // The factor has drifted too far from A to precondition it cheaply.
-    refresh_due_ = solver.preconditioner == CgPreconditioner::kLaggedCholesky && solver.cg_refresh_iterations > 0 &&
+    refresh_due_ = solver.preconditioner == CgPreconditioner::kLaggedCholesky &&
+                   solver.cg_refresh_iterations > 0 &&
                    (result.iterations > solver.cg_refresh_iterations || !result.converged);
   } else {
     warp_.solve(cholmod_, rhs_.data(), v_next_.data());
   }
 }
 
-void Body::integrate_and_project(const ContactSet* contacts, const SphereLinks* links, StepReport& report) {
+void Body::integrate_and_project(const ContactSet* contacts, const SphereLinks* links,
+                                 StepReport& report) {
   x_start_ = x_;
   x_ += h_ * v_next_;
   if (contacts == nullptr) {
@@ -330,9 +350,10 @@ void Body::integrate_and_project(const ContactSet* contacts, const SphereLinks* 
     return;
   }
   report.contacts_applied = true;
-  report.projection = project_contacts(*contacts, *links, inverse_mass_, settings_.projection,
-                                       {x_.data(), static_cast<std::size_t>(x_.size())},
-                                       {x_start_.data(), static_cast<std::size_t>(x_start_.size())});
+  report.projection =
+      project_contacts(*contacts, *links, inverse_mass_, settings_.projection,
+                       {x_.data(), static_cast<std::size_t>(x_.size())},
+                       {x_start_.data(), static_cast<std::size_t>(x_start_.size())});
   v_ = (x_ - x_start_) / h_;
 }
 
@@ -341,7 +362,8 @@ StepReport Body::step(const ContactSet* contacts, const SphereLinks* links) {
   const bool use_contacts = accept_contacts(contacts, links, report);
   bool touching = external_force_set_;
   if (use_contacts) {
-    for (const Contact& contact : contacts->contacts) touching = touching || contact_is_projected(contact);
+    for (const Contact& contact : contacts->contacts)
+      touching = touching || contact_is_projected(contact);
   }
   if (sleep_.asleep() && touching) sleep_.wake();
   if (sleep_.asleep()) {
@@ -366,21 +388,23 @@ StepReport Body::step(const ContactSet* contacts, const SphereLinks* links) {
   // 5. Sleep bookkeeping.
   report.kinetic_energy_j = kinetic_energy();
   const double weight = total_mass_kg_ * settings_.gravity_m_per_s2.norm();
-  if (sleep_.update(settings_.sleep, report.kinetic_energy_j, total_mass_kg_, report.residual_force_n, weight,
-                    touching)) {
+  if (sleep_.update(settings_.sleep, report.kinetic_energy_j, total_mass_kg_,
+                    report.residual_force_n, weight, touching)) {
     v_.setZero();
   }
   finish_step(report);
   return report;
 }
 
-bool Body::compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links, std::span<float> out) {
+bool Body::compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links,
+                      std::span<float> out) {
   if (!prepare_compliance_factor()) return false;
   return compliance_.compute(spheres, links, fixed_dof_, cholmod_, warp_, h_, out);
 }
 
-bool Body::compliance_along(std::span<const std::uint32_t> spheres, std::span<const Eigen::Vector3d> normals,
-                            const SphereLinks& links, std::span<float> out) {
+bool Body::compliance_along(std::span<const std::uint32_t> spheres,
+                            std::span<const Eigen::Vector3d> normals, const SphereLinks& links,
+                            std::span<float> out) {
   if (!prepare_compliance_factor()) return false;
   return compliance_.compute_along(spheres, normals, links, fixed_dof_, cholmod_, warp_, h_, out);
 }
@@ -389,7 +413,8 @@ bool Body::prepare_compliance_factor() {
   const SolverSettings& solver = settings_.solver;
   const bool factor_unused = solver.kind == LinearSolver::kConjugateGradient &&
                              solver.preconditioner == CgPreconditioner::kJacobi;
-  if (factor_unused && solver.refactor_period > 0 && steps_since_factor_ >= solver.refactor_period) {
+  if (factor_unused && solver.refactor_period > 0 &&
+      steps_since_factor_ >= solver.refactor_period) {
     // Jacobi-CG keeps no factorisation per step; A of the last step is
     // assembled, so refresh the factor from it when it is older than asked.
     warp_.update_rotations(rest_, rotations_);
@@ -417,9 +442,13 @@ void Body::set_node_position(std::uint32_t node, const Eigen::Vector3d& position
   sleep_.wake();
 }
 
-void Body::set_velocities_zero() { v_.setZero(); }
+void Body::set_velocities_zero() {
+  v_.setZero();
+}
 
-void Body::wake() { sleep_.wake(); }
+void Body::wake() {
+  sleep_.wake();
+}
 
 bool Body::reset_to_rest() {
   x_ = rest_x_;

@@ -21,7 +21,8 @@ TetMesh make_box_mesh(const std::array<int, 3>& cells, const Eigen::Vector3d& si
   for (int k = 0; k <= nz; ++k) {
     for (int j = 0; j <= ny; ++j) {
       for (int i = 0; i <= nx; ++i) {
-        mesh.nodes_m.push_back(origin_m + Eigen::Vector3d(i * step.x(), j * step.y(), k * step.z()));
+        mesh.nodes_m.push_back(origin_m +
+                               Eigen::Vector3d(i * step.x(), j * step.y(), k * step.z()));
       }
     }
   }
@@ -41,7 +42,8 @@ TetMesh make_box_mesh(const std::array<int, 3>& cells, const Eigen::Vector3d& si
           }
           // Odd permutations give negative volume: swap two nodes.
           Eigen::Matrix3d dm;
-          dm << mesh.nodes_m[tet[1]] - mesh.nodes_m[tet[0]], mesh.nodes_m[tet[2]] - mesh.nodes_m[tet[0]],
+          dm << mesh.nodes_m[tet[1]] - mesh.nodes_m[tet[0]],
+              mesh.nodes_m[tet[2]] - mesh.nodes_m[tet[0]],
               mesh.nodes_m[tet[3]] - mesh.nodes_m[tet[0]];
           if (dm.determinant() < 0.0) std::swap(tet[2], tet[3]);
           mesh.tets.push_back(tet);

@@ -27,7 +27,8 @@ void CgSolver::resize(std::size_t dofs) {
   inverse_diagonal_.setZero(n);
 }
 
-void CgSolver::apply_preconditioner(CgPreconditioner preconditioner, CholmodSolver* factor, WarpedFactor* warp) {
+void CgSolver::apply_preconditioner(CgPreconditioner preconditioner, CholmodSolver* factor,
+                                    WarpedFactor* warp) {
   if (preconditioner == CgPreconditioner::kLaggedCholesky && factor != nullptr && warp != nullptr) {
     warp->solve(*factor, r_.data(), z_.data());
   } else {

@@ -22,8 +22,8 @@ struct CholmodSolver::State {
     cholmod_dense* x = nullptr;
     cholmod_dense* y = nullptr;
     cholmod_dense* e = nullptr;
-    int columns = 0;            // 0: unused
-    std::uint64_t last_use = 0; // for replacing the least recently used set
+    int columns = 0;             // 0: unused
+    std::uint64_t last_use = 0;  // for replacing the least recently used set
   };
   std::array<Buffers, CholmodSolver::kColumnCounts> sets{};
   std::uint64_t uses = 0;
@@ -85,7 +85,8 @@ struct CholmodSolver::State {
     rhs.xtype = CHOLMOD_REAL;
     rhs.dtype = CHOLMOD_DOUBLE;
     restore_simplicial_workspace(buffers.y, rhs.ncol);
-    cholmod_solve2(CHOLMOD_A, factor, &rhs, nullptr, &buffers.x, nullptr, &buffers.y, &buffers.e, &common);
+    cholmod_solve2(CHOLMOD_A, factor, &rhs, nullptr, &buffers.x, nullptr, &buffers.y, &buffers.e,
+                   &common);
     std::memcpy(out, buffers.x->x, sizeof(double) * rows * rhs.ncol);
   }
 };
@@ -101,13 +102,20 @@ CholmodSolver::~CholmodSolver() = default;
 bool CholmodSolver::analyze(const SparseMatrix& matrix, const CholmodOptions& options) {
   State& s = *state_;
   switch (options.factor) {
-    case CholmodFactorKind::kAuto: s.common.supernodal = CHOLMOD_AUTO; break;
-    case CholmodFactorKind::kSimplicial: s.common.supernodal = CHOLMOD_SIMPLICIAL; break;
-    case CholmodFactorKind::kSupernodal: s.common.supernodal = CHOLMOD_SUPERNODAL; break;
+    case CholmodFactorKind::kAuto:
+      s.common.supernodal = CHOLMOD_AUTO;
+      break;
+    case CholmodFactorKind::kSimplicial:
+      s.common.supernodal = CHOLMOD_SIMPLICIAL;
+      break;
+    case CholmodFactorKind::kSupernodal:
+      s.common.supernodal = CHOLMOD_SUPERNODAL;
+      break;
   }
   if (options.ordering != CholmodOrdering::kDefault) {
     s.common.nmethods = 1;
-    s.common.method[0].ordering = options.ordering == CholmodOrdering::kAmd ? CHOLMOD_AMD : CHOLMOD_METIS;
+    s.common.method[0].ordering =
+        options.ordering == CholmodOrdering::kAmd ? CHOLMOD_AMD : CHOLMOD_METIS;
     s.common.postorder = 1;
   }
   if (s.factor != nullptr) cholmod_free_factor(&s.factor, &s.common);
@@ -140,9 +148,13 @@ bool CholmodSolver::factorize() {
   return s.numeric;
 }
 
-bool CholmodSolver::factorized() const { return state_->numeric; }
+bool CholmodSolver::factorized() const {
+  return state_->numeric;
+}
 
-std::uint64_t CholmodSolver::factorisations() const { return state_->factorisations; }
+std::uint64_t CholmodSolver::factorisations() const {
+  return state_->factorisations;
+}
 
 void CholmodSolver::solve(std::span<const double> b, std::span<double> x) {
   state_->solve_dense(b.data(), x.data(), 1);

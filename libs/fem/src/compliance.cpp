@@ -14,11 +14,13 @@ constexpr std::array<std::size_t, 4> kChunkSpheres{8, 4, 2, 1};
 
 // Row 3s + d of J times a solved column x: the motion of sphere s's centre
 // along d (its weights over its nodes' DOFs).
-double sphere_motion(const SphereLinks& links, std::uint32_t sphere, const double* x, std::size_t d) {
+double sphere_motion(const SphereLinks& links, std::uint32_t sphere, const double* x,
+                     std::size_t d) {
   const auto nodes = links.nodes(sphere);
   const auto weights = links.weights(sphere);
   double sum = 0.0;
-  for (std::size_t m = 0; m < nodes.size(); ++m) sum += weights[m] * x[3 * std::size_t{nodes[m]} + d];
+  for (std::size_t m = 0; m < nodes.size(); ++m)
+    sum += weights[m] * x[3 * std::size_t{nodes[m]} + d];
   return sum;
 }
 
@@ -54,19 +56,23 @@ void ComplianceBlock::reserve(std::size_t dofs, std::size_t max_spheres) {
   last_solved_ = 0;
 }
 
-std::size_t ComplianceBlock::slot_for(std::uint32_t sphere, std::uint64_t factorisation, bool& cached) {
+std::size_t ComplianceBlock::slot_for(std::uint32_t sphere, std::uint64_t factorisation,
+                                      bool& cached) {
   const std::uint64_t now = uses_;
   std::size_t oldest = slots_.size();
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     Slot& slot = slots_[i];
     // A slot already claimed in this call (last_use == now) for the same
     // sphere is shared, solved or not.
-    if (slot.sphere == sphere && slot.factorisation == factorisation && (slot.valid || slot.last_use == now)) {
+    if (slot.sphere == sphere && slot.factorisation == factorisation &&
+        (slot.valid || slot.last_use == now)) {
       cached = slot.valid || slot.last_use == now;
       slot.last_use = now;
       return i;
     }
-    if (slot.last_use != now && (oldest == slots_.size() || slot.last_use < slots_[oldest].last_use)) oldest = i;
+    if (slot.last_use != now &&
+        (oldest == slots_.size() || slot.last_use < slots_[oldest].last_use))
+      oldest = i;
   }
   // There are more slots than spheres in one request, so one is free.
   Slot& slot = slots_[oldest];
@@ -83,7 +89,8 @@ void ComplianceBlock::solve_chunk(std::span<const std::size_t> slots, const Sphe
   std::fill(rhs_.begin(), rhs_.begin() + static_cast<std::ptrdiff_t>(dofs_ * columns), 0.0);
   for (std::size_t s = 0; s < slots.size(); ++s) {
     for (std::size_t d = 0; d < 3; ++d) {
-      add_spread(links, slots_[slots[s]].sphere, Eigen::Vector3d::Unit(static_cast<Eigen::Index>(d)), fixed_dof,
+      add_spread(links, slots_[slots[s]].sphere,
+                 Eigen::Vector3d::Unit(static_cast<Eigen::Index>(d)), fixed_dof,
                  rhs_.data() + dofs_ * (3 * s + d));
     }
   }
@@ -139,31 +146,36 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
     const double* x = column(request_slots_[t / 3], t % 3);
     for (std::size_t s = 0; s < k; ++s) {
       for (std::size_t d = 0; d < 3; ++d) {
-        out[(3 * s + d) * rows + t] = static_cast<float>(h2 * sphere_motion(links, spheres[s], x, d));
+        out[(3 * s + d) * rows + t] =
+            static_cast<float>(h2 * sphere_motion(links, spheres[s], x, d));
       }
     }
   }
   return true;
 }
 
-bool ComplianceBlock::compute_along(std::span<const std::uint32_t> spheres, std::span<const Eigen::Vector3d> normals,
-                                    const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
-                                    CholmodSolver& factor, WarpedFactor& warp, double time_step_s,
-                                    std::span<float> out) {
+bool ComplianceBlock::compute_along(std::span<const std::uint32_t> spheres,
+                                    std::span<const Eigen::Vector3d> normals,
+                                    const SphereLinks& links,
+                                    std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
+                                    WarpedFactor& warp, double time_step_s, std::span<float> out) {
   const std::size_t k = spheres.size();
   last_solved_ = 0;
   if (k == 0) return true;
-  if (k > max_spheres_ || normals.size() < k || out.size() < 3 * k * k || !factor.factorized()) return false;
+  if (k > max_spheres_ || normals.size() < k || out.size() < 3 * k * k || !factor.factorized())
+    return false;
   for (const std::uint32_t s : spheres) {
     if (s >= links.size()) return false;
   }
   // The columns of the 3x3 blocks' cache are not these: leave it alone.
   const double h2 = time_step_s * time_step_s;
-  const std::size_t per_chunk = rhs_.size() / dofs_;  // columns a chunk holds (3 x kChunkSpheres.front())
+  const std::size_t per_chunk =
+      rhs_.size() / dofs_;  // columns a chunk holds (3 x kChunkSpheres.front())
   for (std::size_t done = 0; done < k;) {
     // Column counts CHOLMOD keeps buffers for: the blocks' 24, 12, 6, 3, then 2 and 1.
     std::size_t chunk = 1;
-    for (const std::size_t c : {per_chunk, per_chunk / 2, per_chunk / 4, per_chunk / 8, std::size_t{2}}) {
+    for (const std::size_t c :
+         {per_chunk, per_chunk / 2, per_chunk / 4, per_chunk / 8, std::size_t{2}}) {
       if (c > 0 && c <= k - done) {
         chunk = c;
         break;
@@ -181,7 +193,8 @@ bool ComplianceBlock::compute_along(std::span<const std::uint32_t> spheres, std:
       const std::size_t t = done + c;
       for (std::size_t s = 0; s < k; ++s) {
         for (std::size_t d = 0; d < 3; ++d) {
-          out[(3 * s + d) * k + t] = static_cast<float>(h2 * sphere_motion(links, spheres[s], x, d));
+          out[(3 * s + d) * k + t] =
+              static_cast<float>(h2 * sphere_motion(links, spheres[s], x, d));
         }
       }
     }

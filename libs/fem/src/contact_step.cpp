@@ -19,7 +19,10 @@ bool carries_force(const Contact& c) {
 }  // namespace
 
 ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStepSettings& settings)
-    : body_(body), links_(links), settings_(settings), projection_settings_(body.settings().projection) {
+    : body_(body),
+      links_(links),
+      settings_(settings),
+      projection_settings_(body.settings().projection) {
   projection_settings_.spread = settings_.spread;
   projection_settings_.frozen_target = settings_.frozen_target;
   const std::size_t dofs = 3 * body.node_count();
@@ -45,7 +48,8 @@ bool ContactStep::fix_compliance_spheres(std::span<const std::uint32_t> spheres)
   fixed_spheres_ = true;
   spheres_.clear();
   compliance_valid_ = false;
-  const bool known = std::all_of(spheres.begin(), spheres.end(), [&](std::uint32_t s) { return s < links_.size(); });
+  const bool known = std::all_of(spheres.begin(), spheres.end(),
+                                 [&](std::uint32_t s) { return s < links_.size(); });
   if (!known || spheres.size() > settings_.max_compliance_spheres) {
     compliance_.clear();
     free_centres_.clear();
@@ -53,7 +57,8 @@ bool ContactStep::fix_compliance_spheres(std::span<const std::uint32_t> spheres)
   }
   spheres_.assign(spheres.begin(), spheres.end());
   slot_of_sphere_.assign(links_.size(), kNoSlot);
-  for (std::size_t i = 0; i < spheres_.size(); ++i) slot_of_sphere_[spheres_[i]] = static_cast<std::int32_t>(i);
+  for (std::size_t i = 0; i < spheres_.size(); ++i)
+    slot_of_sphere_[spheres_[i]] = static_cast<std::int32_t>(i);
   lambda_n_.assign(spheres_.size(), 0.0);
   normals_.assign(spheres_.size(), Eigen::Vector3d::Zero());
   compliance_.assign(9 * spheres_.size() * spheres_.size(), 0.0f);
@@ -66,7 +71,9 @@ bool ContactStep::fix_compliance_spheres(std::span<const std::uint32_t> spheres)
 
 void ContactStep::set_obstacles(std::span<const ObstacleField* const> fields,
                                 const ObstacleProjectionSettings& settings) {
-  obstacles_ = fields.empty() ? nullptr : std::make_unique<ObstacleProjection>(fields, body_.node_count(), settings);
+  obstacles_ = fields.empty()
+                   ? nullptr
+                   : std::make_unique<ObstacleProjection>(fields, body_.node_count(), settings);
   projection_settings_.project_obstacle_contacts = obstacles_ == nullptr;
   supports_ = obstacles_ && settings.support_stiffness_ratio > 0.0
                   ? std::make_unique<ObstacleSupport>(body_.node_count())
@@ -85,8 +92,8 @@ void ContactStep::set_tool_obstacle(const ObstacleField* field) {
   ObstacleProjectionSettings settings;
   settings.margin_m = 0.0;
   settings.support_stiffness_ratio = 0.0;
-  tool_pass_ = std::make_unique<ObstacleProjection>(std::span<const ObstacleField* const>(&tool_field_, 1),
-                                                    body_.node_count(), settings);
+  tool_pass_ = std::make_unique<ObstacleProjection>(
+      std::span<const ObstacleField* const>(&tool_field_, 1), body_.node_count(), settings);
   tool_start_.assign(3 * body_.node_count(), 0.0);
 }
 
@@ -113,7 +120,8 @@ void ContactStep::add_sphere_force(const Contact& c) {
   const auto weights = links_.weights(c.sphere_id);
   for (std::size_t m = 0; m < nodes.size(); ++m) {
     for (std::size_t d = 0; d < 3; ++d) {
-      force_n_[3 * std::size_t{nodes[m]} + d] += weights[m] * c.force_n * c.normal[static_cast<Eigen::Index>(d)];
+      force_n_[3 * std::size_t{nodes[m]} + d] +=
+          weights[m] * c.force_n * c.normal[static_cast<Eigen::Index>(d)];
     }
   }
 }
@@ -168,7 +176,8 @@ void ContactStep::apply_forces(std::span<const double> extra_forces_n) {
   for (std::size_t n = 0; n < body_.node_count(); ++n) {
     Eigen::Vector3d f(force_n_[3 * n], force_n_[3 * n + 1], force_n_[3 * n + 2]);
     if (!extra_forces_n.empty()) {
-      f += Eigen::Vector3d(extra_forces_n[3 * n], extra_forces_n[3 * n + 1], extra_forces_n[3 * n + 2]);
+      f += Eigen::Vector3d(extra_forces_n[3 * n], extra_forces_n[3 * n + 1],
+                           extra_forces_n[3 * n + 2]);
     }
     if (f.squaredNorm() > 0.0) body_.set_external_force(static_cast<std::uint32_t>(n), f);
   }
@@ -185,7 +194,8 @@ void ContactStep::update_compliance(bool refactorised) {
   const bool along = along_normals();
   if (compliance_valid_ && !refactorised &&
       std::equal(spheres_.begin(), spheres_.end(), compliance_of_.begin(), compliance_of_.end()) &&
-      (!along || std::equal(normals_.begin(), normals_.end(), normals_of_.begin(), normals_of_.end()))) {
+      (!along ||
+       std::equal(normals_.begin(), normals_.end(), normals_of_.begin(), normals_of_.end()))) {
     ++compliance_reuses_;
     return;
   }
@@ -220,15 +230,16 @@ void ContactStep::update_free_centres() {
       if (along) {
         // Column t is W_st n_t, n_t the normal lambda_t pushed along.
         for (std::size_t d = 0; d < 3; ++d) {
-          shift[static_cast<Eigen::Index>(d)] += lambda_n_[t] * double{compliance_[(3 * s + d) * k + t]};
+          shift[static_cast<Eigen::Index>(d)] +=
+              lambda_n_[t] * double{compliance_[(3 * s + d) * k + t]};
         }
         continue;
       }
       for (std::size_t d = 0; d < 3; ++d) {
         const float* row = compliance_.data() + (3 * s + d) * 3 * k + 3 * t;
-        shift[static_cast<Eigen::Index>(d)] += lambda_n_[t] * (double{row[0]} * normals_[t].x() +
-                                                               double{row[1]} * normals_[t].y() +
-                                                               double{row[2]} * normals_[t].z());
+        shift[static_cast<Eigen::Index>(d)] +=
+            lambda_n_[t] * (double{row[0]} * normals_[t].x() + double{row[1]} * normals_[t].y() +
+                            double{row[2]} * normals_[t].z());
       }
     }
     free_centres_[s] = links_.centre(spheres_[s], x) - shift;
@@ -239,8 +250,8 @@ bool ContactStep::diverged() const {
   const auto x = body_.positions_m();
   const double limit2 = settings_.divergence_limit_m * settings_.divergence_limit_m;
   for (std::size_t n = 0; n < body_.node_count(); ++n) {
-    const Eigen::Vector3d moved =
-        Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]) - body_.rest_position(static_cast<std::uint32_t>(n));
+    const Eigen::Vector3d moved = Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]) -
+                                  body_.rest_position(static_cast<std::uint32_t>(n));
     // Written so that a NaN counts as diverged.
     if (!(moved.squaredNorm() <= limit2)) return true;
   }
@@ -267,17 +278,19 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
     tool_pass_->begin_step();
     tool_pass_->forget_clearances();
     for (std::size_t n = 0; n < body_.node_count(); ++n) {
-      const Eigen::Vector3d start(start_positions_[3 * n], start_positions_[3 * n + 1], start_positions_[3 * n + 2]);
+      const Eigen::Vector3d start(start_positions_[3 * n], start_positions_[3 * n + 1],
+                                  start_positions_[3 * n + 2]);
       const Eigen::Vector3d carried = tool_motion_ * start;
-      for (std::size_t d = 0; d < 3; ++d) tool_start_[3 * n + d] = carried[static_cast<Eigen::Index>(d)];
+      for (std::size_t d = 0; d < 3; ++d)
+        tool_start_[3 * n + d] = carried[static_cast<Eigen::Index>(d)];
     }
   }
   for (int round = 0; round < rounds; ++round) {
     // After a round: whether the anatomy's last pass left nothing to redo.
     bool settled = round > 0;
     if (tool) {
-      projection_ =
-          project_contacts(*contacts, links_, inverse_mass, projection_settings_, projected_, start_positions_);
+      projection_ = project_contacts(*contacts, links_, inverse_mass, projection_settings_,
+                                     projected_, start_positions_);
       sweeps += projection_.sweeps;
       // It moved nothing the tool constraints needed (with a floor: nor
       // squeezed a tet below it, checked after the floor's pass).
@@ -299,7 +312,8 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
     ++anatomy.obstacle_rounds;
     // Without tool constraints or a floor, nothing the anatomy moved can
     // need another round.
-    if (obstacles_->project(projected_, inverse_mass, anatomy, start_positions_, body_.rest_positions_m()) == 0 ||
+    if (obstacles_->project(projected_, inverse_mass, anatomy, start_positions_,
+                            body_.rest_positions_m()) == 0 ||
         (!tool && !volume_floor_))
       break;
   }
@@ -327,7 +341,8 @@ void ContactStep::project(const ContactSet* contacts) {
                                 projected_[3 * n + 2] - free_positions_[3 * n + 2]);
     if (moved.squaredNorm() == 0.0) continue;
     const auto node = static_cast<std::uint32_t>(n);
-    body_.set_node_position(node, Eigen::Vector3d(projected_[3 * n], projected_[3 * n + 1], projected_[3 * n + 2]));
+    body_.set_node_position(
+        node, Eigen::Vector3d(projected_[3 * n], projected_[3 * n + 1], projected_[3 * n + 2]));
     const Eigen::Vector3d carry = mass[n] * moved / h2;
     for (std::size_t d = 0; d < 3; ++d) carry_n_[3 * n + d] = carry[static_cast<Eigen::Index>(d)];
   }
@@ -344,7 +359,8 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   update_compliance(report.refactorised);
   update_free_centres();
   projection_ = {};
-  if (obstacles_ || tool_pass_ || volume_floor_ || (contacts != nullptr && !contacts->contacts.empty())) {
+  if (obstacles_ || tool_pass_ || volume_floor_ ||
+      (contacts != nullptr && !contacts->contacts.empty())) {
     project(contacts);
   }
   if (supports_ && supports_->update(*obstacles_, start_positions_, free_positions_)) {

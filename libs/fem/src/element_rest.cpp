@@ -12,7 +12,8 @@ double longest_edge(const std::array<Eigen::Vector3d, 4>& x) {
   double longest = 0.0;
   for (int a = 0; a < 4; ++a) {
     for (int b = a + 1; b < 4; ++b) {
-      longest = std::max(longest, (x[static_cast<std::size_t>(a)] - x[static_cast<std::size_t>(b)]).norm());
+      longest = std::max(longest,
+                         (x[static_cast<std::size_t>(a)] - x[static_cast<std::size_t>(b)]).norm());
     }
   }
   return longest;
@@ -44,8 +45,8 @@ std::string build_element_rest(std::span<const Eigen::Vector3d> rest_positions_m
     // Inverted (negative) or flat tets are rejected: the corotated force of
     // an element inverted at rest would push it further inside out.
     if (!(edge > 0.0) || det / (edge * edge * edge) < kMinTetShapeQuality) {
-      return "tet " + std::to_string(e) + " has non-positive or near-zero volume (6V = " +
-             std::to_string(det) + " m^3)";
+      return "tet " + std::to_string(e) +
+             " has non-positive or near-zero volume (6V = " + std::to_string(det) + " m^3)";
     }
     rest.volume_m3[e] = det / 6.0;
     rest.dm_inv[e] = dm.inverse();

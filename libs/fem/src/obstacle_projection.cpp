@@ -30,7 +30,8 @@ constexpr int kHomeTraceSteps = 256;
 
 }  // namespace
 
-ObstacleProjection::ObstacleProjection(std::span<const ObstacleField* const> fields, std::size_t node_count,
+ObstacleProjection::ObstacleProjection(std::span<const ObstacleField* const> fields,
+                                       std::size_t node_count,
                                        const ObstacleProjectionSettings& settings)
     : fields_(fields.begin(), fields.end()),
       settings_(settings),
@@ -52,9 +53,11 @@ void ObstacleProjection::begin_step() {
 }
 
 bool ObstacleProjection::segment_enters(const ObstacleField& field, const Eigen::Vector3d& a,
-                                        const Eigen::Vector3d& b, double level_m, bool if_undecided) const {
+                                        const Eigen::Vector3d& b, double level_m,
+                                        bool if_undecided) const {
   const double length = (b - a).norm();
-  const Eigen::Vector3d direction = length > 0.0 ? Eigen::Vector3d((b - a) / length) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d direction =
+      length > 0.0 ? Eigen::Vector3d((b - a) / length) : Eigen::Vector3d::Zero();
   double t = 0.0;
   for (int i = 0; i < kHomeTraceSteps; ++i) {
     const double d = field.sample(a + std::min(t, length) * direction).distance_m;
@@ -66,7 +69,9 @@ bool ObstacleProjection::segment_enters(const ObstacleField& field, const Eigen:
   return if_undecided;
 }
 
-void ObstacleProjection::forget_clearances() { std::fill(clearance_m_.begin(), clearance_m_.end(), kUnsampled); }
+void ObstacleProjection::forget_clearances() {
+  std::fill(clearance_m_.begin(), clearance_m_.end(), kUnsampled);
+}
 
 void ObstacleProjection::spend_clearance(std::size_t node, double distance_m) {
   double* clearance = clearance_m_.data() + node * fields_.size();
@@ -75,9 +80,10 @@ void ObstacleProjection::spend_clearance(std::size_t node, double distance_m) {
 
 // Illinois regula falsi on g(t) = d(start + t (x - start)) - level, with
 // g(0) >= 0 > g(1): keeps the bracket, halves a stale end's value.
-Eigen::Vector3d ObstacleProjection::entry_point(const ObstacleField& field, const Eigen::Vector3d& start,
-                                                double start_distance_m, const Eigen::Vector3d& x, double distance_m,
-                                                double level_m) const {
+Eigen::Vector3d ObstacleProjection::entry_point(const ObstacleField& field,
+                                                const Eigen::Vector3d& start,
+                                                double start_distance_m, const Eigen::Vector3d& x,
+                                                double distance_m, double level_m) const {
   double t_out = 0.0, g_out = start_distance_m - level_m;
   double t_in = 1.0, g_in = distance_m - level_m;
   int stale_side = 0;
@@ -105,8 +111,9 @@ Eigen::Vector3d ObstacleProjection::entry_point(const ObstacleField& field, cons
 // when the path is clear, when it started within the margin (a node resting
 // on the bone: the push along the normal decides) or when the path grazes
 // the margin for longer than the trace follows it.
-double ObstacleProjection::enter_along_path(const ObstacleField& field, const Eigen::Vector3d& start,
-                                            Eigen::Vector3d& x, ObstacleSample& s, ProjectionReport& report) const {
+double ObstacleProjection::enter_along_path(const ObstacleField& field,
+                                            const Eigen::Vector3d& start, Eigen::Vector3d& x,
+                                            ObstacleSample& s, ProjectionReport& report) const {
   const double margin = settings_.margin_m;
   const double length = (x - start).norm();
   const double d0 = field.sample(start).distance_m;
@@ -121,7 +128,8 @@ double ObstacleProjection::enter_along_path(const ObstacleField& field, const Ei
     if (!std::isfinite(d_next)) return 0.0;
     if (d_next < margin - settings_.tolerance_m) {
       report.obstacle_deepest_m = std::max(report.obstacle_deepest_m, -s.distance_m);
-      const Eigen::Vector3d entry = entry_point(field, start + t * direction, d, next, d_next, margin);
+      const Eigen::Vector3d entry =
+          entry_point(field, start + t * direction, d, next, d_next, margin);
       const Eigen::Vector3d end = x;
       x = entry;
       s = field.sample(x);
@@ -150,8 +158,10 @@ double ObstacleProjection::enter_along_path(const ObstacleField& field, const Ei
 // is out, then move it out along the normal until it sits at the margin.
 // A move out of one obstacle may take a node toward another sampled before;
 // the clearances record it and the next round's pass catches it.
-ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t node, const Eigen::Vector3d* start,
-                                                                 const Eigen::Vector3d* rest, Eigen::Vector3d& x,
+ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t node,
+                                                                 const Eigen::Vector3d* start,
+                                                                 const Eigen::Vector3d* rest,
+                                                                 Eigen::Vector3d& x,
                                                                  ProjectionReport& report) {
   const double margin = settings_.margin_m;
   spend_clearance(node, (x - sampled_at_m_[node]).norm());
@@ -187,7 +197,8 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
       const ObstacleSample end_sample = s;
       double back = enter_along_path(*fields_[f], *start, x, s, report);
       if (back > 0.0 && rest != nullptr && s.distance_m >= 0.0 && end_sample.distance_m >= 0.0 &&
-          !segment_enters(*fields_[f], *rest, end, 0.0, true) && segment_enters(*fields_[f], *rest, *start, 0.0, false)) {
+          !segment_enters(*fields_[f], *rest, end, 0.0, true) &&
+          segment_enters(*fields_[f], *rest, *start, 0.0, false)) {
         // Beyond the bone and going home through it: let it.
         x = end;
         s = end_sample;
@@ -199,7 +210,9 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
         moved = true;
       }
     }
-    for (int move = 0; move < settings_.max_moves_per_node && s.distance_m < margin - settings_.tolerance_m; ++move) {
+    for (int move = 0;
+         move < settings_.max_moves_per_node && s.distance_m < margin - settings_.tolerance_m;
+         ++move) {
       const double length = s.normal.norm();
       if (!(length > kMinNormalLength) || !s.normal.allFinite()) break;
       report.obstacle_deepest_m = std::max(report.obstacle_deepest_m, -s.distance_m);
@@ -222,7 +235,8 @@ ObstacleProjection::NodeOutcome ObstacleProjection::project_node(std::size_t nod
   return moved ? NodeOutcome::kMoved : NodeOutcome::kClear;
 }
 
-int ObstacleProjection::project(std::span<double> positions_m, std::span<const double> inverse_mass_per_node,
+int ObstacleProjection::project(std::span<double> positions_m,
+                                std::span<const double> inverse_mass_per_node,
                                 ProjectionReport& report, std::span<const double> start_positions_m,
                                 std::span<const double> rest_positions_m) {
   if (fields_.empty()) return 0;
@@ -245,7 +259,8 @@ int ObstacleProjection::project(std::span<double> positions_m, std::span<const d
     const bool have_rest = rest_positions_m.size() >= 3 * (n + 1);
     Eigen::Vector3d rest = Eigen::Vector3d::Zero();
     if (have_rest) rest = Eigen::Map<const Eigen::Vector3d>(rest_positions_m.data() + 3 * n);
-    const NodeOutcome outcome = project_node(n, start_usable ? &start : nullptr, have_rest ? &rest : nullptr, x, report);
+    const NodeOutcome outcome =
+        project_node(n, start_usable ? &start : nullptr, have_rest ? &rest : nullptr, x, report);
     if (outcome == NodeOutcome::kNonFinite || !x.allFinite()) {
       // Leave the node where the step put it and sample it afresh next time.
       std::fill_n(clearance_m_.data() + n * fields_.size(), fields_.size(), kUnsampled);

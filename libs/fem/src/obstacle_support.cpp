@@ -28,8 +28,10 @@ bool ObstacleSupport::update(const ObstacleProjection& anatomy, std::span<const 
                              std::span<const double> free_m) {
   const std::size_t previous_count = count_;
   std::copy_n(supports_.begin(), previous_count, previous_.begin());
-  for (std::size_t i = 0; i < previous_count; ++i) slot_of_node_[previous_[i].node] = static_cast<std::int32_t>(i);
-  const std::size_t nodes = std::min({anatomy.node_count(), supports_.size(), start_m.size() / 3, free_m.size() / 3});
+  for (std::size_t i = 0; i < previous_count; ++i)
+    slot_of_node_[previous_[i].node] = static_cast<std::int32_t>(i);
+  const std::size_t nodes =
+      std::min({anatomy.node_count(), supports_.size(), start_m.size() / 3, free_m.size() / 3});
   bool changed = false;
   count_ = 0;
   // Node order, so the set (and A) does not depend on the order of moves.
@@ -43,7 +45,8 @@ bool ObstacleSupport::update(const ObstacleProjection& anatomy, std::span<const 
     }
     if (slot < 0) continue;
     const NodeSupport& held = previous_[static_cast<std::size_t>(slot)];
-    const Eigen::Vector3d free_motion(free_m[3 * n] - start_m[3 * n], free_m[3 * n + 1] - start_m[3 * n + 1],
+    const Eigen::Vector3d free_motion(free_m[3 * n] - start_m[3 * n],
+                                      free_m[3 * n + 1] - start_m[3 * n + 1],
                                       free_m[3 * n + 2] - start_m[3 * n + 2]);
     if (held.normal.dot(free_motion) > kLiftOffM || !free_motion.allFinite()) {
       changed = true;  // lifts off: the spring would pull it back

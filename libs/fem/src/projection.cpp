@@ -10,7 +10,8 @@ namespace {
 // normalised reliably (c == q at the haptic side) and is skipped.
 constexpr double kMinNormalLength = 1e-9;
 
-bool translate_sphere_nodes(std::size_t sphere, const SphereLinks& links, std::span<const double> inverse_mass_per_node,
+bool translate_sphere_nodes(std::size_t sphere, const SphereLinks& links,
+                            std::span<const double> inverse_mass_per_node,
                             const Eigen::Vector3d& dc_m, std::span<double> positions_m) {
   const auto nodes = links.nodes(sphere);
   const auto weights = links.weights(sphere);
@@ -69,7 +70,8 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
                                   const ProjectionSettings& settings, std::span<double> positions_m,
                                   std::span<const double> step_start_m) {
   ProjectionReport report;
-  const bool hold_at_start = settings.frozen_target == FrozenTarget::kStepStart && !step_start_m.empty();
+  const bool hold_at_start =
+      settings.frozen_target == FrozenTarget::kStepStart && !step_start_m.empty();
   for (const Contact& contact : contacts.contacts) {
     if (contact_is_projected(contact, settings)) ++report.constraints;
   }
@@ -89,8 +91,9 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
       const Eigen::Vector3d centre = links.centre(contact.sphere_id, positions_m.data());
       Eigen::Vector3d dc = Eigen::Vector3d::Zero();
       if (contact_is_frozen(contact)) {
-        const Eigen::Vector3d target =
-            hold_at_start ? links.centre(contact.sphere_id, step_start_m.data()) : contact.hold_centre_m;
+        const Eigen::Vector3d target = hold_at_start
+                                           ? links.centre(contact.sphere_id, step_start_m.data())
+                                           : contact.hold_centre_m;
         dc = target - centre;
       } else {
         const double length = contact.normal.norm();
@@ -99,11 +102,13 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
           continue;
         }
         const Eigen::Vector3d n = contact.normal / length;
-        const double gap = (centre - contact.plane_point_m).dot(n) - links.radius_m(contact.sphere_id);
+        const double gap =
+            (centre - contact.plane_point_m).dot(n) - links.radius_m(contact.sphere_id);
         if (gap >= 0.0) continue;  // inequality satisfied: no correction
         dc = -gap * n;
       }
-      if (!move_sphere_centre(contact.sphere_id, links, inverse_mass_per_node, dc, positions_m, settings.spread)) {
+      if (!move_sphere_centre(contact.sphere_id, links, inverse_mass_per_node, dc, positions_m,
+                              settings.spread)) {
         ++report.unmovable;
         continue;
       }

@@ -17,7 +17,9 @@ Eigen::Vector3d node(std::span<const double> x, std::uint32_t n) {
 
 double signed_volume(std::span<const double> positions_m, const Tet& t) {
   const Eigen::Vector3d x0 = node(positions_m, t[0]);
-  return (node(positions_m, t[1]) - x0).dot((node(positions_m, t[2]) - x0).cross(node(positions_m, t[3]) - x0)) / 6.0;
+  return (node(positions_m, t[1]) - x0)
+             .dot((node(positions_m, t[2]) - x0).cross(node(positions_m, t[3]) - x0)) /
+         6.0;
 }
 
 VolumeFloor::VolumeFloor(const ElementRest& rest, const VolumeFloorSettings& settings)
@@ -58,7 +60,8 @@ bool VolumeFloor::open(std::size_t e, std::span<double> positions_m,
   return true;
 }
 
-VolumeFloorReport VolumeFloor::project(std::span<double> positions_m, std::span<const double> inverse_mass_per_kg) {
+VolumeFloorReport VolumeFloor::project(std::span<double> positions_m,
+                                       std::span<const double> inverse_mass_per_kg) {
   VolumeFloorReport report;
   if (settings_.ratio <= 0.0) return report;
   for (int sweep = 0; sweep < settings_.max_sweeps; ++sweep) {
@@ -80,7 +83,8 @@ VolumeFloorReport VolumeFloor::project(std::span<double> positions_m, std::span<
   }
   // A count without moves, for the report.
   for (std::size_t e = 0; e < rest_.size(); ++e) {
-    if (signed_volume(positions_m, rest_.tets[e]) < kVolumeFloorSlack * floor_m3_[e]) ++report.unresolved;
+    if (signed_volume(positions_m, rest_.tets[e]) < kVolumeFloorSlack * floor_m3_[e])
+      ++report.unresolved;
   }
   return report;
 }

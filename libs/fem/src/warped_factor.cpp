@@ -12,10 +12,12 @@ void WarpedFactor::resize(std::size_t node_count) {
   current_.assign(node_count, Eigen::Matrix3d::Identity());
   at_factor_.assign(node_count, Eigen::Matrix3d::Identity());
   delta_.assign(node_count, Eigen::Matrix3d::Identity());
-  scratch_.setZero(static_cast<Eigen::Index>(3 * node_count));  // one column: solves rotate column by column
+  scratch_.setZero(
+      static_cast<Eigen::Index>(3 * node_count));  // one column: solves rotate column by column
 }
 
-void WarpedFactor::update_rotations(const ElementRest& rest, std::span<const Eigen::Matrix3d> element_rotations) {
+void WarpedFactor::update_rotations(const ElementRest& rest,
+                                    std::span<const Eigen::Matrix3d> element_rotations) {
   if (!enabled_) return;
   for (Eigen::Matrix3d& sum : sums_) sum.setZero();
   for (std::size_t e = 0; e < rest.size(); ++e) {
@@ -38,13 +40,15 @@ void WarpedFactor::mark_factorised() {
 
 void WarpedFactor::rotate_to_factor_frame(const double* in, double* out) const {
   for (std::size_t i = 0; i < delta_.size(); ++i) {
-    Eigen::Map<Eigen::Vector3d>(out + 3 * i) = delta_[i].transpose() * Eigen::Map<const Eigen::Vector3d>(in + 3 * i);
+    Eigen::Map<Eigen::Vector3d>(out + 3 * i) =
+        delta_[i].transpose() * Eigen::Map<const Eigen::Vector3d>(in + 3 * i);
   }
 }
 
 void WarpedFactor::rotate_to_current_frame(const double* in, double* out) const {
   for (std::size_t i = 0; i < delta_.size(); ++i) {
-    Eigen::Map<Eigen::Vector3d>(out + 3 * i) = delta_[i] * Eigen::Map<const Eigen::Vector3d>(in + 3 * i);
+    Eigen::Map<Eigen::Vector3d>(out + 3 * i) =
+        delta_[i] * Eigen::Map<const Eigen::Vector3d>(in + 3 * i);
   }
 }
 
@@ -60,7 +64,8 @@ void WarpedFactor::solve(CholmodSolver& factor, const double* b, double* x) {
   rotate_to_current_frame(scratch_.data(), x);
 }
 
-void WarpedFactor::solve_columns(CholmodSolver& factor, std::span<double> b, std::span<double> x, int columns) {
+void WarpedFactor::solve_columns(CholmodSolver& factor, std::span<double> b, std::span<double> x,
+                                 int columns) {
   const std::size_t n = 3 * delta_.size();
   const auto count = static_cast<std::size_t>(columns);
   if (enabled_) {

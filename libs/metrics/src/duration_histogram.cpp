@@ -10,7 +10,8 @@ DurationHistogram::DurationHistogram(std::chrono::nanoseconds bin_width) : bin_w
 
 void DurationHistogram::record(std::chrono::nanoseconds duration) {
   const std::int64_t ns = std::max<std::int64_t>(duration.count(), 0);
-  const auto bin = std::min<std::int64_t>(ns / bin_width_.count(), static_cast<std::int64_t>(kBins - 1));
+  const auto bin =
+      std::min<std::int64_t>(ns / bin_width_.count(), static_cast<std::int64_t>(kBins - 1));
   ++bins_[static_cast<std::size_t>(bin)];
   ++count_;
   sum_ += std::chrono::nanoseconds(ns);
@@ -33,7 +34,8 @@ std::chrono::nanoseconds DurationHistogram::percentile(double q) const {
   if (count_ == 0) return std::chrono::nanoseconds(0);
   const double clamped = std::clamp(q, 0.0, 1.0);
   // Rank of the sample at quantile q, 1-based (nearest-rank definition).
-  const auto rank = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(clamped * static_cast<double>(count_))));
+  const auto rank = std::max<std::uint64_t>(
+      1, static_cast<std::uint64_t>(std::ceil(clamped * static_cast<double>(count_))));
   std::uint64_t seen = 0;
   for (std::size_t bin = 0; bin < kBins; ++bin) {
     seen += bins_[bin];

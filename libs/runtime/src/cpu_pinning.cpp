@@ -16,7 +16,8 @@ namespace {
 int parse_cpu(std::string_view text, const std::string& list) {
   int cpu = -1;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), cpu);
-  if (text.empty() || error != std::errc() || end != text.data() + text.size() || cpu < 0 || cpu >= CPU_SETSIZE) {
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() || cpu < 0 ||
+      cpu >= CPU_SETSIZE) {
     throw std::invalid_argument("--cpus: '" + list + "': '" + std::string(text) +
                                 "' is not a CPU number (a list such as 0, 1,3 or 0-2)");
   }
@@ -45,7 +46,9 @@ std::vector<int> parse_cpu_list(const std::string& list) {
     } else {
       const int first = parse_cpu(item.substr(0, dash), list);
       const int last = parse_cpu(item.substr(dash + 1), list);
-      if (last < first) throw std::invalid_argument("--cpus: '" + list + "': range '" + std::string(item) + "' runs backwards");
+      if (last < first)
+        throw std::invalid_argument("--cpus: '" + list + "': range '" + std::string(item) +
+                                    "' runs backwards");
       for (int cpu = first; cpu <= last; ++cpu) cpus.push_back(cpu);
     }
     if (comma == std::string_view::npos) break;
@@ -64,14 +67,16 @@ void pin_to_cpus(const std::string& list) {
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
   if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0) {
-    throw std::runtime_error(std::string("--cpus: cannot read this process's CPUs: ") + std::strerror(errno));
+    throw std::runtime_error(std::string("--cpus: cannot read this process's CPUs: ") +
+                             std::strerror(errno));
   }
   cpu_set_t wanted;
   CPU_ZERO(&wanted);
   for (const int cpu : cpus) {
     if (!CPU_ISSET(cpu, &allowed)) {
-      throw std::invalid_argument("--cpus: CPU " + std::to_string(cpu) + " is not one this process may run on (" +
-                                  allowed_cpus(allowed) + ")");
+      throw std::invalid_argument("--cpus: CPU " + std::to_string(cpu) +
+                                  " is not one this process may run on (" + allowed_cpus(allowed) +
+                                  ")");
     }
     CPU_SET(cpu, &wanted);
   }

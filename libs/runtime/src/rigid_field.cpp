@@ -25,8 +25,8 @@ std::unique_ptr<RigidField> load_rigid_field(const scene::Body& body) {
   try {
     field->sdf = std::make_unique<geometry::SignedDistanceField>(field->surface, options);
   } catch (const std::exception& e) {
-    throw std::runtime_error("body '" + body.name + "' (" + body.mesh_path.string() + "): signed distance field: " +
-                             e.what());
+    throw std::runtime_error("body '" + body.name + "' (" + body.mesh_path.string() +
+                             "): signed distance field: " + e.what());
   }
   return field;
 }
@@ -34,7 +34,8 @@ std::unique_ptr<RigidField> load_rigid_field(const scene::Body& body) {
 std::vector<std::size_t> hard_obstacles_of(const scene::Scene& scene, std::size_t deformable) {
   std::vector<std::size_t> obstacles;
   for (const scene::BodyPair& pair : scene::derive_plan(scene).pairs) {
-    if (pair.kind == scene::PairKind::kHard && pair.first == deformable) obstacles.push_back(pair.second);
+    if (pair.kind == scene::PairKind::kHard && pair.first == deformable)
+      obstacles.push_back(pair.second);
   }
   return obstacles;
 }

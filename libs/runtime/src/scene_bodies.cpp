@@ -11,7 +11,8 @@ geometry::TetMesh world_tet_mesh(const scene::Body& body) {
   const geometry::TetMesh local = geometry::load_tet_mesh(body.mesh_path, body.mesh_scale);
   std::vector<Eigen::Vector3d> world;
   world.reserve(local.node_count());
-  for (const auto& p : local.rest_positions()) world.push_back(body.pose.position_m + body.pose.orientation * p);
+  for (const auto& p : local.rest_positions())
+    world.push_back(body.pose.position_m + body.pose.orientation * p);
   return geometry::TetMesh(std::move(world), local.tets());
 }
 

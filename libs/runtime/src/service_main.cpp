@@ -10,7 +10,8 @@
 
 namespace fahr::runtime {
 
-int run_service_main(const char* service_name, int (*run)(int argc, char** argv), int argc, char** argv) {
+int run_service_main(const char* service_name, int (*run)(int argc, char** argv), int argc,
+                     char** argv) {
   try {
     return run(argc, argv);
   } catch (const scene::SceneError& e) {

@@ -18,11 +18,13 @@ void add_service_options(CLI::App& app, ServiceOptions& o) {
   app.add_option("--dds", o.dds, "DDS vendor: fastdds, cyclonedds, inprocess");
   app.add_option("--domain", o.domain, "DDS domain id 0-230");
   app.add_option("--dds-profile", o.profile, "vendor XML configuration");
-  app.add_option("--duration-s", o.duration_s,
-                 "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");
+  app.add_option(
+      "--duration-s", o.duration_s,
+      "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");
   app.add_option("--mode", o.mode, "realtime or lockstep (default: the scene's run.mode)")
       ->check(CLI::IsMember({"realtime", "lockstep"}));
-  app.add_option("--cpus", o.cpus, "run on these CPUs only, e.g. 0 or 0-1 (default: wherever the kernel puts it)");
+  app.add_option("--cpus", o.cpus,
+                 "run on these CPUs only, e.g. 0 or 0-1 (default: wherever the kernel puts it)");
 }
 
 }  // namespace fahr::runtime

@@ -242,11 +242,11 @@ std::optional<DeviceSettings> parse_device(const ParseContext& ctx, const MapRea
 FemSolverSettings parse_solver(const ParseContext& ctx, const MapReader& top) {
   FemSolverSettings s;
   if (!top.has("solver")) return s;
-  const MapReader map(ctx.log, top.value("solver"), "solver",
-                      {"linear_solver", "cg_tolerance", "cg_max_iterations",
-                       "projection_max_iterations", "projection_tolerance_m", "compliance", "compliance_columns",
-                       "max_candidate_contacts", "max_contact_age_ms", "sleep_speed_mps",
-                       "volume_floor_ratio"});
+  const MapReader map(
+      ctx.log, top.value("solver"), "solver",
+      {"linear_solver", "cg_tolerance", "cg_max_iterations", "projection_max_iterations",
+       "projection_tolerance_m", "compliance", "compliance_columns", "max_candidate_contacts",
+       "max_contact_age_ms", "sleep_speed_mps", "volume_floor_ratio"});
   map.read_enum("linear_solver", kLinearSolverNames, s.linear_solver);
   if (s.linear_solver != LinearSolver::kPcg) {
     for (const char* key : {"cg_tolerance", "cg_max_iterations"}) {

@@ -10,7 +10,7 @@ namespace fahr::sphere_layout::detail {
 
 struct CandidateSphere {
   Eigen::Vector3d centre_m = Eigen::Vector3d::Zero();  // m
-  double radius_m = 0.0;                                // m
+  double radius_m = 0.0;                               // m
   std::uint8_t level = 0;
   SphereOrigin origin = SphereOrigin::kGrid;
 };

@@ -23,8 +23,9 @@ constexpr int kOuterProbeVoxels = 3;
 
 class VoxelOutside {
  public:
-  VoxelOutside(std::span<const Eigen::Vector3d> centres, std::span<const double> radii, double voxel,
-               std::size_t max_voxels) : voxel_(voxel) {
+  VoxelOutside(std::span<const Eigen::Vector3d> centres, std::span<const double> radii,
+               double voxel, std::size_t max_voxels)
+      : voxel_(voxel) {
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector3d hi = -lo;
     for (std::size_t i = 0; i < centres.size(); ++i) {
@@ -39,7 +40,8 @@ class VoxelOutside {
       total *= dims_[a];
     }
     if (total > static_cast<double>(max_voxels)) {
-      throw std::invalid_argument("coverage: voxel_size_m gives more voxels than max_voxels; raise voxel_size_m");
+      throw std::invalid_argument(
+          "coverage: voxel_size_m gives more voxels than max_voxels; raise voxel_size_m");
     }
     state_.assign(static_cast<std::size_t>(total), kFree);
     for (std::size_t s = 0; s < centres.size(); ++s) rasterise(centres[s], radii[s]);
@@ -62,12 +64,14 @@ class VoxelOutside {
   std::size_t index(int i, int j, int k) const {
     return static_cast<std::size_t>(i) +
            static_cast<std::size_t>(dims_.x()) *
-               (static_cast<std::size_t>(j) + static_cast<std::size_t>(dims_.y()) * static_cast<std::size_t>(k));
+               (static_cast<std::size_t>(j) +
+                static_cast<std::size_t>(dims_.y()) * static_cast<std::size_t>(k));
   }
   std::size_t voxel_of(const Eigen::Vector3d& p) const {
     int c[3];
     for (int a = 0; a < 3; ++a) {
-      c[a] = std::clamp(static_cast<int>(std::floor((p[a] - origin_[a]) / voxel_)), 0, dims_[a] - 1);
+      c[a] =
+          std::clamp(static_cast<int>(std::floor((p[a] - origin_[a]) / voxel_)), 0, dims_[a] - 1);
     }
     return index(c[0], c[1], c[2]);
   }
@@ -75,12 +79,14 @@ class VoxelOutside {
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::max(0, static_cast<int>(std::floor((c[a] - r - origin_[a]) / voxel_)));
-      hi[a] = std::min(dims_[a] - 1, static_cast<int>(std::floor((c[a] + r - origin_[a]) / voxel_)));
+      hi[a] =
+          std::min(dims_[a] - 1, static_cast<int>(std::floor((c[a] + r - origin_[a]) / voxel_)));
     }
     for (int k = lo[2]; k <= hi[2]; ++k)
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) {
-          const Eigen::Vector3d centre = origin_ + voxel_ * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
+          const Eigen::Vector3d centre =
+              origin_ + voxel_ * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
           if ((centre - c).squaredNorm() < r * r) state_[index(i, j, k)] = kOccupied;
         }
   }
@@ -93,9 +99,11 @@ class VoxelOutside {
     for (std::size_t head = 0; head < queue.size(); ++head) {
       const std::uint32_t v = queue[head];
       const int i = static_cast<int>(v % static_cast<std::uint32_t>(nx));
-      const int j = static_cast<int>((v / static_cast<std::uint32_t>(nx)) % static_cast<std::uint32_t>(ny));
+      const int j =
+          static_cast<int>((v / static_cast<std::uint32_t>(nx)) % static_cast<std::uint32_t>(ny));
       const int k = static_cast<int>(v / static_cast<std::uint32_t>(nx * ny));
-      const int next[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+      const int next[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                              {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
       for (const auto& n : next) {
         if (n[0] < 0 || n[1] < 0 || n[2] < 0 || n[0] >= nx || n[1] >= ny || n[2] >= nz) continue;
         const std::size_t w = index(n[0], n[1], n[2]);
@@ -123,18 +131,21 @@ Eigen::Vector3d fibonacci_direction(std::size_t k, std::size_t n) {
 
 }  // namespace
 
-CoverageReport measure_coverage(std::span<const Eigen::Vector3d> centres_m, std::span<const double> radii_m,
+CoverageReport measure_coverage(std::span<const Eigen::Vector3d> centres_m,
+                                std::span<const double> radii_m,
                                 const geometry::SurfaceMesh& boundary,
                                 const geometry::SignedDistanceField& boundary_sdf,
                                 const CoverageSettings& settings, CoverageOutliers* outliers) {
   if (centres_m.empty() || centres_m.size() != radii_m.size() || boundary.triangle_count() == 0) {
-    throw std::invalid_argument("coverage: no spheres, or no boundary triangles, or centres and radii differ in count");
+    throw std::invalid_argument(
+        "coverage: no spheres, or no boundary triangles, or centres and radii differ in count");
   }
   if (!(settings.sample_spacing_m > 0.0) || !(settings.voxel_size_m > 0.0)) {
     throw std::invalid_argument("coverage: sample_spacing_m and voxel_size_m must be > 0 (m)");
   }
   const double max_radius = *std::max_element(radii_m.begin(), radii_m.end());
-  const detail::SphereHash hash(centres_m, radii_m, std::max(2.0 * max_radius, 4.0 * settings.sample_spacing_m));
+  const detail::SphereHash hash(centres_m, radii_m,
+                                std::max(2.0 * max_radius, 4.0 * settings.sample_spacing_m));
   CoverageReport report;
   if (outliers != nullptr) {
     outliers->boundary_points_m.clear();
@@ -175,7 +186,8 @@ CoverageReport measure_coverage(std::span<const Eigen::Vector3d> centres_m, std:
     }
   }
   report.boundary_to_union_mean_m = sum / static_cast<double>(report.boundary_samples);
-  const std::size_t rank = gaps.size() - 1 - gaps.size() / 1000;  // nearest rank of the 99.9th percentile
+  const std::size_t rank =
+      gaps.size() - 1 - gaps.size() / 1000;  // nearest rank of the 99.9th percentile
   std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(rank), gaps.end());
   report.boundary_to_union_p999_m = gaps[rank];
 
@@ -186,8 +198,9 @@ CoverageReport measure_coverage(std::span<const Eigen::Vector3d> centres_m, std:
     const double r = radii_m[s];
     const double area = 4.0 * std::numbers::pi * r * r;
     const auto n = std::clamp<std::size_t>(
-        static_cast<std::size_t>(std::ceil(area / (settings.sample_spacing_m * settings.sample_spacing_m))), 12,
-        settings.max_samples_per_sphere);
+        static_cast<std::size_t>(
+            std::ceil(area / (settings.sample_spacing_m * settings.sample_spacing_m))),
+        12, settings.max_samples_per_sphere);
     for (std::size_t k = 0; k < n; ++k) {
       const Eigen::Vector3d dir = fibonacci_direction(k, n);
       const Eigen::Vector3d p = centres_m[s] + r * dir;
@@ -203,7 +216,8 @@ CoverageReport measure_coverage(std::span<const Eigen::Vector3d> centres_m, std:
       if (outliers != nullptr && d > outliers->threshold_m) outliers->union_points_m.push_back(p);
     }
   }
-  report.union_to_boundary_mean_m = report.union_samples > 0 ? sum / static_cast<double>(report.union_samples) : 0.0;
+  report.union_to_boundary_mean_m =
+      report.union_samples > 0 ? sum / static_cast<double>(report.union_samples) : 0.0;
   return report;
 }
 

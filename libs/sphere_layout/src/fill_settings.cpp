@@ -29,12 +29,14 @@ void validate_fill_settings(const FillSettings& s) {
           "[1, 64]");
   require(std::isfinite(s.weight_spread) && s.weight_spread >= 0.0 && s.weight_spread < 1.0,
           "weight_spread", s.weight_spread, "[0, 1)");
-  require(std::isfinite(s.hugging_weight_spread) && s.hugging_weight_spread >= 0.0 && s.hugging_weight_spread < 1.0,
+  require(std::isfinite(s.hugging_weight_spread) && s.hugging_weight_spread >= 0.0 &&
+              s.hugging_weight_spread < 1.0,
           "hugging_weight_spread", s.hugging_weight_spread, "[0, 1)");
   require(std::isfinite(s.hugging_anchor_depth_factor) && s.hugging_anchor_depth_factor >= 1.0 &&
               s.hugging_anchor_depth_factor <= 8.0,
           "hugging_anchor_depth_factor", s.hugging_anchor_depth_factor, "[1, 8]");
-  require(s.anchor_gap_m >= 0.0, "anchor_gap_m", s.anchor_gap_m, ">= 0 (m) or +infinity");  // NaN fails
+  require(s.anchor_gap_m >= 0.0, "anchor_gap_m", s.anchor_gap_m,
+          ">= 0 (m) or +infinity");  // NaN fails
   require(std::isfinite(s.min_radius_fraction) && s.min_radius_fraction >= 0.0 &&
               s.min_radius_fraction <= 1.0,
           "min_radius_fraction", s.min_radius_fraction, "[0, 1]");

@@ -22,7 +22,8 @@ namespace {
 // speeds up the far field, so a coarse one (half a coarse radius) is enough.
 constexpr double kSdfCellPerCoarseRadius = 0.5;
 
-geometry::SurfaceMesh checked_boundary(const geometry::TetMesh& mesh, std::vector<geometry::Index>& surface_to_node) {
+geometry::SurfaceMesh checked_boundary(const geometry::TetMesh& mesh,
+                                       std::vector<geometry::Index>& surface_to_node) {
   if (mesh.tet_count() == 0 || mesh.node_count() == 0) {
     throw std::invalid_argument("sphere filling: the tet mesh is empty (0 tets); nothing to fill");
   }
@@ -51,7 +52,8 @@ detail::SphereLink anchored_link(detail::TetLinker& linker, const detail::Candid
     return linker.link(c.centre_m, c.radius_m, 0.0);
   }
   const Eigen::Vector3d weights(tangent.weights[0], tangent.weights[1], tangent.weights[2]);
-  return linker.link_anchored(c.centre_m, c.radius_m, tangent.rest_point_m, tangent.nodes, weights, depth_factor);
+  return linker.link_anchored(c.centre_m, c.radius_m, tangent.rest_point_m, tangent.nodes, weights,
+                              depth_factor);
 }
 
 }  // namespace
@@ -80,7 +82,8 @@ SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& set
   }
   if (candidates.empty()) {
     throw std::invalid_argument(
-        "sphere filling: no sphere fits in the mesh; lower volume_ratio or raise refinement_levels");
+        "sphere filling: no sphere fits in the mesh; lower volume_ratio or raise "
+        "refinement_levels");
   }
 
   detail::TetLinker linker(mesh, settings.max_linked_tets);
@@ -91,12 +94,14 @@ SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& set
   std::vector<std::uint8_t> has_anchor(candidates.size(), 0);
   records.reserve(candidates.size());
   for (const auto& c : candidates) {
-    const double spread =
-        c.origin == SphereOrigin::kHugging ? settings.hugging_weight_spread : settings.weight_spread;
-    const bool anchored = c.origin == SphereOrigin::kHugging && settings.hugging_anchor_depth_factor > 1.0;
-    const detail::SphereLink link = anchored ? anchored_link(linker, c, boundary, surface_to_node, sdf,
-                                                             settings.hugging_anchor_depth_factor)
-                                             : linker.link(c.centre_m, c.radius_m, spread);
+    const double spread = c.origin == SphereOrigin::kHugging ? settings.hugging_weight_spread
+                                                             : settings.weight_spread;
+    const bool anchored =
+        c.origin == SphereOrigin::kHugging && settings.hugging_anchor_depth_factor > 1.0;
+    const detail::SphereLink link = anchored
+                                        ? anchored_link(linker, c, boundary, surface_to_node, sdf,
+                                                        settings.hugging_anchor_depth_factor)
+                                        : linker.link(c.centre_m, c.radius_m, spread);
     SphereRecord r;
     r.rest_centre_m = link.centre_m;
     r.rest_radius_m = c.radius_m;
@@ -106,21 +111,22 @@ SphereLayout fill_spheres(const geometry::TetMesh& mesh, const FillSettings& set
     r.link_count = static_cast<std::uint32_t>(link.nodes.size());
     r.first_tet = static_cast<std::uint32_t>(tets.size());
     r.tet_count = static_cast<std::uint32_t>(link.tets.size());
-    for (const std::uint32_t t : link.tets) r.rest_linked_volume_m3 += mesh.rest_data()[t].volume_m3;
+    for (const std::uint32_t t : link.tets)
+      r.rest_linked_volume_m3 += mesh.rest_data()[t].volume_m3;
     nodes.insert(nodes.end(), link.nodes.begin(), link.nodes.end());
     weights.insert(weights.end(), link.weights.begin(), link.weights.end());
     tets.insert(tets.end(), link.tets.begin(), link.tets.end());
     // The anchor of the centre as linked (the point the FEM moves).
     const std::size_t i = records.size();
-    has_anchor[i] = settings.surface_anchors &&
-                            detail::nearest_face_point(boundary, surface_to_node, sdf, link.centre_m,
-                                                       c.radius_m + settings.anchor_gap_m, anchors[i])
+    has_anchor[i] = settings.surface_anchors && detail::nearest_face_point(
+                                                    boundary, surface_to_node, sdf, link.centre_m,
+                                                    c.radius_m + settings.anchor_gap_m, anchors[i])
                         ? 1
                         : 0;
     records.push_back(r);
   }
-  SphereLayout layout(std::move(records), std::move(nodes), std::move(weights), std::move(tets), mesh.tets(),
-                      mesh.node_count(), settings.refinement_levels, coarse_radius);
+  SphereLayout layout(std::move(records), std::move(nodes), std::move(weights), std::move(tets),
+                      mesh.tets(), mesh.node_count(), settings.refinement_levels, coarse_radius);
   layout.set_anchors(std::move(anchors), std::move(has_anchor));
   return layout;
 }

@@ -37,7 +37,8 @@ struct Filler {
     if (level < settings.refinement_levels) {
       const double child = 0.5 * edge;
       for (int k = 0; k < 8; ++k) {
-        const Eigen::Vector3d offset((k & 1) ? 0.5 : -0.5, (k & 2) ? 0.5 : -0.5, (k & 4) ? 0.5 : -0.5);
+        const Eigen::Vector3d offset((k & 1) ? 0.5 : -0.5, (k & 2) ? 0.5 : -0.5,
+                                     (k & 4) ? 0.5 : -0.5);
         visit(centre + child * offset, child, level + 1);
       }
       return;
@@ -67,14 +68,13 @@ std::vector<CandidateSphere> octree_fill(const geometry::SignedDistanceField& bo
   // budget early keeps a bad ratio from running for minutes.
   if (cell_count > 64.0 * static_cast<double>(settings.max_spheres)) {
     std::ostringstream message;
-    message << "sphere filling: volume_ratio = " << settings.volume_ratio << " gives "
-            << cell_count << " coarse cells, far beyond max_spheres = " << settings.max_spheres;
+    message << "sphere filling: volume_ratio = " << settings.volume_ratio << " gives " << cell_count
+            << " coarse cells, far beyond max_spheres = " << settings.max_spheres;
     throw std::invalid_argument(message.str());
   }
   // The grid is centred on the box, so the result does not depend on where
   // the box starts.
-  const Eigen::Vector3d origin =
-      0.5 * (box_min_m + box_max_m) - 0.5 * edge * cells.cast<double>();
+  const Eigen::Vector3d origin = 0.5 * (box_min_m + box_max_m) - 0.5 * edge * cells.cast<double>();
   std::vector<CandidateSphere> out;
   Filler filler{boundary_sdf, settings, out};
   for (int k = 0; k < cells.z(); ++k) {

@@ -21,7 +21,8 @@ SphereHash::SphereHash(std::span<const Eigen::Vector3d> centres_m, std::span<con
     hi = hi.cwiseMax(centres_[i] + Eigen::Vector3d::Constant(radii_[i]));
   }
   origin_ = lo;
-  for (int a = 0; a < 3; ++a) dims_[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo[a]) / cell_m_)) + 1);
+  for (int a = 0; a < 3; ++a)
+    dims_[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo[a]) / cell_m_)) + 1);
   const std::size_t cells = static_cast<std::size_t>(dims_.x()) * dims_.y() * dims_.z();
   std::vector<std::uint32_t> count(cells, 0);
   for (int pass = 0; pass < 2; ++pass) {
@@ -57,7 +58,8 @@ Eigen::Vector3i SphereHash::cell_of(const Eigen::Vector3d& p) const {
   return c;
 }
 
-bool SphereHash::covered_by_other(const Eigen::Vector3d& p, std::uint32_t self, double slack_m) const {
+bool SphereHash::covered_by_other(const Eigen::Vector3d& p, std::uint32_t self,
+                                  double slack_m) const {
   if (centres_.empty()) return false;
   const Eigen::Vector3i c = cell_of(p);
   const std::size_t cell = index(c.x(), c.y(), c.z());
@@ -88,7 +90,8 @@ double SphereHash::distance_to_union(const Eigen::Vector3d& p, double reach_m) c
 
 double SphereHash::distance_to_union_brute_force(const Eigen::Vector3d& p) const {
   double best = std::numeric_limits<double>::infinity();
-  for (std::size_t s = 0; s < centres_.size(); ++s) best = std::min(best, (p - centres_[s]).norm() - radii_[s]);
+  for (std::size_t s = 0; s < centres_.size(); ++s)
+    best = std::min(best, (p - centres_[s]).norm() - radii_[s]);
   return best;
 }
 

@@ -12,7 +12,8 @@ namespace fahr::sphere_layout::detail {
 
 class SphereHash {
  public:
-  SphereHash(std::span<const Eigen::Vector3d> centres_m, std::span<const double> radii_m, double cell_m);
+  SphereHash(std::span<const Eigen::Vector3d> centres_m, std::span<const double> radii_m,
+             double cell_m);
 
   // True if p lies strictly inside a sphere other than `self` by more than `slack_m`.
   bool covered_by_other(const Eigen::Vector3d& p, std::uint32_t self, double slack_m) const;
@@ -27,7 +28,8 @@ class SphereHash {
   std::size_t index(int i, int j, int k) const {
     return static_cast<std::size_t>(i) +
            static_cast<std::size_t>(dims_.x()) *
-               (static_cast<std::size_t>(j) + static_cast<std::size_t>(dims_.y()) * static_cast<std::size_t>(k));
+               (static_cast<std::size_t>(j) +
+                static_cast<std::size_t>(dims_.y()) * static_cast<std::size_t>(k));
   }
 
   std::span<const Eigen::Vector3d> centres_;

@@ -38,8 +38,8 @@ void hash_record(std::uint64_t& hash, const SphereRecord& s) {
 
 SphereLayout::SphereLayout(std::vector<SphereRecord> spheres, std::vector<std::uint32_t> link_nodes,
                            std::vector<double> link_weights, std::vector<std::uint32_t> linked_tets,
-                           std::vector<geometry::Tet> tets, std::size_t node_count, int finest_level,
-                           double coarse_radius_m)
+                           std::vector<geometry::Tet> tets, std::size_t node_count,
+                           int finest_level, double coarse_radius_m)
     : spheres_(std::move(spheres)),
       link_nodes_(std::move(link_nodes)),
       link_weights_(std::move(link_weights)),
@@ -75,11 +75,13 @@ SphereLayout::SphereLayout(std::vector<SphereRecord> spheres, std::vector<std::u
   }
 }
 
-void SphereLayout::set_anchors(std::vector<SurfaceAnchor> anchors, std::vector<std::uint8_t> has_anchor) {
-  if (anchors.size() != has_anchor.size() || (!anchors.empty() && anchors.size() != spheres_.size())) {
-    throw std::invalid_argument("sphere layout: " + std::to_string(anchors.size()) + " anchors and " +
-                                std::to_string(has_anchor.size()) + " flags for " + std::to_string(spheres_.size()) +
-                                " spheres");
+void SphereLayout::set_anchors(std::vector<SurfaceAnchor> anchors,
+                               std::vector<std::uint8_t> has_anchor) {
+  if (anchors.size() != has_anchor.size() ||
+      (!anchors.empty() && anchors.size() != spheres_.size())) {
+    throw std::invalid_argument("sphere layout: " + std::to_string(anchors.size()) +
+                                " anchors and " + std::to_string(has_anchor.size()) +
+                                " flags for " + std::to_string(spheres_.size()) + " spheres");
   }
   for (std::size_t i = 0; i < anchors.size(); ++i) {
     if (has_anchor[i] == 0) continue;
@@ -102,7 +104,8 @@ void SphereLayout::set_anchors(std::vector<SurfaceAnchor> anchors, std::vector<s
 }
 
 std::size_t SphereLayout::anchor_count() const {
-  return static_cast<std::size_t>(std::count_if(has_anchor_.begin(), has_anchor_.end(), [](std::uint8_t f) { return f != 0; }));
+  return static_cast<std::size_t>(
+      std::count_if(has_anchor_.begin(), has_anchor_.end(), [](std::uint8_t f) { return f != 0; }));
 }
 
 std::size_t SphereLayout::count(SphereOrigin origin) const {
@@ -111,9 +114,9 @@ std::size_t SphereLayout::count(SphereOrigin origin) const {
 }
 
 std::size_t SphereLayout::count_at_level(int level) const {
-  return static_cast<std::size_t>(std::count_if(spheres_.begin(), spheres_.end(), [&](const SphereRecord& s) {
-    return s.origin == SphereOrigin::kGrid && s.level == level;
-  }));
+  return static_cast<std::size_t>(std::count_if(
+      spheres_.begin(), spheres_.end(),
+      [&](const SphereRecord& s) { return s.origin == SphereOrigin::kGrid && s.level == level; }));
 }
 
 std::uint64_t SphereLayout::fingerprint() const {
@@ -127,7 +130,8 @@ std::uint64_t SphereLayout::fingerprint() const {
     hash_bytes(hash, anchors_[i].nodes.data(), 3 * sizeof(std::uint32_t));
     hash_bytes(hash, anchors_[i].weights.data(), 3 * sizeof(double));
     hash_bytes(hash, anchors_[i].rest_point_m.data(), 3 * sizeof(double));
-    for (const Eigen::Vector3d& p : anchors_[i].rest_face_m) hash_bytes(hash, p.data(), 3 * sizeof(double));
+    for (const Eigen::Vector3d& p : anchors_[i].rest_face_m)
+      hash_bytes(hash, p.data(), 3 * sizeof(double));
   }
   return hash;
 }

@@ -19,9 +19,11 @@ namespace fahr::sphere_layout::detail {
 // `reach_m` (m; +infinity: anywhere), as a SurfaceAnchor whose nodes are the
 // tet mesh's (surface_to_node). False when none lies within the reach or the
 // face is degenerate.
-inline bool nearest_face_point(const geometry::SurfaceMesh& boundary, const std::vector<geometry::Index>& surface_to_node,
-                        const geometry::SignedDistanceField& sdf, const Eigen::Vector3d& centre_m, double reach_m,
-                        SurfaceAnchor& out) {
+inline bool nearest_face_point(const geometry::SurfaceMesh& boundary,
+                               const std::vector<geometry::Index>& surface_to_node,
+                               const geometry::SignedDistanceField& sdf,
+                               const Eigen::Vector3d& centre_m, double reach_m,
+                               SurfaceAnchor& out) {
   const double reach_squared = std::isinf(reach_m) ? reach_m : reach_m * reach_m;
   const geometry::BvhClosestPoint hit = sdf.bvh().closest_point(centre_m, reach_squared);
   if (hit.triangle < 0) return false;

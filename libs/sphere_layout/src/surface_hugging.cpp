@@ -57,7 +57,9 @@ class AddedSpheres {
   }
   double distance(const Eigen::Vector3d& p) const {
     double best = std::numeric_limits<double>::infinity();
-    visit(p, [&](std::size_t s) { best = std::min(best, (p - spheres_[s].centre_m).norm() - spheres_[s].radius_m); });
+    visit(p, [&](std::size_t s) {
+      best = std::min(best, (p - spheres_[s].centre_m).norm() - spheres_[s].radius_m);
+    });
     return best;
   }
 
@@ -74,7 +76,8 @@ class AddedSpheres {
         }
   }
   Eigen::Vector3i cell(const Eigen::Vector3d& p) const {
-    return {static_cast<int>(std::floor(p.x() / cell_)), static_cast<int>(std::floor(p.y() / cell_)),
+    return {static_cast<int>(std::floor(p.x() / cell_)),
+            static_cast<int>(std::floor(p.y() / cell_)),
             static_cast<int>(std::floor(p.z() / cell_))};
   }
   static std::int64_t key(const Eigen::Vector3i& c) {
@@ -115,14 +118,15 @@ void add_surface_hugging_spheres(std::vector<CandidateSphere>& spheres,
     // First round: samples closer than the spacing of a triangular lattice of
     // r_h spheres whose holes are within the tolerance are left to their
     // neighbours' spheres (a Poisson-disc pick); later rounds fill what is left.
-    const double lattice = std::sqrt(3.0) *
-                           std::sqrt(hugging_radius_m * hugging_radius_m -
-                                     std::pow(std::max(0.0, hugging_radius_m - tolerance), 2.0));
+    const double lattice =
+        std::sqrt(3.0) * std::sqrt(hugging_radius_m * hugging_radius_m -
+                                   std::pow(std::max(0.0, hugging_radius_m - tolerance), 2.0));
     const double min_spacing = round == 0 ? kPoissonFraction * lattice : 0.0;
     auto push = [&](const CandidateSphere& sphere, const Eigen::Vector3d& anchor) {
       if (spheres.size() >= settings.max_spheres) {
         std::ostringstream message;
-        message << "sphere filling: surface-hugging spheres pass max_spheres = " << settings.max_spheres
+        message << "sphere filling: surface-hugging spheres pass max_spheres = "
+                << settings.max_spheres
                 << " (hugging_tolerance_m = " << settings.hugging_tolerance_m
                 << ", refinement_levels = " << settings.refinement_levels
                 << "); raise max_spheres or hugging_tolerance_m";
@@ -168,7 +172,8 @@ void add_surface_hugging_spheres(std::vector<CandidateSphere>& spheres,
       if (best.radius_m > 0.0) push(best, p);
     };
     for (std::size_t k = 0; k < outliers.boundary_points_m.size(); ++k) {
-      place(outliers.boundary_points_m[k], outliers.boundary_normals[k], outliers.boundary_gaps_m[k]);
+      place(outliers.boundary_points_m[k], outliers.boundary_normals[k],
+            outliers.boundary_gaps_m[k]);
     }
     for (const Eigen::Vector3d& u : outliers.union_points_m) {
       const geometry::SdfSample s = boundary_sdf.query_exact(u);

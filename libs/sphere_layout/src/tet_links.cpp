@@ -48,9 +48,9 @@ TetLinker::TetLinker(const geometry::TetMesh& mesh, int max_linked_tets)
   }
   const std::size_t cell_count = static_cast<std::size_t>(dims_.x()) * dims_.y() * dims_.z();
   auto index = [&](const Eigen::Vector3i& c) {
-    return static_cast<std::size_t>(c.x()) + static_cast<std::size_t>(dims_.x()) *
-                                                  (static_cast<std::size_t>(c.y()) +
-                                                   static_cast<std::size_t>(dims_.y()) * c.z());
+    return static_cast<std::size_t>(c.x()) +
+           static_cast<std::size_t>(dims_.x()) *
+               (static_cast<std::size_t>(c.y()) + static_cast<std::size_t>(dims_.y()) * c.z());
   };
   // Two passes (count, fill): a compressed layout, tets in index order per cell.
   std::vector<std::uint32_t> counts(cell_count + 1, 0);
@@ -94,9 +94,10 @@ void TetLinker::candidates(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
   for (int k = a.z(); k <= b.z(); ++k)
     for (int j = a.y(); j <= b.y(); ++j)
       for (int i = a.x(); i <= b.x(); ++i) {
-        const std::size_t c = static_cast<std::size_t>(i) +
-                              static_cast<std::size_t>(dims_.x()) *
-                                  (static_cast<std::size_t>(j) + static_cast<std::size_t>(dims_.y()) * k);
+        const std::size_t c =
+            static_cast<std::size_t>(i) +
+            static_cast<std::size_t>(dims_.x()) *
+                (static_cast<std::size_t>(j) + static_cast<std::size_t>(dims_.y()) * k);
         for (std::uint32_t e = cell_start_[c]; e < cell_start_[c + 1]; ++e) {
           const std::uint32_t t = cell_tets_[e];
           if (stamp_[t] == current_stamp_) continue;
@@ -126,17 +127,20 @@ double TetLinker::distance_to_tet(std::uint32_t tet, const Eigen::Vector3d& p) c
 }
 
 SphereLink TetLinker::link(const Eigen::Vector3d& centre_m, double radius_m, double weight_spread) {
-  candidates(centre_m - Eigen::Vector3d::Constant(radius_m), centre_m + Eigen::Vector3d::Constant(radius_m));
+  candidates(centre_m - Eigen::Vector3d::Constant(radius_m),
+             centre_m + Eigen::Vector3d::Constant(radius_m));
   std::vector<std::pair<double, std::uint32_t>> near;
   for (const std::uint32_t t : found_) {
     const double d = distance_to_tet(t, centre_m);
     if (d <= radius_m) near.emplace_back(d, t);
   }
   if (near.empty()) {  // a centre outside every tet's reach: the nearest tet of all
-    for (std::uint32_t t = 0; t < mesh_.tet_count(); ++t) near.emplace_back(distance_to_tet(t, centre_m), t);
+    for (std::uint32_t t = 0; t < mesh_.tet_count(); ++t)
+      near.emplace_back(distance_to_tet(t, centre_m), t);
   }
   std::sort(near.begin(), near.end());
-  if (near.size() > static_cast<std::size_t>(max_linked_)) near.resize(static_cast<std::size_t>(max_linked_));
+  if (near.size() > static_cast<std::size_t>(max_linked_))
+    near.resize(static_cast<std::size_t>(max_linked_));
 
   // The holding tet: among those at distance 0 the one with the largest
   // smallest barycentric coordinate (the best conditioned); else the nearest.
@@ -188,7 +192,8 @@ SphereLink TetLinker::link(const Eigen::Vector3d& centre_m, double radius_m, dou
   return link;
 }
 
-void TetLinker::set_weights(const std::map<std::uint32_t, double>& weights, SphereLink& link) const {
+void TetLinker::set_weights(const std::map<std::uint32_t, double>& weights,
+                            SphereLink& link) const {
   double sum = 0.0;
   for (const auto& [node, w] : weights) {
     if (w <= 0.0) continue;
@@ -199,7 +204,8 @@ void TetLinker::set_weights(const std::map<std::uint32_t, double>& weights, Sphe
   const auto& x = mesh_.rest_positions();
   for (double& w : link.weights) w /= sum;
   link.centre_m = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < link.nodes.size(); ++k) link.centre_m += link.weights[k] * x[link.nodes[k]];
+  for (std::size_t k = 0; k < link.nodes.size(); ++k)
+    link.centre_m += link.weights[k] * x[link.nodes[k]];
 }
 
 std::int64_t TetLinker::holding_tet(const Eigen::Vector3d& p) {
@@ -216,24 +222,30 @@ std::int64_t TetLinker::holding_tet(const Eigen::Vector3d& p) {
   return best;
 }
 
-SphereLink TetLinker::link_anchored(const Eigen::Vector3d& centre_m, double radius_m, const Eigen::Vector3d& anchor_m,
+SphereLink TetLinker::link_anchored(const Eigen::Vector3d& centre_m, double radius_m,
+                                    const Eigen::Vector3d& anchor_m,
                                     const std::array<std::uint32_t, 3>& face_nodes,
                                     const Eigen::Vector3d& face_weights, double depth_factor) {
   SphereLink plain = link(centre_m, radius_m, 0.0);
   const Eigen::Vector3d down = centre_m - anchor_m;
   double k = depth_factor;
   std::int64_t tet = -1;
-  for (int attempt = 0; attempt < kAnchorAttempts && k > 1.0 + kMinAnchorShare; ++attempt, k = 1.0 + 0.5 * (k - 1.0)) {
+  for (int attempt = 0; attempt < kAnchorAttempts && k > 1.0 + kMinAnchorShare;
+       ++attempt, k = 1.0 + 0.5 * (k - 1.0)) {
     tet = holding_tet(anchor_m + k * down);
     if (tet >= 0) break;
   }
   if (tet < 0) return plain;
-  const Eigen::Vector4d inner = barycentric(static_cast<std::uint32_t>(tet), anchor_m + k * down).cwiseMax(0.0);
+  const Eigen::Vector4d inner =
+      barycentric(static_cast<std::uint32_t>(tet), anchor_m + k * down).cwiseMax(0.0);
   const double inner_share = 1.0 / k;
   std::map<std::uint32_t, double> weights;
-  for (int j = 0; j < 3; ++j) weights[face_nodes[static_cast<std::size_t>(j)]] += (1.0 - inner_share) * std::max(0.0, face_weights[j]);
+  for (int j = 0; j < 3; ++j)
+    weights[face_nodes[static_cast<std::size_t>(j)]] +=
+        (1.0 - inner_share) * std::max(0.0, face_weights[j]);
   const auto& ht = mesh_.tets()[static_cast<std::size_t>(tet)];
-  for (int j = 0; j < 4; ++j) weights[static_cast<std::uint32_t>(ht[j])] += inner_share * inner[j] / inner.sum();
+  for (int j = 0; j < 4; ++j)
+    weights[static_cast<std::uint32_t>(ht[j])] += inner_share * inner[j] / inner.sum();
   SphereLink out;
   out.tets = std::move(plain.tets);
   set_weights(weights, out);

@@ -4,8 +4,8 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <map>
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include "fahr/geometry/tet_mesh.h"
@@ -13,9 +13,9 @@
 namespace fahr::sphere_layout::detail {
 
 struct SphereLink {
-  std::vector<std::uint32_t> tets;     // nearest first, ties by index
-  std::vector<std::uint32_t> nodes;    // ascending
-  std::vector<double> weights;         // >= 0, sum 1, sum w x_rest = centre
+  std::vector<std::uint32_t> tets;                     // nearest first, ties by index
+  std::vector<std::uint32_t> nodes;                    // ascending
+  std::vector<double> weights;                         // >= 0, sum 1, sum w x_rest = centre
   Eigen::Vector3d centre_m = Eigen::Vector3d::Zero();  // = sum w x_rest, m
 };
 
@@ -42,9 +42,10 @@ class TetLinker {
   // follows the surface when it deforms. The factor is lowered toward 1 when
   // p would leave the mesh; at 1 (or if no tet holds p) this is link() with
   // no spread. Tets (for the radius) are link()'s.
-  SphereLink link_anchored(const Eigen::Vector3d& centre_m, double radius_m, const Eigen::Vector3d& anchor_m,
-                           const std::array<std::uint32_t, 3>& face_nodes, const Eigen::Vector3d& face_weights,
-                           double depth_factor);
+  SphereLink link_anchored(const Eigen::Vector3d& centre_m, double radius_m,
+                           const Eigen::Vector3d& anchor_m,
+                           const std::array<std::uint32_t, 3>& face_nodes,
+                           const Eigen::Vector3d& face_weights, double depth_factor);
 
  private:
   Eigen::Vector4d barycentric(std::uint32_t tet, const Eigen::Vector3d& p) const;

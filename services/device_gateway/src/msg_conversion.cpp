@@ -9,7 +9,9 @@ void put(const device::Vec3& v, msg::Vec3& out) {
   out.y(v.y());
   out.z(v.z());
 }
-device::Vec3 get(const msg::Vec3& v) { return device::Vec3(v.x(), v.y(), v.z()); }
+device::Vec3 get(const msg::Vec3& v) {
+  return device::Vec3(v.x(), v.y(), v.z());
+}
 }  // namespace
 
 void to_msg(const device::DevicePoseSample& pose, std::uint32_t device_id, msg::DevicePose& out) {
@@ -29,7 +31,8 @@ void to_msg(const device::DevicePoseSample& pose, std::uint32_t device_id, msg::
   out.max_stiffness_npm(pose.max_stiffness_npm);
   put(pose.rendered_force_n, out.rendered_force_n());
   // Same enumerator order in safety_state and the IDL (types.h).
-  out.safety_state(static_cast<msg::DeviceSafetyState>(static_cast<std::uint32_t>(pose.safety_state)));
+  out.safety_state(
+      static_cast<msg::DeviceSafetyState>(static_cast<std::uint32_t>(pose.safety_state)));
 }
 
 void from_msg(const msg::ForceCommand& in, device::ForceCommandSample& out) {

@@ -5,7 +5,9 @@
 
 namespace fahr::gateway_service {
 namespace {
-double ms(std::chrono::nanoseconds d) { return static_cast<double>(d.count()) * 1e-6; }
+double ms(std::chrono::nanoseconds d) {
+  return static_cast<double>(d.count()) * 1e-6;
+}
 }  // namespace
 
 void GatewayMetrics::take_newest() {
@@ -35,7 +37,8 @@ void GatewayMetrics::fill(std::vector<std::pair<std::string, double>>& metrics) 
   metrics.emplace_back("rejected_non_finite", static_cast<double>(s.safety.rejected_non_finite));
   metrics.emplace_back("rejected_stale", static_cast<double>(s.safety.rejected_stale));
   metrics.emplace_back("rejected_from_future", static_cast<double>(s.safety.rejected_from_future));
-  metrics.emplace_back("rejected_out_of_order", static_cast<double>(s.safety.rejected_out_of_order));
+  metrics.emplace_back("rejected_out_of_order",
+                       static_cast<double>(s.safety.rejected_out_of_order));
   metrics.emplace_back("saturated_ticks", static_cast<double>(s.safety.saturated_ticks));
   metrics.emplace_back("rate_limited_ticks", static_cast<double>(s.safety.rate_limited_ticks));
   metrics.emplace_back("silence_events", static_cast<double>(s.safety.silence_events));
@@ -48,17 +51,19 @@ std::string GatewayMetrics::summary(std::uint64_t late_periods) {
   const StatusSnapshot& s = last_;
   const device::LatencyHistogram& latency = last_latency_;
   char line[512];
-  std::snprintf(line, sizeof(line),
-                "ticks %llu, late periods %llu, motion-to-force (last window with commands) n=%llu p50 %.3f ms p99 %.3f ms, "
-                "peak force %.3f N, renderable %.3f N, commands accepted %llu, rejected nan %llu stale %llu, "
-                "silences %llu, PC removed %.3f mJ",
-                static_cast<unsigned long long>(s.ticks), static_cast<unsigned long long>(late_periods),
-                static_cast<unsigned long long>(latency.count()), ms(latency.percentile(0.5)),
-                ms(latency.percentile(0.99)), s.peak_force_n, s.renderable_force_n,
-                static_cast<unsigned long long>(s.safety.accepted),
-                static_cast<unsigned long long>(s.safety.rejected_non_finite),
-                static_cast<unsigned long long>(s.safety.rejected_stale),
-                static_cast<unsigned long long>(s.safety.silence_events), s.passivity_dissipated_j * 1e3);
+  std::snprintf(
+      line, sizeof(line),
+      "ticks %llu, late periods %llu, motion-to-force (last window with commands) n=%llu p50 %.3f "
+      "ms p99 %.3f ms, "
+      "peak force %.3f N, renderable %.3f N, commands accepted %llu, rejected nan %llu stale %llu, "
+      "silences %llu, PC removed %.3f mJ",
+      static_cast<unsigned long long>(s.ticks), static_cast<unsigned long long>(late_periods),
+      static_cast<unsigned long long>(latency.count()), ms(latency.percentile(0.5)),
+      ms(latency.percentile(0.99)), s.peak_force_n, s.renderable_force_n,
+      static_cast<unsigned long long>(s.safety.accepted),
+      static_cast<unsigned long long>(s.safety.rejected_non_finite),
+      static_cast<unsigned long long>(s.safety.rejected_stale),
+      static_cast<unsigned long long>(s.safety.silence_events), s.passivity_dissipated_j * 1e3);
   return line;
 }
 

@@ -47,7 +47,8 @@ std::vector<std::unique_ptr<AnatomyField>> load_anatomy_fields(const scene::Scen
   const auto index = static_cast<std::size_t>(&deformable - scene.bodies.data());
   std::vector<std::unique_ptr<AnatomyField>> fields;
   for (const std::size_t obstacle : runtime::hard_obstacles_of(scene, index)) {
-    fields.push_back(std::make_unique<AnatomyField>(runtime::load_rigid_field(scene.bodies[obstacle])));
+    fields.push_back(
+        std::make_unique<AnatomyField>(runtime::load_rigid_field(scene.bodies[obstacle])));
   }
   return fields;
 }

@@ -5,7 +5,9 @@
 
 namespace fahr::fem_service {
 namespace {
-Eigen::Vector3d vec(const msg::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+Eigen::Vector3d vec(const msg::Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 }  // namespace
 
 void to_fem(const msg::ContactSet& wire, fem::ContactSet& out) {
@@ -15,9 +17,9 @@ void to_fem(const msg::ContactSet& wire, fem::ContactSet& out) {
     const auto& w = wire.contacts()[i];
     auto& c = out.contacts[i];
     c.sphere_id = w.sphere_id();
-    c.kind = w.kind() == msg::CONTACT_OBSTACLE  ? fem::ContactKind::kObstacle
+    c.kind = w.kind() == msg::CONTACT_OBSTACLE     ? fem::ContactKind::kObstacle
              : w.kind() == msg::CONTACT_FORCE_ONLY ? fem::ContactKind::kForceOnly
-                                                : fem::ContactKind::kTool;
+                                                   : fem::ContactKind::kTool;
     c.state = w.state() == msg::CONSTRAINT_ACTIVE   ? fem::ContactState::kActive
               : w.state() == msg::CONSTRAINT_FROZEN ? fem::ContactState::kFrozen
                                                     : fem::ContactState::kCandidate;
@@ -34,7 +36,8 @@ bool tool_pose(const msg::ContactSet& wire, Eigen::Isometry3d& world_from_tool) 
   const Eigen::Quaterniond orientation(q.w(), q.x(), q.y(), q.z());
   const Eigen::Vector3d position = vec(wire.world_from_tool().position_m());
   const double norm = orientation.norm();
-  if (!(norm > 0.5 && norm < 2.0) || !position.allFinite()) return false;  // NaN fails the range too
+  if (!(norm > 0.5 && norm < 2.0) || !position.allFinite())
+    return false;  // NaN fails the range too
   world_from_tool = Eigen::Translation3d(position) * orientation.normalized();
   return true;
 }

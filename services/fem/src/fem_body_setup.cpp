@@ -5,8 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "fahr/sphere_layout/fill_spheres.h"
 #include "fahr/runtime/scene_bodies.h"
+#include "fahr/sphere_layout/fill_spheres.h"
 
 namespace fahr::fem_service {
 namespace {
@@ -23,12 +23,14 @@ std::vector<std::uint32_t> fixed_nodes(const scene::Body& body, const geometry::
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   for (auto n : nodes) {
     if (n >= mesh.node_count()) {
-      throw std::runtime_error("body '" + body.name + "': fixed node " + std::to_string(n) + " is beyond the mesh's " +
-                               std::to_string(mesh.node_count()) + " nodes (" + body.deformable->fixed.nodes_file.string() +
-                               ")");
+      throw std::runtime_error("body '" + body.name + "': fixed node " + std::to_string(n) +
+                               " is beyond the mesh's " + std::to_string(mesh.node_count()) +
+                               " nodes (" + body.deformable->fixed.nodes_file.string() + ")");
     }
   }
-  if (nodes.empty()) throw std::runtime_error("body '" + body.name + "': no fixed nodes; the tongue would fall away");
+  if (nodes.empty())
+    throw std::runtime_error("body '" + body.name +
+                             "': no fixed nodes; the tongue would fall away");
   return nodes;
 }
 
@@ -39,8 +41,9 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
                 m.rayleigh_mass_per_s, m.rayleigh_stiffness_s, m.yeoh_c20_over_c10};
   s.time_step = std::chrono::duration<double>(1.0 / scene.rates.fem_hz);
   s.gravity_m_per_s2 = scene.gravity_mps2;
-  s.solver.kind = scene.solver.linear_solver == scene::LinearSolver::kCholmod ? fem::LinearSolver::kCholmod
-                                                                               : fem::LinearSolver::kConjugateGradient;
+  s.solver.kind = scene.solver.linear_solver == scene::LinearSolver::kCholmod
+                      ? fem::LinearSolver::kCholmod
+                      : fem::LinearSolver::kConjugateGradient;
   // Reuse one factorisation and refresh it when an element has turned
   // 0.1 rad: 681 steps/s on a 5k-tet body where refactorising every step
   // gives 116 (tools/fem_bench, `fem_bench target`); the force stays exact,
@@ -66,9 +69,11 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
   s.solver.cg_max_iterations = scene.solver.cg_max_iterations;
   s.projection.max_sweeps = scene.solver.projection_max_iterations;
   s.projection.tolerance_m = scene.solver.projection_tolerance_m;
-  const double age_steps = std::chrono::duration<double>(scene.solver.max_contact_age).count() * scene.rates.fem_hz;
+  const double age_steps =
+      std::chrono::duration<double>(scene.solver.max_contact_age).count() * scene.rates.fem_hz;
   s.max_contact_age_steps = static_cast<std::uint64_t>(std::max(1.0, std::ceil(age_steps)));
-  s.max_compliance_spheres = static_cast<std::size_t>(std::min(scene.solver.max_candidate_contacts, 64));
+  s.max_compliance_spheres =
+      static_cast<std::size_t>(std::min(scene.solver.max_candidate_contacts, 64));
   return s;
 }
 
@@ -80,20 +85,24 @@ FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body) {
   setup.mesh = runtime::world_tet_mesh(body);
   setup.fixed_nodes = fixed_nodes(body, setup.mesh);
   setup.settings = body_settings(scene, body);
-  setup.compliance_along_normals = scene.solver.compliance_columns == scene::ComplianceColumns::kNormals;
+  setup.compliance_along_normals =
+      scene.solver.compliance_columns == scene::ComplianceColumns::kNormals;
   setup.volume_floor.ratio = scene.solver.volume_floor_ratio;
-  const sphere_layout::SphereLayout layout = sphere_layout::fill_spheres(setup.mesh, runtime::fill_settings_for(body));
+  const sphere_layout::SphereLayout layout =
+      sphere_layout::fill_spheres(setup.mesh, runtime::fill_settings_for(body));
   for (std::size_t i = 0; i < layout.size(); ++i) {
-    const std::string error = setup.links.add_sphere(layout.nodes(i), layout.weights(i), layout.sphere(i).rest_radius_m);
+    const std::string error =
+        setup.links.add_sphere(layout.nodes(i), layout.weights(i), layout.sphere(i).rest_radius_m);
     if (!error.empty()) throw std::runtime_error("body '" + body.name + "': " + error);
   }
   std::vector<fem::Tet> tets;
   tets.reserve(setup.mesh.tet_count());
   for (const auto& t : setup.mesh.tets()) {
-    tets.push_back({static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]), static_cast<std::uint32_t>(t[2]),
-                    static_cast<std::uint32_t>(t[3])});
+    tets.push_back({static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
+                    static_cast<std::uint32_t>(t[2]), static_cast<std::uint32_t>(t[3])});
   }
-  auto created = fem::Body::create(setup.settings, setup.mesh.rest_positions(), tets, setup.fixed_nodes);
+  auto created =
+      fem::Body::create(setup.settings, setup.mesh.rest_positions(), tets, setup.fixed_nodes);
   if (!created.body) throw std::runtime_error("body '" + body.name + "': " + created.error);
   setup.body = std::move(created.body);
   setup.anatomy = load_anatomy_fields(scene, body);

@@ -21,14 +21,15 @@ double divergence_limit_m(const geometry::TetMesh& mesh) {
 
 ServiceStep::ServiceStep(FemBodySetup& setup)
     : setup_(setup),
-      contact_step_(*setup.body, setup.links,
-                    fem::ContactStepSettings{.apply_contact_forces = true,
-                                             .max_compliance_spheres = setup.settings.max_compliance_spheres,
-                                             .spread = setup.sphere_spread,
-                                             .frozen_target = setup.frozen_target,
-                                             .compliance_along_normals = setup.compliance_along_normals,
-                                             .divergence_limit_m = divergence_limit_m(setup.mesh),
-                                             .volume_floor = setup.volume_floor}) {
+      contact_step_(
+          *setup.body, setup.links,
+          fem::ContactStepSettings{.apply_contact_forces = true,
+                                   .max_compliance_spheres = setup.settings.max_compliance_spheres,
+                                   .spread = setup.sphere_spread,
+                                   .frozen_target = setup.frozen_target,
+                                   .compliance_along_normals = setup.compliance_along_normals,
+                                   .divergence_limit_m = divergence_limit_m(setup.mesh),
+                                   .volume_floor = setup.volume_floor}) {
   const std::size_t cap = setup.settings.max_compliance_spheres;
   std::vector<const fem::ObstacleField*> anatomy;
   if (setup.enforce_anatomy) {
@@ -57,18 +58,21 @@ void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
 
 void ServiceStep::step() {
   // A set older than the body allows is ignored and counted (stale).
-  const bool usable = have_contacts_ && setup_.body->step_index() <=
-                                            contacts_.state_step + setup_.settings.max_contact_age_steps;
+  const bool usable =
+      have_contacts_ &&
+      setup_.body->step_index() <= contacts_.state_step + setup_.settings.max_contact_age_steps;
   if (have_contacts_ && !usable) ++stale_sets_;
   if (setup_.tool) {
     // The tool where the newest set left it; it stays put without one.
-    const Eigen::Isometry3d now = usable && have_tool_pose_ ? world_from_tool_ : world_from_tool_at_last_step_;
+    const Eigen::Isometry3d now =
+        usable && have_tool_pose_ ? world_from_tool_ : world_from_tool_at_last_step_;
     setup_.tool->set_world_from_body(now);
     contact_step_.set_tool_motion(now * world_from_tool_at_last_step_.inverse());
     world_from_tool_at_last_step_ = now;
   }
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
-  inverted_max_ = std::max<std::uint64_t>(inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
+  inverted_max_ = std::max<std::uint64_t>(
+      inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
   if (last_report_.diverged_reset) ++divergence_resets_;
   anatomy_returned_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_returned);
   anatomy_beyond_steps_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_beyond);
@@ -89,12 +93,14 @@ void ServiceStep::fill_compliance() {
   auto& along = state_.compliance_normals();
   along.resize(3 * normals.size());
   for (std::size_t s = 0; s < normals.size(); ++s) {
-    for (std::size_t d = 0; d < 3; ++d) along[3 * s + d] = static_cast<float>(normals[s][static_cast<Eigen::Index>(d)]);
+    for (std::size_t d = 0; d < 3; ++d)
+      along[3 * s + d] = static_cast<float>(normals[s][static_cast<Eigen::Index>(d)]);
   }
   auto& centres = state_.compliance_free_centres_m();
   centres.resize(3 * free.size());
   for (std::size_t s = 0; s < free.size(); ++s) {
-    for (std::size_t d = 0; d < 3; ++d) centres[3 * s + d] = static_cast<float>(free[s][static_cast<Eigen::Index>(d)]);
+    for (std::size_t d = 0; d < 3; ++d)
+      centres[3 * s + d] = static_cast<float>(free[s][static_cast<Eigen::Index>(d)]);
   }
 }
 
@@ -104,12 +110,15 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));
   out.emplace_back("divergence_resets", static_cast<double>(divergence_resets_));
   out.emplace_back("projection_sweeps_last", static_cast<double>(last_report_.projection.sweeps));
-  out.emplace_back("anatomy_nodes_last", static_cast<double>(last_report_.projection.obstacle_nodes));
+  out.emplace_back("anatomy_nodes_last",
+                   static_cast<double>(last_report_.projection.obstacle_nodes));
   out.emplace_back("anatomy_depth_mm_max", 1e3 * anatomy_depth_max_m_);
   out.emplace_back("anatomy_nodes_returned", static_cast<double>(anatomy_returned_));
   out.emplace_back("anatomy_node_steps_beyond", static_cast<double>(anatomy_beyond_steps_));
-  out.emplace_back("anatomy_unresolved_last", static_cast<double>(last_report_.projection.obstacle_unresolved));
-  out.emplace_back("volume_floor_below_last", static_cast<double>(last_report_.projection.volume_floor_below));
+  out.emplace_back("anatomy_unresolved_last",
+                   static_cast<double>(last_report_.projection.obstacle_unresolved));
+  out.emplace_back("volume_floor_below_last",
+                   static_cast<double>(last_report_.projection.volume_floor_below));
   out.emplace_back("volume_floor_unresolved_last",
                    static_cast<double>(last_report_.projection.volume_floor_unresolved));
   out.emplace_back("solver_iterations_last", static_cast<double>(last_report_.solver_iterations));

@@ -30,7 +30,8 @@ void relaxed_store(std::atomic<T>& a, T v) {
 }
 
 double elapsed_us(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since).count();
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - since)
+      .count();
 }
 
 void store_max(std::atomic<double>& a, double v) {
@@ -49,9 +50,10 @@ template <class Contact>
 std::size_t keep_deepest(std::vector<std::uint32_t>& indices, std::size_t n, std::size_t keep,
                          const Contact& contacts) {
   if (n <= keep) return 0;
-  std::partial_sort(indices.begin(), indices.begin() + static_cast<std::ptrdiff_t>(keep),
-                    indices.begin() + static_cast<std::ptrdiff_t>(n),
-                    [&](std::uint32_t a, std::uint32_t b) { return contacts[a].depth_m > contacts[b].depth_m; });
+  std::partial_sort(
+      indices.begin(), indices.begin() + static_cast<std::ptrdiff_t>(keep),
+      indices.begin() + static_cast<std::ptrdiff_t>(n),
+      [&](std::uint32_t a, std::uint32_t b) { return contacts[a].depth_m > contacts[b].depth_m; });
   return n - keep;
 }
 
@@ -69,7 +71,8 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
       row_key_(kToolContactCapacity, 0.0),
       anatomy_contacts_(kAnatomyContactCapacity),
       anatomy_order_(kAnatomyContactCapacity, 0),
-      tissue_row_budget_(std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES, setup.response.max_rows)),
+      tissue_row_budget_(
+          std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES, setup.response.max_rows)),
       rows_(setup.response.max_rows) {
   if (setup.collision == CollisionMethod::kTriangle) {
     triangle_contacts_.reserve(kToolContactCapacity);
@@ -100,7 +103,8 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
     collision::RigidBody body;
     body.id = field.scene_body->id;
     body.sdf = field.sdf.get();
-    body.world_from_body = Eigen::Translation3d(field.scene_body->pose.position_m) * field.scene_body->pose.orientation;
+    body.world_from_body = Eigen::Translation3d(field.scene_body->pose.position_m) *
+                           field.scene_body->pose.orientation;
     anatomy_bodies_.push_back(body);
   }
 }
@@ -115,7 +119,8 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   if (pose.max_stiffness_npm() > 0.0) d.max_stiffness_npm = pose.max_stiffness_npm();
   // The servo count gives the time since the last answered pose, whatever
   // DDS dropped in between; bounded so a stall does not make the damper vanish.
-  const std::uint64_t ticks = started_ && pose.servo_tick() > last_servo_tick_ ? pose.servo_tick() - last_servo_tick_ : 1;
+  const std::uint64_t ticks =
+      started_ && pose.servo_tick() > last_servo_tick_ ? pose.servo_tick() - last_servo_tick_ : 1;
   d.dt_s = nominal_period_s_ * static_cast<double>(std::min<std::uint64_t>(ticks, 10));
   last_servo_tick_ = pose.servo_tick();
   return d;
@@ -141,7 +146,8 @@ std::size_t HapticLoop::select_rows(const TissueSnapshot& tissue) {
     if (w >= 0) key += free_depth ? double{tissue.free_shift_m[static_cast<std::size_t>(w)]} : 1.0;
     row_key_[i] = key;
   }
-  std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
+  std::partial_sort(order_.begin(),
+                    order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
                     order_.begin() + static_cast<std::ptrdiff_t>(n),
                     [&](std::uint32_t a, std::uint32_t b) { return row_key_[a] > row_key_[b]; });
   return tissue_row_budget_;
@@ -152,7 +158,8 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
   // and only those get their point and normal (defer_outside_contacts).
   const std::size_t keep = select_rows(tissue);
   relaxed_add<std::uint64_t>(metrics_.rows_dropped, tool_contacts_.size() - keep);
-  collision::complete_deferred(tissue.tree, tool_body_, tool_query_, tool_contacts_, order_.data(), keep);
+  collision::complete_deferred(tissue.tree, tool_body_, tool_query_, tool_contacts_, order_.data(),
+                               keep);
   // (The penalty baseline's forces are part of the FEM's step, so it reads
   // the published centres.)
   const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
@@ -188,7 +195,8 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
 // sphere, radius included, onto the plane through a blade vertex.
 void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
   // The AIST rows' candidate margin: both methods hand the solve the same kind of rows.
-  tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_, tool_query_.candidate_margin_m);
+  tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_,
+                            tool_query_.candidate_margin_m);
   const auto& vertex_sphere = setup_.triangles->vertex_sphere;
   std::size_t slots = 0;
   for (std::size_t i = 0; i < triangle_contacts_.size() && slots < sphere_contact_.size(); ++i) {
@@ -200,13 +208,15 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
       row_of_sphere_[sphere] = static_cast<std::int32_t>(slots);
       slot_sphere_[slots] = sphere;
       sphere_contact_[slots++] = static_cast<std::uint32_t>(i);
-    } else if (c.depth_m > triangle_contacts_[sphere_contact_[static_cast<std::size_t>(slot)]].depth_m) {
+    } else if (c.depth_m >
+               triangle_contacts_[sphere_contact_[static_cast<std::size_t>(slot)]].depth_m) {
       sphere_contact_[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(i);
     }
   }
   for (std::size_t k = 0; k < slots; ++k) row_of_sphere_[slot_sphere_[k]] = -1;
   const std::size_t keep = std::min(slots, tissue_row_budget_);
-  relaxed_add<std::uint64_t>(metrics_.rows_dropped, keep_deepest(sphere_contact_, slots, keep, triangle_contacts_));
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped,
+                             keep_deepest(sphere_contact_, slots, keep, triangle_contacts_));
   // (The penalty baseline's forces are part of the FEM's step, so it reads
   // the published centres.)
   const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
@@ -231,13 +241,14 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
 void HapticLoop::collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool) {
   std::size_t n = 0;
   for (const collision::RigidBody& body : anatomy_bodies_) {
-    const auto stats =
-        collision::query_surface_samples(setup_.tool_samples, world_from_tool, body, kAnatomyMarginM, anatomy_contacts_, n);
+    const auto stats = collision::query_surface_samples(setup_.tool_samples, world_from_tool, body,
+                                                        kAnatomyMarginM, anatomy_contacts_, n);
     if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
   }
   const std::size_t keep = std::min({n, kMaxAnatomyRows, rows_.size() - row_count_});
   std::iota(anatomy_order_.begin(), anatomy_order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
-  relaxed_add<std::uint64_t>(metrics_.rows_dropped, keep_deepest(anatomy_order_, n, keep, anatomy_contacts_));
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped,
+                             keep_deepest(anatomy_order_, n, keep, anatomy_contacts_));
   for (std::size_t r = 0; r < keep; ++r) {
     const collision::SurfaceContact& c = anatomy_contacts_[anatomy_order_[r]];
     contact::ContactRow& row = rows_[row_count_++];
@@ -255,8 +266,8 @@ void HapticLoop::collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool) 
   relaxed_store(metrics_.anatomy_rows, static_cast<std::uint32_t>(keep));
 }
 
-void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue, msg::ForceCommand& command,
-                      msg::ContactSet& contacts) {
+void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
+                      msg::ForceCommand& command, msg::ContactSet& contacts) {
   const auto start = std::chrono::steady_clock::now();
   const contact::DeviceSample device = device_sample(pose);
   if (!started_) {
@@ -279,8 +290,8 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
     collect_triangle_rows(tissue);
   } else {
     tool_contacts_.clear();
-    const auto stats =
-        collision::query_spheres(tissue.tree, tissue.spheres, tool_body_, tool_query_, tool_memory_, tool_contacts_);
+    const auto stats = collision::query_spheres(tissue.tree, tissue.spheres, tool_body_,
+                                                tool_query_, tool_memory_, tool_contacts_);
     if (stats.overflowed) relaxed_add<std::uint64_t>(metrics_.query_overflows, 1);
     phases_.tissue_query = stats;
     collect_tissue_rows(tissue);
@@ -316,15 +327,16 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   contacts.fem_step(tissue.fem_step);
   if (setup_.penalty) {
     contacts.tool_frozen(false);
-    fill_contacts({penalty_contacts_.data(), penalty_count_}, tool_body_.id, tissue.tissue_obstacle_body_ids(),
-                  contacts);
+    fill_contacts({penalty_contacts_.data(), penalty_count_}, tool_body_.id,
+                  tissue.tissue_obstacle_body_ids(), contacts);
   } else {
     contacts.tool_frozen(response_.tool_frozen());
     fill_contacts(response_.contacts(), tool_body_.id, tissue.tissue_obstacle_body_ids(), contacts);
   }
   // Where the FEM finds the tool: the proxy after this tick (the penalty
   // baseline's tool is the device).
-  put(setup_.penalty ? device.position_m : response_.proxy().position_m, contacts.world_from_tool().position_m());
+  put(setup_.penalty ? device.position_m : response_.proxy().position_m,
+      contacts.world_from_tool().position_m());
   put(device.orientation, contacts.world_from_tool().orientation());
   contacts.header().sim_step(pose.servo_tick());
   contacts.header().sim_time_ns(pose.header().sim_time_ns());
@@ -333,12 +345,13 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   relaxed_add<std::uint64_t>(metrics_.ticks, 1);
   relaxed_store(metrics_.tool_rows, static_cast<std::uint32_t>(tissue_rows));
   relaxed_store(metrics_.active_contacts, out.active_contacts);
-  relaxed_store(metrics_.missing_compliance,
-                static_cast<std::uint32_t>(std::max(0, response_.report().load.missing_compliance)));
+  relaxed_store(metrics_.missing_compliance, static_cast<std::uint32_t>(std::max(
+                                                 0, response_.report().load.missing_compliance)));
   relaxed_store(metrics_.reaction_n, out.tissue_reaction_n);
   relaxed_store(metrics_.obstacle_reaction_n, response_.report().obstacle_reaction_n);
   const double force_n = out.force_n.norm();
-  if (force_n > metrics_.peak_force_n.load(std::memory_order_relaxed)) relaxed_store(metrics_.peak_force_n, force_n);
+  if (force_n > metrics_.peak_force_n.load(std::memory_order_relaxed))
+    relaxed_store(metrics_.peak_force_n, force_n);
   if (out.lost_track) {
     relaxed_add<std::uint64_t>(metrics_.lost_track_ticks, 1);
     if (!was_lost_) relaxed_add<std::uint64_t>(metrics_.lost_track_episodes, 1);
@@ -354,7 +367,8 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
 // projects nothing); bone rows push the tool but not the tissue.
 const contact::ForceOutput& HapticLoop::penalty_tick(const contact::DeviceSample& device,
                                                      const TissueSnapshot& tissue) {
-  const contact::ForceOutput& out = penalty_.tick(device, {rows_.data(), row_count_}, tissue.fem_step);
+  const contact::ForceOutput& out =
+      penalty_.tick(device, {rows_.data(), row_count_}, tissue.fem_step);
   penalty_count_ = 0;
   for (const contact::SphereForce& f : penalty_.sphere_forces()) {
     const double magnitude = f.force_n.norm();
@@ -377,7 +391,9 @@ const contact::ForceOutput& HapticLoop::penalty_tick(const contact::DeviceSample
 }
 
 void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out) {
-  const auto get = [](const auto& a) { return static_cast<double>(a.load(std::memory_order_relaxed)); };
+  const auto get = [](const auto& a) {
+    return static_cast<double>(a.load(std::memory_order_relaxed));
+  };
   out.emplace_back("fem_states_used", get(metrics_.snapshots));
   out.emplace_back("tool_rows", get(metrics_.tool_rows));
   out.emplace_back("anatomy_rows", get(metrics_.anatomy_rows));

@@ -6,9 +6,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "fahr/sphere_layout/fill_spheres.h"
 #include "fahr/runtime/scene_bodies.h"
 #include "fahr/scene/plan.h"
+#include "fahr/sphere_layout/fill_spheres.h"
 
 namespace fahr::haptic_service {
 namespace {
@@ -53,9 +53,12 @@ std::unique_ptr<TriangleCollisionSetup> triangle_setup(const HapticSetup& setup)
 
 HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fem_keeps_anatomy) {
   const scene::ServicePlan plan = scene::derive_plan(scene);
-  if (!plan.tool_body) throw std::runtime_error("scene '" + scene.name + "' has no tool: nothing for the haptic service");
+  if (!plan.tool_body)
+    throw std::runtime_error("scene '" + scene.name +
+                             "' has no tool: nothing for the haptic service");
   if (plan.fem_bodies.size() != 1) {
-    throw std::runtime_error("scene '" + scene.name + "' has " + std::to_string(plan.fem_bodies.size()) +
+    throw std::runtime_error("scene '" + scene.name + "' has " +
+                             std::to_string(plan.fem_bodies.size()) +
                              " deformable bodies; this service handles exactly one");
   }
   HapticSetup setup;
@@ -68,16 +71,19 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fe
     setup.row_compliance = RowCompliance::kFreeDepth;
   }
   try {
-    setup.layout = sphere_layout::fill_spheres(setup.mesh, runtime::fill_settings_for(*setup.deformable));
+    setup.layout =
+        sphere_layout::fill_spheres(setup.mesh, runtime::fill_settings_for(*setup.deformable));
   } catch (const std::exception& e) {
     throw std::runtime_error("body '" + setup.deformable->name + "': AIST: " + e.what());
   }
   setup.tool = runtime::load_rigid_field(scene.bodies[*plan.tool_body]);
   setup.tool_grid = std::make_unique<collision::FieldGrid>(*setup.tool->sdf);
   try {
-    setup.tool_samples = collision::SurfaceSamples(setup.tool->surface, collision::SurfaceSampleSettings{});
+    setup.tool_samples =
+        collision::SurfaceSamples(setup.tool->surface, collision::SurfaceSampleSettings{});
   } catch (const std::exception& e) {
-    throw std::runtime_error("body '" + setup.tool->scene_body->name + "': surface samples: " + e.what());
+    throw std::runtime_error("body '" + setup.tool->scene_body->name +
+                             "': surface samples: " + e.what());
   }
   // Each anatomy body is loaded once, whichever pairs name it.
   std::vector<std::size_t> anatomy_of_body(scene.bodies.size(), SIZE_MAX);
@@ -92,7 +98,8 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fe
     if (pair.kind == scene::PairKind::kHard && pair.first == plan.fem_bodies.front()) {
       if (fem_keeps_anatomy) continue;
       setup.tissue_obstacles.push_back(anatomy_index(pair.second));
-    } else if (pair.kind == scene::PairKind::kTool && pair.reason == scene::PairReason::kToolObstacle &&
+    } else if (pair.kind == scene::PairKind::kTool &&
+               pair.reason == scene::PairReason::kToolObstacle &&
                scene.contact.tool_stops_at_anatomy) {
       setup.tool_obstacles.push_back(anatomy_index(pair.second));
     }

@@ -22,7 +22,8 @@ void put(const Eigen::Quaterniond& q, msg::Quat& out) {
   out.z(q.z());
 }
 
-void fill_command(const contact::ForceOutput& output, std::uint32_t device_id, msg::ForceCommand& out) {
+void fill_command(const contact::ForceOutput& output, std::uint32_t device_id,
+                  msg::ForceCommand& out) {
   out.device_id(device_id);
   out.answered_pose_seq(output.answered_pose_seq);
   put(output.answered_position_m, out.answered_position_m());

@@ -44,7 +44,8 @@ void describe_deformable(const HapticSetup& setup, msg::SceneDescription& d) {
 std::vector<msg::SceneDescription> describe_scene(const HapticSetup& setup) {
   const scene::Scene& scene = *setup.scene;
   std::vector<msg::SceneDescription> out;
-  const std::size_t text_bytes = std::min<std::size_t>(scene.source_text.size(), msg::MAX_SCENE_TEXT);
+  const std::size_t text_bytes =
+      std::min<std::size_t>(scene.source_text.size(), msg::MAX_SCENE_TEXT);
   for (const auto& body : scene.bodies) {
     msg::SceneDescription d;
     d.body_id(body.id);
@@ -53,7 +54,8 @@ std::vector<msg::SceneDescription> describe_scene(const HapticSetup& setup) {
     d.body_name(body.name);
     d.role(wire_role(body.role));
     d.mesh_uri(body.mesh_uri.substr(0, 255));
-    d.scene_text_utf8().assign(scene.source_text.begin(), scene.source_text.begin() + static_cast<std::ptrdiff_t>(text_bytes));
+    d.scene_text_utf8().assign(scene.source_text.begin(),
+                               scene.source_text.begin() + static_cast<std::ptrdiff_t>(text_bytes));
     if (&body == setup.deformable) describe_deformable(setup, d);
     out.push_back(std::move(d));
   }

@@ -30,7 +30,8 @@ void TissueFeed::run() {
     }
     buffer_.publish();
     metrics_.fem_states.fetch_add(1, std::memory_order_relaxed);
-    metrics_.obstacle_contacts.store(static_cast<std::uint32_t>(next.obstacle_count), std::memory_order_relaxed);
+    metrics_.obstacle_contacts.store(static_cast<std::uint32_t>(next.obstacle_count),
+                                     std::memory_order_relaxed);
     if (next.obstacle_overflow) metrics_.obstacle_overflows.fetch_add(1, std::memory_order_relaxed);
     metrics_.free_centres.store(next.have_free_centres, std::memory_order_relaxed);
     if (next.digest_us > metrics_.digest_us_max.load(std::memory_order_relaxed)) {
@@ -43,13 +44,17 @@ void TissueFeed::run() {
 }
 
 void TissueFeed::append_metrics(std::vector<std::pair<std::string, double>>& out) {
-  const auto get = [](const auto& a) { return static_cast<double>(a.load(std::memory_order_relaxed)); };
+  const auto get = [](const auto& a) {
+    return static_cast<double>(a.load(std::memory_order_relaxed));
+  };
   out.emplace_back("fem_states", get(metrics_.fem_states));
   out.emplace_back("bad_states", get(metrics_.bad_states));
   out.emplace_back("obstacle_contacts", get(metrics_.obstacle_contacts));
   out.emplace_back("obstacle_overflows", get(metrics_.obstacle_overflows));
-  out.emplace_back("free_centres", metrics_.free_centres.load(std::memory_order_relaxed) ? 1.0 : 0.0);
-  out.emplace_back("digest_us_max", metrics_.digest_us_max.exchange(0.0, std::memory_order_relaxed));
+  out.emplace_back("free_centres",
+                   metrics_.free_centres.load(std::memory_order_relaxed) ? 1.0 : 0.0);
+  out.emplace_back("digest_us_max",
+                   metrics_.digest_us_max.exchange(0.0, std::memory_order_relaxed));
 }
 
 }  // namespace fahr::haptic_service

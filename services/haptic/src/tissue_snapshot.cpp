@@ -37,7 +37,9 @@ contact::TissueCompliance TissueSnapshot::compliance() const {
 }
 
 TissueDigest::TissueDigest(const HapticSetup& setup)
-    : setup_(setup), positions_m_(3 * setup.mesh.node_count(), 0.0), obstacle_buffer_(kObstacleContactCapacity) {
+    : setup_(setup),
+      positions_m_(3 * setup.mesh.node_count(), 0.0),
+      obstacle_buffer_(kObstacleContactCapacity) {
   // Tissue against anatomy changes only with the FEM state, so the grid
   // distance is enough: off by a fraction of a cell at edges only.
   obstacle_query_.exact_narrow_phase = false;
@@ -51,8 +53,8 @@ TissueDigest::TissueDigest(const HapticSetup& setup)
     collision::RigidBody body;
     body.id = field->scene_body->id;
     body.sdf = field->sdf.get();
-    body.world_from_body =
-        Eigen::Translation3d(field->scene_body->pose.position_m) * field->scene_body->pose.orientation;
+    body.world_from_body = Eigen::Translation3d(field->scene_body->pose.position_m) *
+                           field->scene_body->pose.orientation;
     obstacle_bodies_.push_back(body);
     obstacle_memory_.emplace_back(setup.layout.size());
   }
@@ -73,8 +75,8 @@ TissueSnapshot TissueDigest::make_snapshot() {
   s.obstacle_contacts.assign(kObstacleContactCapacity, fem::Contact{});
   s.obstacle_body_ids.assign(kObstacleContactCapacity, 0);
   if (setup_.collision == CollisionMethod::kTriangle) {
-    s.triangles = std::make_unique<collision::TriangleBaseline>(setup_.triangles->boundary,
-                                                              setup_.triangles->surface_to_node, setup_.tool->surface);
+    s.triangles = std::make_unique<collision::TriangleBaseline>(
+        setup_.triangles->boundary, setup_.triangles->surface_to_node, setup_.tool->surface);
   }
   // Until the FEM publishes, the tongue is at rest and may already lie on
   // the anatomy.
@@ -94,7 +96,8 @@ bool TissueDigest::digest(const msg::DeformationState& state, TissueSnapshot& ou
   out.fem_step = state.step();
   query_obstacles(out);
   index_compliance(state, out);
-  out.digest_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  out.digest_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   return true;
 }
 
@@ -111,7 +114,8 @@ void TissueDigest::index_compliance(const msg::DeformationState& state, TissueSn
   const bool along = !state.compliance_normals().empty();
   if (along && state.compliance_normals().size() < 3 * k) return;
   const std::size_t entries = along ? 3 * k * k : 9 * k * k;
-  if (k == 0 || state.compliance_mpn().size() < entries) return;  // no usable W: rows use the fallback
+  if (k == 0 || state.compliance_mpn().size() < entries)
+    return;  // no usable W: rows use the fallback
   for (std::size_t i = 0; i < k; ++i) {
     // An id beyond the layout would index past the table: the whole W is
     // refused rather than solved with a row missing.
@@ -135,7 +139,8 @@ void TissueDigest::index_compliance(const msg::DeformationState& state, TissueSn
     const auto centres = out.spheres.centres_m();
     for (std::size_t i = 0; i < k; ++i) {
       const float* f = out.free_centres_m.data() + 3 * i;
-      out.free_shift_m[i] = static_cast<float>((centres[ids[i]] - Eigen::Vector3d(f[0], f[1], f[2])).norm());
+      out.free_shift_m[i] =
+          static_cast<float>((centres[ids[i]] - Eigen::Vector3d(f[0], f[1], f[2])).norm());
     }
   }
 }
@@ -144,8 +149,9 @@ void TissueDigest::query_obstacles(TissueSnapshot& out) {
   obstacle_buffer_.clear();
   out.obstacle_overflow = false;
   for (std::size_t b = 0; b < obstacle_bodies_.size(); ++b) {
-    const auto stats = collision::query_spheres(out.tree, out.spheres, obstacle_bodies_[b], obstacle_query_,
-                                             obstacle_memory_[b], obstacle_buffer_);
+    const auto stats =
+        collision::query_spheres(out.tree, out.spheres, obstacle_bodies_[b], obstacle_query_,
+                                 obstacle_memory_[b], obstacle_buffer_);
     out.obstacle_overflow = out.obstacle_overflow || stats.overflowed;
   }
   out.obstacle_count = 0;

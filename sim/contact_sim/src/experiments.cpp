@@ -13,7 +13,9 @@ namespace {
 
 constexpr double kDt = 0.001;  // haptic tick, s
 
-int period_ticks(double fem_hz) { return static_cast<int>(std::lround(1.0 / (fem_hz * kDt))); }
+int period_ticks(double fem_hz) {
+  return static_cast<int>(std::lround(1.0 / (fem_hz * kDt)));
+}
 
 double boussinesq(double radius_m, double depth_m) {
   const fem::Material m = fem::neonatal_tongue();
@@ -34,7 +36,8 @@ double fem_static_force(double punch_radius_m, double depth_m) {
   fixed.insert(fixed.end(), scene.sphere_nodes.begin(), scene.sphere_nodes.end());
   fem::BodySettings settings = block_body_settings(kStaticStep);
   settings.sleep.enabled = false;
-  fem::BodyOrError made = fem::Body::create(settings, scene.block.mesh.nodes_m, scene.block.mesh.tets, fixed);
+  fem::BodyOrError made =
+      fem::Body::create(settings, scene.block.mesh.nodes_m, scene.block.mesh.tets, fixed);
   if (!made.body) return 0.0;
   fem::Body& body = *made.body;
   for (const std::uint32_t node : scene.sphere_nodes) {
@@ -55,7 +58,8 @@ double fem_static_stiffness(double punch_radius_m) {
   return fem_static_force(punch_radius_m, kDepth) / kDepth;
 }
 
-PunchResult run_punch_experiment(double fem_hz, double punch_radius_m, double depth_m, double fem_static_npm) {
+PunchResult run_punch_experiment(double fem_hz, double punch_radius_m, double depth_m,
+                                 double fem_static_npm) {
   PunchResult result;
   result.fem_hz = fem_hz;
   result.punch_radius_m = punch_radius_m;
@@ -71,8 +75,9 @@ PunchResult run_punch_experiment(double fem_hz, double punch_radius_m, double de
   config.fem_period_ticks = period_ticks(fem_hz);
   config.dt_s = kDt;
   config.tool = ToolShape{ToolKind::kFlatPunch, punch_radius_m * (1.0 + 1e-6), 0.002};
-  config.response.coupling.stiffness_npm = 1480.0;  // the Touch X's stiffest: the proxy stops closest
-  config.renderable_force_n = 50.0;                 // accuracy, not force awareness, is measured here
+  config.response.coupling.stiffness_npm =
+      1480.0;                        // the Touch X's stiffest: the proxy stops closest
+  config.renderable_force_n = 50.0;  // accuracy, not force awareness, is measured here
   const double r = scene.sphere_radius_m;
   const double start_y = r + 0.001;
   const double floor_y = r - depth_m;
@@ -84,7 +89,8 @@ PunchResult run_punch_experiment(double fem_hz, double punch_radius_m, double de
   run.run(
       ticks,
       [&](std::uint64_t k) {
-        return Eigen::Vector3d(0.0, std::max(floor_y, start_y - speed * kDt * static_cast<double>(k)), 0.0);
+        return Eigen::Vector3d(
+            0.0, std::max(floor_y, start_y - speed * kDt * static_cast<double>(k)), 0.0);
       },
       [&](const TickRecord& rec) {
         last = rec;
@@ -141,7 +147,8 @@ OvershootResult run_overshoot_experiment(Method method, double limit_n, double d
       total,
       [&](std::uint64_t k) {
         if (phase == Phase::kDescend) {
-          const bool deep_enough = method == Method::kPenalty ? device_y <= device_floor_y_m : commanded >= 3.0 * limit_n;
+          const bool deep_enough = method == Method::kPenalty ? device_y <= device_floor_y_m
+                                                              : commanded >= 3.0 * limit_n;
           if (deep_enough) {
             phase = Phase::kHold;
             hold_until = k + 5000;
@@ -175,7 +182,8 @@ OvershootResult run_overshoot_experiment(Method method, double limit_n, double d
           // (F_cmd - L)/K_c, F_cmd = K_c |x_d - p_freeze| the hand's command.
           const double f_cmd = k_c * (rec.device_m - freeze_proxy).norm();
           const double expected = limit_n / k_c + (f_cmd - limit_n) / k_c;
-          result.max_gap_error_m = std::max(result.max_gap_error_m, std::abs(rec.gap_m.norm() - expected));
+          result.max_gap_error_m =
+              std::max(result.max_gap_error_m, std::abs(rec.gap_m.norm() - expected));
         }
         if (was_lost && !rec.lost_track) {
           reengaged = true;
@@ -194,11 +202,12 @@ OvershootResult run_overshoot_experiment(Method method, double limit_n, double d
           const double energy = fem.body().energy().elastic_j;
           result.max_elastic_energy_j = std::max(result.max_elastic_energy_j, energy);
           result.final_elastic_energy_j = energy;
-          result.max_penetration_m =
-              std::max({result.max_penetration_m, rec.active_penetration_m, rec.force_only_penetration_m});
+          result.max_penetration_m = std::max(
+              {result.max_penetration_m, rec.active_penetration_m, rec.force_only_penetration_m});
         }
         result.max_penetration_m = std::max(result.max_penetration_m, rec.max_row_penetration_m);
-        if (released && rec.tick == release_tick + 1000) result.displacement_1s_after_release_m = fem.max_displacement_m();
+        if (released && rec.tick == release_tick + 1000)
+          result.displacement_1s_after_release_m = fem.max_displacement_m();
       });
   result.max_inverted = std::max(result.max_inverted, fem.inverted_now());
   return result;
@@ -223,7 +232,10 @@ SmoothnessResult run_smoothness_experiment(Method method) {
   std::vector<double> force, times;
   double sweeps = 0.0;
   run.run(
-      1700, [&](std::uint64_t k) { return Eigen::Vector3d(0.0, r - speed * kDt * static_cast<double>(k), 0.0); },
+      1700,
+      [&](std::uint64_t k) {
+        return Eigen::Vector3d(0.0, r - speed * kDt * static_cast<double>(k), 0.0);
+      },
       [&](const TickRecord& rec) {
         if (rec.tick < 700) return;
         force.push_back(rec.force_n.norm());

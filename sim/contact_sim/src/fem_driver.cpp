@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace fahr::contact::sim {
 
 fem::SphereLinks make_node_spheres(std::span<const std::uint32_t> nodes, double radius_m) {
@@ -16,15 +15,20 @@ fem::SphereLinks make_node_spheres(std::span<const std::uint32_t> nodes, double 
   return links;
 }
 
-std::unique_ptr<FemDriver> FemDriver::create(const FemDriverSettings& settings, const fem::TetMesh& mesh,
-                                             std::span<const std::uint32_t> fixed_nodes, fem::SphereLinks links,
-                                             std::span<const std::uint32_t> compliance_spheres, std::string& error) {
+std::unique_ptr<FemDriver> FemDriver::create(const FemDriverSettings& settings,
+                                             const fem::TetMesh& mesh,
+                                             std::span<const std::uint32_t> fixed_nodes,
+                                             fem::SphereLinks links,
+                                             std::span<const std::uint32_t> compliance_spheres,
+                                             std::string& error) {
   std::unique_ptr<FemDriver> driver(new FemDriver());
   driver->settings_ = settings;
   // Sleep is off: a sleeping body skips the free step the solve reads.
   driver->settings_.body.sleep.enabled = false;
-  driver->settings_.body.max_compliance_spheres = std::max(settings.body.max_compliance_spheres, compliance_spheres.size());
-  fem::BodyOrError made = fem::Body::create(driver->settings_.body, mesh.nodes_m, mesh.tets, fixed_nodes);
+  driver->settings_.body.max_compliance_spheres =
+      std::max(settings.body.max_compliance_spheres, compliance_spheres.size());
+  fem::BodyOrError made =
+      fem::Body::create(driver->settings_.body, mesh.nodes_m, mesh.tets, fixed_nodes);
   if (!made.body) {
     error = made.error;
     return nullptr;
@@ -40,8 +44,9 @@ std::unique_ptr<FemDriver> FemDriver::create(const FemDriverSettings& settings, 
   for (std::size_t i = 0; i < compliance_spheres.size(); ++i) {
     driver->compliance_index_[compliance_spheres[i]] = static_cast<std::int32_t>(i);
   }
-  const fem::ContactStepSettings step{.apply_contact_forces = settings.apply_contact_forces,
-                                      .max_compliance_spheres = driver->settings_.body.max_compliance_spheres};
+  const fem::ContactStepSettings step{
+      .apply_contact_forces = settings.apply_contact_forces,
+      .max_compliance_spheres = driver->settings_.body.max_compliance_spheres};
   driver->contact_step_ = std::make_unique<fem::ContactStep>(*driver->body_, driver->links_, step);
   if (!driver->contact_step_->fix_compliance_spheres(compliance_spheres)) {
     error = "compliance of the candidate spheres failed";
@@ -75,7 +80,8 @@ void FemDriver::update_centres() {
   for (std::size_t i = 0; i < ids.size(); ++i) free_centres_[ids[i]] = free[i];
 }
 
-FemStepReport FemDriver::step(const fem::ContactSet* contacts, std::span<const double> external_forces_n) {
+FemStepReport FemDriver::step(const fem::ContactSet* contacts,
+                              std::span<const double> external_forces_n) {
   FemStepReport report;
   const fem::StepReport step = contact_step_->step(contacts, external_forces_n);
   report.inverted_elements = step.inverted_elements;
@@ -104,7 +110,9 @@ Eigen::Matrix3d deformation_gradient(const fem::ElementRest& rest, std::size_t e
   const Eigen::Map<const Eigen::Vector3d> x0(x + 3 * std::size_t{tet[0]});
   Eigen::Matrix3d ds;
   for (Eigen::Index a = 0; a < 3; ++a) {
-    ds.col(a) = Eigen::Map<const Eigen::Vector3d>(x + 3 * std::size_t{tet[static_cast<std::size_t>(a + 1)]}) - x0;
+    ds.col(a) = Eigen::Map<const Eigen::Vector3d>(
+                    x + 3 * std::size_t{tet[static_cast<std::size_t>(a + 1)]}) -
+                x0;
   }
   return ds * rest.dm_inv[e];
 }
@@ -125,7 +133,8 @@ double FemDriver::max_strain() const {
 int FemDriver::inverted_now() const {
   int inverted = 0;
   const double* x = body_->positions_m().data();
-  for (std::size_t e = 0; e < rest_.size(); ++e) inverted += deformation_gradient(rest_, e, x).determinant() <= 0.0;
+  for (std::size_t e = 0; e < rest_.size(); ++e)
+    inverted += deformation_gradient(rest_, e, x).determinant() <= 0.0;
   return inverted;
 }
 

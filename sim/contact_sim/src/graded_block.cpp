@@ -29,11 +29,13 @@ std::vector<double> graded_axis(double extent, double fine_extent, double fine, 
 }  // namespace
 
 BlockScene make_graded_block(const GradedBlockSpec& spec) {
-  const std::vector<double> half = graded_axis(spec.half_width_m, spec.fine_half_width_m, spec.fine_cell_m, spec.growth);
+  const std::vector<double> half =
+      graded_axis(spec.half_width_m, spec.fine_half_width_m, spec.fine_cell_m, spec.growth);
   std::vector<double> xs;
   for (std::size_t i = half.size(); i-- > 1;) xs.push_back(-half[i]);
   xs.insert(xs.end(), half.begin(), half.end());
-  const std::vector<double> down = graded_axis(spec.depth_m, spec.fine_depth_m, spec.fine_cell_m, spec.growth);
+  const std::vector<double> down =
+      graded_axis(spec.depth_m, spec.fine_depth_m, spec.fine_cell_m, spec.growth);
   std::vector<double> ys;
   for (std::size_t i = down.size(); i-- > 0;) ys.push_back(-down[i]);  // bottom (-depth) to top (0)
 
@@ -45,11 +47,13 @@ BlockScene make_graded_block(const GradedBlockSpec& spec) {
   scene.mesh.nodes_m.resize(nx * ny * nz);
   for (std::size_t k = 0; k < nz; ++k) {
     for (std::size_t j = 0; j < ny; ++j) {
-      for (std::size_t i = 0; i < nx; ++i) scene.mesh.nodes_m[index(i, j, k)] = Eigen::Vector3d(xs[i], ys[j], xs[k]);
+      for (std::size_t i = 0; i < nx; ++i)
+        scene.mesh.nodes_m[index(i, j, k)] = Eigen::Vector3d(xs[i], ys[j], xs[k]);
     }
   }
   // The six paths from corner 000 to 111 along the axes in every order.
-  constexpr std::array<std::array<int, 3>, 6> kOrders{{{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
+  constexpr std::array<std::array<int, 3>, 6> kOrders{
+      {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
   for (std::size_t k = 0; k + 1 < nz; ++k) {
     for (std::size_t j = 0; j + 1 < ny; ++j) {
       for (std::size_t i = 0; i + 1 < nx; ++i) {
@@ -62,7 +66,8 @@ BlockScene make_graded_block(const GradedBlockSpec& spec) {
             tet[s + 1] = index(at[0], at[1], at[2]);
           }
           const auto& p = scene.mesh.nodes_m;
-          const double volume = (p[tet[1]] - p[tet[0]]).cross(p[tet[2]] - p[tet[0]]).dot(p[tet[3]] - p[tet[0]]);
+          const double volume =
+              (p[tet[1]] - p[tet[0]]).cross(p[tet[2]] - p[tet[0]]).dot(p[tet[3]] - p[tet[0]]);
           if (volume < 0.0) std::swap(tet[1], tet[2]);  // odd permutations come out inverted
           scene.mesh.tets.push_back(tet);
         }

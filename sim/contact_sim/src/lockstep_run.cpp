@@ -8,13 +8,17 @@
 
 namespace fahr::contact::sim {
 
-LockstepRun::LockstepRun(const LockstepConfig& config, FemDriver& fem, const Eigen::Vector3d& device_start_m)
-    : config_(config), fem_(fem), response_([&] {
+LockstepRun::LockstepRun(const LockstepConfig& config, FemDriver& fem,
+                         const Eigen::Vector3d& device_start_m)
+    : config_(config),
+      fem_(fem),
+      response_([&] {
         ResponseSettings s = config.response;
         if (config.method == Method::kNaive) s.mode = ResponseMode::kNaive;
         return s;
       }()),
-      penalty_(config.penalty), previous_device_m_(device_start_m) {
+      penalty_(config.penalty),
+      previous_device_m_(device_start_m) {
   response_.reset(device_start_m, Eigen::Quaterniond::Identity());
   rows_.reserve(fem.links().size() + config.obstacles.size());
   pending_.contacts.reserve(config.response.max_contacts);
@@ -37,7 +41,8 @@ void LockstepRun::haptic_tick(const Eigen::Vector3d& device_m, TickRecord& recor
   // The compliance solve reads the free-motion centres; the naive loop and
   // the penalty baseline read the published (projected) positions.
   const bool free = config_.method == Method::kForceAware;
-  const SphereView spheres{free ? fem_.free_centres() : fem_.centres(), fem_.radii(), fem_.compliance_index()};
+  const SphereView spheres{free ? fem_.free_centres() : fem_.centres(), fem_.radii(),
+                           fem_.compliance_index()};
   const ForceOutput* out = nullptr;
   std::fill(pending_forces_.begin(), pending_forces_.end(), 0.0);
   pending_.contacts.clear();
@@ -46,16 +51,19 @@ void LockstepRun::haptic_tick(const Eigen::Vector3d& device_m, TickRecord& recor
     collect_rows(config_.tool, device_m, spheres, config_.obstacles, rows_);
     out = &penalty_.tick(device, rows_, fem_.step_index());
     spread_sphere_forces(penalty_.sphere_forces(), fem_.links(), pending_forces_);
-    for (const ContactRow& row : rows_) record.max_row_penetration_m = std::max(record.max_row_penetration_m, row.penetration_m());
+    for (const ContactRow& row : rows_)
+      record.max_row_penetration_m = std::max(record.max_row_penetration_m, row.penetration_m());
   } else {
     collect_rows(config_.tool, response_.proxy().position_m, spheres, config_.obstacles, rows_);
     TickInput input;
     input.device = device;
     input.rows = rows_;
-    input.compliance = TissueCompliance{fem_.step_index(), fem_.compliance_spheres(), fem_.compliance(), {}};
+    input.compliance =
+        TissueCompliance{fem_.step_index(), fem_.compliance_spheres(), fem_.compliance(), {}};
     const auto start = std::chrono::steady_clock::now();
     out = &response_.tick(input);
-    record.tick_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record.tick_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     record.response = response_.report();
     const auto contacts = response_.contacts();
     pending_.contacts.assign(contacts.begin(), contacts.end());
@@ -72,19 +80,23 @@ void LockstepRun::haptic_tick(const Eigen::Vector3d& device_m, TickRecord& recor
 
 void LockstepRun::fem_step(TickRecord& record) {
   const bool penalty = config_.method == Method::kPenalty;
-  record.fem = fem_.step(penalty ? nullptr : &applied_, penalty ? std::span<const double>(applied_forces_)
-                                                                : std::span<const double>());
+  record.fem =
+      fem_.step(penalty ? nullptr : &applied_,
+                penalty ? std::span<const double>(applied_forces_) : std::span<const double>());
   record.fem_stepped = true;
   const auto centres = fem_.centres();
   for (const fem::Contact& c : applied_.contacts) {
     if (c.state != fem::ContactState::kActive) continue;
-    const double depth = fem_.radii()[c.sphere_id] - (centres[c.sphere_id] - c.plane_point_m).dot(c.normal);
-    double& worst = c.kind == fem::ContactKind::kForceOnly ? record.force_only_penetration_m : record.active_penetration_m;
+    const double depth =
+        fem_.radii()[c.sphere_id] - (centres[c.sphere_id] - c.plane_point_m).dot(c.normal);
+    double& worst = c.kind == fem::ContactKind::kForceOnly ? record.force_only_penetration_m
+                                                           : record.active_penetration_m;
     worst = std::max(worst, depth);
   }
 }
 
-void LockstepRun::run(std::uint64_t ticks, const std::function<Eigen::Vector3d(std::uint64_t)>& device,
+void LockstepRun::run(std::uint64_t ticks,
+                      const std::function<Eigen::Vector3d(std::uint64_t)>& device,
                       const std::function<void(const TickRecord&)>& observe) {
   const auto period = static_cast<std::uint64_t>(std::max(config_.fem_period_ticks, 1));
   for (std::uint64_t n = 0; n < ticks; ++n, ++tick_) {

@@ -35,14 +35,16 @@ PunchScene make_punch_scene(double punch_radius_m, double fem_period_s, std::str
     if (std::hypot(p.x(), p.z()) <= a + 1e-9) scene.sphere_nodes.push_back(node);
   }
   scene.effective_radius_m =
-      spec.fine_cell_m * std::sqrt(static_cast<double>(scene.sphere_nodes.size()) / std::numbers::pi);
+      spec.fine_cell_m *
+      std::sqrt(static_cast<double>(scene.sphere_nodes.size()) / std::numbers::pi);
   std::vector<std::uint32_t> ids(scene.sphere_nodes.size());
   for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::uint32_t>(i);
   FemDriverSettings settings;
   settings.body = block_body_settings(fem_period_s);
   if (recompute_compliance) settings.body.solver.refactor_period = 1;
-  scene.fem = FemDriver::create(settings, scene.block.mesh, scene.block.fixed_nodes,
-                                make_node_spheres(scene.sphere_nodes, scene.sphere_radius_m), ids, error);
+  scene.fem =
+      FemDriver::create(settings, scene.block.mesh, scene.block.fixed_nodes,
+                        make_node_spheres(scene.sphere_nodes, scene.sphere_radius_m), ids, error);
   return scene;
 }
 

@@ -50,8 +50,9 @@ void ball_rows(const ToolShape& tool, const Eigen::Vector3d& t, const SphereView
 
 }  // namespace
 
-void collect_rows(const ToolShape& tool, const Eigen::Vector3d& tool_position_m, const SphereView& spheres,
-                  std::span<const PlaneObstacle> obstacles, std::vector<ContactRow>& rows) {
+void collect_rows(const ToolShape& tool, const Eigen::Vector3d& tool_position_m,
+                  const SphereView& spheres, std::span<const PlaneObstacle> obstacles,
+                  std::vector<ContactRow>& rows) {
   rows.clear();
   if (tool.kind == ToolKind::kFlatPunch) {
     punch_rows(tool, tool_position_m, spheres, rows);
@@ -62,8 +63,9 @@ void collect_rows(const ToolShape& tool, const Eigen::Vector3d& tool_position_m,
     // The tool point deepest into the plane: the ball's extreme point, or
     // the punch's reference point (its face centre) for the simple scenes.
     const Eigen::Vector3d deepest =
-        tool.kind == ToolKind::kBall ? Eigen::Vector3d(tool_position_m - tool.radius_m * plane.outward_normal)
-                                     : tool_position_m;
+        tool.kind == ToolKind::kBall
+            ? Eigen::Vector3d(tool_position_m - tool.radius_m * plane.outward_normal)
+            : tool_position_m;
     const double height = (deepest - plane.point_m).dot(plane.outward_normal);
     if (height > tool.margin_m) continue;
     ContactRow row;

@@ -4,8 +4,8 @@
 #include <stdexcept>
 
 #include "fahr/common/clock.h"
-#include "fahr/scene/plan.h"
 #include "fahr/gateway_service/msg_conversion.h"
+#include "fahr/scene/plan.h"
 
 namespace fahr::stack_sim {
 namespace {
@@ -13,7 +13,8 @@ namespace {
 const scene::Body& deformable_body(const scene::Scene& scene) {
   const scene::ServicePlan plan = scene::derive_plan(scene);
   if (plan.fem_bodies.size() != 1) {
-    throw std::runtime_error("stack_sim: scene '" + scene.name + "' needs exactly one deformable body");
+    throw std::runtime_error("stack_sim: scene '" + scene.name +
+                             "' needs exactly one deformable body");
   }
   return scene.bodies[plan.fem_bodies.front()];
 }
@@ -27,17 +28,21 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
       haptic_setup_(haptic_service::set_up(*scene_, options.collision, options.fem_anatomy)),
       fem_setup_(fem_service::set_up_body(*scene_, deformable_body(*scene_))) {
   if (scene_->rates.haptic_period() != scene_->run.base_period) {
-    throw std::runtime_error("stack_sim: the haptic rate must be the base rate of scene '" + scene_->name + "'");
+    throw std::runtime_error("stack_sim: the haptic rate must be the base rate of scene '" +
+                             scene_->name + "'");
   }
-  if (!device::model_by_name("touch_x", gateway_config_.model)) throw std::runtime_error("stack_sim: no touch_x model");
+  if (!device::model_by_name("touch_x", gateway_config_.model))
+    throw std::runtime_error("stack_sim: no touch_x model");
   gateway_config_.period = scene_->run.base_period;
   const device::HandImpedance hand;
-  device::Trajectory script = options.script == device::Script::kOvershoot
-                                  ? device::overshoot_script(gateway_config_.model.peak_force_n, hand.stiffness_npm,
-                                                             options.overshoot_factor)
-                                  : device::intubation_script();
-  hand_ = std::make_unique<device::SimulatedBackend>(std::move(script), hand, gateway_config_.model,
-                                                     gateway_config_.mapping, gateway_config_.period);
+  device::Trajectory script =
+      options.script == device::Script::kOvershoot
+          ? device::overshoot_script(gateway_config_.model.peak_force_n, hand.stiffness_npm,
+                                     options.overshoot_factor)
+          : device::intubation_script();
+  hand_ =
+      std::make_unique<device::SimulatedBackend>(std::move(script), hand, gateway_config_.model,
+                                                 gateway_config_.mapping, gateway_config_.period);
   gateway_ = std::make_unique<device::ServoCore>(gateway_config_, *hand_);
   haptic_setup_.response.force_aware.held_proxy = options.held_proxy;
   if (options.row_compliance) haptic_setup_.row_compliance = *options.row_compliance;
@@ -46,9 +51,11 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   digest_ = std::make_unique<haptic_service::TissueDigest>(haptic_setup_);
   tissue_ = digest_->make_snapshot();
   fem_setup_.enforce_anatomy = options.fem_anatomy;
-  if (options.fem_support_ratio) fem_setup_.anatomy_settings.support_stiffness_ratio = *options.fem_support_ratio;
+  if (options.fem_support_ratio)
+    fem_setup_.anatomy_settings.support_stiffness_ratio = *options.fem_support_ratio;
   fem_setup_.anatomy_settings.slide_after_entry = options.fem_anatomy_slide;
-  if (options.fem_anatomy_rounds > 0) fem_setup_.anatomy_settings.max_rounds = options.fem_anatomy_rounds;
+  if (options.fem_anatomy_rounds > 0)
+    fem_setup_.anatomy_settings.max_rounds = options.fem_anatomy_rounds;
   if (options.sphere_spread) fem_setup_.sphere_spread = *options.sphere_spread;
   if (options.frozen_target) fem_setup_.frozen_target = *options.frozen_target;
   if (options.fem_tool_obstacle) fem_setup_.tool = fem_service::load_tool_field(*scene_);
@@ -70,7 +77,8 @@ void StackSim::step() {
     gateway_service::from_msg(command_, command_sample_);
     incoming = &command_sample_;
   }
-  const device::DevicePoseSample& sample = gateway_->tick(std::chrono::nanoseconds(now_ns), incoming);
+  const device::DevicePoseSample& sample =
+      gateway_->tick(std::chrono::nanoseconds(now_ns), incoming);
   gateway_service::to_msg(sample, pose_.device_id(), next_pose_);
   next_pose_.header().seq(sample.servo_tick + 1);
   next_pose_.header().sim_step(k);

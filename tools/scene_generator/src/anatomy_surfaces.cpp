@@ -1,11 +1,11 @@
 // Rigid anatomy as parametric closed surfaces (see param_surfaces.h).
 #include "fahr/scenegen/anatomy_surfaces.h"
 
-#include "fahr/scenegen/param_surfaces.h"
-#include "fahr/scenegen/piecewise_linear.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "fahr/scenegen/param_surfaces.h"
+#include "fahr/scenegen/piecewise_linear.h"
 
 namespace fahr::scenegen {
 namespace {
@@ -59,13 +59,13 @@ struct RectangleLoop {
   std::pair<double, double> at(int j) const {
     j %= size();
     const auto f = [](int k, int n) { return static_cast<double>(k) / static_cast<double>(n); };
-    if (j < n_long) return {0.0, f(j, n_long)};            // inner side, top to bottom
+    if (j < n_long) return {0.0, f(j, n_long)};  // inner side, top to bottom
     j -= n_long;
-    if (j < n_short) return {f(j, n_short), 1.0};          // bottom end, inner to outer
+    if (j < n_short) return {f(j, n_short), 1.0};  // bottom end, inner to outer
     j -= n_short;
-    if (j < n_long) return {1.0, 1.0 - f(j, n_long)};      // outer side, bottom to top
+    if (j < n_long) return {1.0, 1.0 - f(j, n_long)};  // outer side, bottom to top
     j -= n_long;
-    return {1.0 - f(j, n_short), 0.0};                     // top end, outer to inner
+    return {1.0 - f(j, n_short), 0.0};  // top end, outer to inner
   }
 };
 
@@ -79,8 +79,9 @@ ParamBox palate_box(const PalateParameters& p, double resolution_mm) {
   const auto map = [p](double u, double v, double w) {
     const double lateral = 2.0 * v - 1.0;
     const double x = arch_x(p.front_x_mm, p.length_mm, kPalateArchSweepBackMm, u, lateral);
-    const double half_width = p.front_half_width_mm + (p.back_half_width_mm - p.front_half_width_mm) *
-                                                          eased_power(u, 0.5, kPalateWidthEase);
+    const double half_width =
+        p.front_half_width_mm +
+        (p.back_half_width_mm - p.front_half_width_mm) * eased_power(u, 0.5, kPalateWidthEase);
     // Vault: rises inside the ridge, both across (ridge at the rim) and along
     // (ridge at the front).
     const double across = smoothstep(0.95, 0.45, std::abs(lateral));
@@ -102,19 +103,20 @@ TriangleMesh make_palate(const PalateParameters& p, double resolution_mm) {
 }
 
 ParamBox jaw_box(const JawParameters& p, const TongueParameters& tongue, double resolution_mm) {
-  constexpr double kWallRiseMm = 3.0;       // inner face of the mandibular body, horizontal run
-  constexpr double kRidgeBackSlopeMm = 4.0; // lingual slope of the lower gum ridge
-  constexpr double kRidgeCrestMm = 2.0;     // crest width of the lower gum ridge
-  constexpr double kMinThicknessMm = 3.0;   // bone under the floor never thinner than this
+  constexpr double kWallRiseMm = 3.0;        // inner face of the mandibular body, horizontal run
+  constexpr double kRidgeBackSlopeMm = 4.0;  // lingual slope of the lower gum ridge
+  constexpr double kRidgeCrestMm = 2.0;      // crest width of the lower gum ridge
+  constexpr double kMinThicknessMm = 3.0;    // bone under the floor never thinner than this
   const auto map = [p, tongue](double u, double v, double w) {
     const double lateral = 2.0 * v - 1.0;
     const double x = arch_x(p.front_x_mm, p.length_mm, kJawArchSweepBackMm, u, lateral);
-    const double half_width = p.front_half_width_mm + (p.back_half_width_mm - p.front_half_width_mm) *
-                                                          eased_power(u, 0.8, kJawWidthEase);
+    const double half_width =
+        p.front_half_width_mm +
+        (p.back_half_width_mm - p.front_half_width_mm) * eased_power(u, 0.8, kJawWidthEase);
     const double z = lateral * half_width;
     // Floor: the tongue's attachment plane lowered by the gap.
-    const double floor_y = tongue.floor_y_at_x15_mm + tongue.floor_slope * (x + 15.0) -
-                           p.floor_gap_mm;
+    const double floor_y =
+        tongue.floor_y_at_x15_mm + tongue.floor_slope * (x + 15.0) - p.floor_gap_mm;
     const double wall = smoothstep(p.wall_inner_half_width_mm,
                                    p.wall_inner_half_width_mm + kWallRiseMm, std::abs(z));
     const double ridge = smoothstep(p.front_x_mm - kRidgeCrestMm - kRidgeBackSlopeMm,
@@ -135,8 +137,8 @@ TriangleMesh make_jaw(const JawParameters& p, const TongueParameters& tongue,
 }
 
 TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
-  constexpr double kCheekSweepBackMm = 6.0;   // outer rim lies this far behind the lips
-  constexpr double kLipBulgeWidth = 0.15;     // radial fraction over which the lips bulge
+  constexpr double kCheekSweepBackMm = 6.0;  // outer rim lies this far behind the lips
+  constexpr double kLipBulgeWidth = 0.15;    // radial fraction over which the lips bulge
   const RectangleLoop loop{cells_for(p.face_half_width_mm - p.mouth_half_width_mm, resolution_mm),
                            cells_for(p.thickness_mm, 0.5 * resolution_mm)};
   const auto map = [&](double around, double loop_fraction) {
@@ -152,7 +154,8 @@ TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
     // Cheeks sweep back at the sides only; above and below the mouth the face
     // stays in front of the gums.
     const double dish = kCheekSweepBackMm * r * r * std::cos(a) * std::cos(a);
-    const double lips = p.lip_protrusion_mm * std::exp(-(r / kLipBulgeWidth) * (r / kLipBulgeWidth));
+    const double lips =
+        p.lip_protrusion_mm * std::exp(-(r / kLipBulgeWidth) * (r / kLipBulgeWidth));
     const double back = p.back_x_mm - dish;
     const double front = p.back_x_mm + p.thickness_mm + lips - dish;
     return Vec3(back + (front - back) * axial, p.mouth_centre_y_mm + zy.y(), zy.x());
@@ -178,9 +181,9 @@ TriangleMesh make_larynx_trachea(const AirwayParameters& p, double resolution_mm
     const double front = std::max(0.0, std::cos(a));
     const double rise = p.epiglottis_height_mm * front * front;
     const double s = -rise + (total + rise) * axial;  // axial position, mm below the inlet
-    double lumen = p.trachea_lumen_radius_mm +
-                   (p.inlet_lumen_radius_mm - p.trachea_lumen_radius_mm) *
-                       smoothstep(p.larynx_length_mm, 0.0, s);
+    double lumen =
+        p.trachea_lumen_radius_mm + (p.inlet_lumen_radius_mm - p.trachea_lumen_radius_mm) *
+                                        smoothstep(p.larynx_length_mm, 0.0, s);
     double forward = 0.0;
     if (s < 0.0) {
       const double t = -s / p.epiglottis_height_mm;

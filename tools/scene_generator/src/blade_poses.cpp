@@ -14,8 +14,7 @@ Vec3 BladePose::apply(const Vec3& p) const {
 }
 
 std::vector<BladePose> suggested_blade_poses() {
-  return {{"initial", 0.0, Vec3(12.0, 0.5, 0.0)},
-          {"pressing", 8.0, Vec3(-33.0, -0.5, 0.0)}};
+  return {{"initial", 0.0, Vec3(12.0, 0.5, 0.0)}, {"pressing", 8.0, Vec3(-33.0, -0.5, 0.0)}};
 }
 
 TriangleMesh transformed(const TriangleMesh& mesh, const BladePose& pose) {

@@ -2,21 +2,21 @@
 // bend at the heel, straight handle), capped by rounded ends.
 #include "fahr/scenegen/laryngoscope_blade.h"
 
-#include "fahr/scenegen/param_surfaces.h"
-#include "fahr/scenegen/piecewise_linear.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
 
+#include "fahr/scenegen/param_surfaces.h"
+#include "fahr/scenegen/piecewise_linear.h"
+
 namespace fahr::scenegen {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kPathStepMm = 0.05;     // integration step of the centre-line
-constexpr double kTipCapMm = 0.8;        // rounded distal end
-constexpr double kHandleCapMm = 4.0;     // rounded end of the handle
+constexpr double kPathStepMm = 0.05;  // integration step of the centre-line
+constexpr double kTipCapMm = 0.8;     // rounded distal end
+constexpr double kHandleCapMm = 4.0;  // rounded end of the handle
 constexpr int kCapStations = 6;
 // Points per side of the L section, fixed so every station has the same count.
 constexpr std::array<int, 6> kSidePoints = {20, 2, 16, 10, 2, 14};
@@ -70,9 +70,9 @@ std::vector<Eigen::Vector2d> l_section(const BladeParameters& p, double w, doubl
   const double t = p.plate_thickness_mm;
   const double tw = p.web_thickness_mm;
   const std::array<Eigen::Vector2d, 6> corners = {
-      Eigen::Vector2d(-0.5 * w, 0.0),         Eigen::Vector2d(0.5 * w, 0.0),
-      Eigen::Vector2d(0.5 * w, t),            Eigen::Vector2d(-0.5 * w + tw, t),
-      Eigen::Vector2d(-0.5 * w + tw, h),      Eigen::Vector2d(-0.5 * w, h)};
+      Eigen::Vector2d(-0.5 * w, 0.0),    Eigen::Vector2d(0.5 * w, 0.0),
+      Eigen::Vector2d(0.5 * w, t),       Eigen::Vector2d(-0.5 * w + tw, t),
+      Eigen::Vector2d(-0.5 * w + tw, h), Eigen::Vector2d(-0.5 * w, h)};
   std::vector<Eigen::Vector2d> points;
   for (size_t side = 0; side < corners.size(); ++side) {
     const Eigen::Vector2d& a = corners[side];

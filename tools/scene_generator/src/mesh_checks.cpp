@@ -2,7 +2,6 @@
 #include "fahr/scenegen/mesh_checks.h"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -159,8 +158,8 @@ double winding_number(const TriangleMesh& mesh, const Vec3& p) {
 double distance_to_surface(const TriangleMesh& mesh, const Vec3& p) {
   double best = std::numeric_limits<double>::infinity();
   for (const auto& t : mesh.triangles) {
-    const Vec3 q = closest_point_on_triangle(p, mesh.vertices[t[0]], mesh.vertices[t[1]],
-                                             mesh.vertices[t[2]]);
+    const Vec3 q =
+        closest_point_on_triangle(p, mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
     best = std::min(best, (q - p).squaredNorm());
   }
   return std::sqrt(best);
@@ -190,8 +189,8 @@ TetQuality tet_quality(const TetMesh& mesh) {
                                   {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};
     const std::array<const Vec3*, 4> v4{&a, &b, &c, &d};
     for (const auto& e : kEdges) {
-      q.max_dihedral_deg = std::max(
-          q.max_dihedral_deg, dihedral_at_edge(*v4[e[0]], *v4[e[1]], *v4[e[2]], *v4[e[3]]));
+      q.max_dihedral_deg = std::max(q.max_dihedral_deg,
+                                    dihedral_at_edge(*v4[e[0]], *v4[e[1]], *v4[e[2]], *v4[e[3]]));
     }
   }
   return q;

@@ -3,10 +3,10 @@
 // watertight by construction.
 #include "fahr/scenegen/param_surfaces.h"
 
-#include "fahr/scenegen/mesh_checks.h"
-
 #include <algorithm>
 #include <vector>
+
+#include "fahr/scenegen/mesh_checks.h"
 
 namespace fahr::scenegen {
 namespace {
@@ -17,7 +17,9 @@ void add_quad(TriangleMesh& mesh, int a, int b, int c, int d) {
   mesh.triangles.push_back({a, c, d});
 }
 
-double grid_coordinate(int i, int n) { return static_cast<double>(i) / static_cast<double>(n); }
+double grid_coordinate(int i, int n) {
+  return static_cast<double>(i) / static_cast<double>(n);
+}
 
 }  // namespace
 

@@ -100,8 +100,8 @@ bool parse_scene_parameters(const std::vector<std::string>& args, SceneParameter
     const std::string& arg = args[i];
     if (arg == "--help" || arg == "-h") {
       std::ostringstream out;
-      out << "fahr_scene_generator [--flag value]...\n  --out DIR (default "
-          << params.out_dir << ")\n";
+      out << "fahr_scene_generator [--flag value]...\n  --out DIR (default " << params.out_dir
+          << ")\n";
       for (const auto& f : flags) {
         out << "  --" << f.name << " (default " << format_number(*f.value) << "): " << f.help
             << "\n";

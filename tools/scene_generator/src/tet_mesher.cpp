@@ -1,12 +1,12 @@
 // Kuhn-grid tet mesher with quality-guarded boundary snapping.
 #include "fahr/scenegen/tet_mesher.h"
 
-#include "fahr/scenegen/mesh_checks.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
+
+#include "fahr/scenegen/mesh_checks.h"
 
 namespace fahr::scenegen {
 namespace {

@@ -1,11 +1,11 @@
 // Implicit tongue: see tongue_shape.h for the construction.
 #include "fahr/scenegen/tongue_shape.h"
 
-#include "fahr/scenegen/piecewise_linear.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "fahr/scenegen/piecewise_linear.h"
 
 namespace fahr::scenegen {
 namespace {
@@ -13,8 +13,7 @@ namespace {
 // Mid-line as a cubic Bezier through the tip, relative to the tip, for a
 // 40 mm tongue: forward part nearly level under the palate, the back third
 // turning down towards the vallecula. Scaled to the requested length.
-const Eigen::Vector2d kSpineControl[4] = {
-    {0.0, 0.0}, {-15.0, 2.5}, {-28.0, 2.5}, {-33.0, -11.0}};
+const Eigen::Vector2d kSpineControl[4] = {{0.0, 0.0}, {-15.0, 2.5}, {-28.0, 2.5}, {-33.0, -11.0}};
 constexpr int kSpineSamples = 400;
 
 // Section profiles along the mid-line, as fractions of the named dimensions
@@ -76,8 +75,7 @@ TongueShape::TongueShape(const TongueParameters& params) : params_(params) {
 TongueShape::Section TongueShape::section_at(double arc_mm) const {
   const double t = std::clamp(arc_mm / params_.length_mm, 0.0, 1.0);
   return {params_.dorsum_height_mm * kDorsalProfile(t),
-          params_.ventral_depth_mm * kVentralProfile(t),
-          0.5 * params_.width_mm * kWidthProfile(t)};
+          params_.ventral_depth_mm * kVentralProfile(t), 0.5 * params_.width_mm * kWidthProfile(t)};
 }
 
 double TongueShape::sweep_value(const Vec3& p) const {
@@ -104,9 +102,9 @@ double TongueShape::sweep_value(const Vec3& p) const {
     }
   }
   // Blend the sample tangents so the local frame turns smoothly along the mid-line.
-  const Eigen::Vector2d tangent = ((1.0 - foot_t) * spine_[foot_segment].tangent +
-                                   foot_t * spine_[foot_segment + 1].tangent)
-                                      .normalized();
+  const Eigen::Vector2d tangent =
+      ((1.0 - foot_t) * spine_[foot_segment].tangent + foot_t * spine_[foot_segment + 1].tangent)
+          .normalized();
   const Eigen::Vector2d dorsal(tangent.y(), -tangent.x());  // tangent turned towards the palate
   const Eigen::Vector2d rel = q - foot;
   const double axial = rel.dot(tangent);

@@ -44,7 +44,8 @@ class FieldGrid {
   struct Read {
     double value = 0.0;
     // The cell's corners and p's fractions in it, for gradient().
-    double v000 = 0.0, v100 = 0.0, v010 = 0.0, v110 = 0.0, v001 = 0.0, v101 = 0.0, v011 = 0.0, v111 = 0.0;
+    double v000 = 0.0, v100 = 0.0, v010 = 0.0, v110 = 0.0, v001 = 0.0, v101 = 0.0, v011 = 0.0,
+           v111 = 0.0;
     double c00 = 0.0, c10 = 0.0, c01 = 0.0, c11 = 0.0, c0 = 0.0, c1 = 0.0;
     double f[3] = {0.0, 0.0, 0.0};
     Eigen::Vector3d outside = Eigen::Vector3d::Zero();  // p less its clamp to the grid
@@ -89,11 +90,13 @@ inline std::size_t FieldGrid::locate(const Eigen::Vector3d& clamped, double f[3]
   f[0] = u.x() - i;
   f[1] = u.y() - j;
   f[2] = u.z() - k;
-  return static_cast<std::size_t>(i) + stride_y_ * static_cast<std::size_t>(j) + stride_z_ * static_cast<std::size_t>(k);
+  return static_cast<std::size_t>(i) + stride_y_ * static_cast<std::size_t>(j) +
+         stride_z_ * static_cast<std::size_t>(k);
 }
 
 inline double FieldGrid::distance(const Eigen::Vector3d& p) const noexcept {
-  if (!p.allFinite()) return std::numeric_limits<double>::quiet_NaN();  // a NaN pose must not index the grid
+  if (!p.allFinite())
+    return std::numeric_limits<double>::quiet_NaN();  // a NaN pose must not index the grid
   if (values_.empty()) return std::numeric_limits<double>::infinity();
   const Eigen::Vector3d clamped = p.cwiseMax(origin_).cwiseMin(top_);
   double f[3];
@@ -109,7 +112,8 @@ inline double FieldGrid::distance(const Eigen::Vector3d& p) const noexcept {
   return c0 + f[2] * (c1 - c0) + beyond(p, clamped);
 }
 
-inline double FieldGrid::distance_gradient(const Eigen::Vector3d& p, Eigen::Vector3d& gradient) const noexcept {
+inline double FieldGrid::distance_gradient(const Eigen::Vector3d& p,
+                                           Eigen::Vector3d& gradient) const noexcept {
   gradient = Eigen::Vector3d::UnitZ();
   if (!p.allFinite()) return std::numeric_limits<double>::quiet_NaN();
   if (values_.empty()) return std::numeric_limits<double>::infinity();
@@ -184,9 +188,10 @@ inline Eigen::Vector3d FieldGrid::gradient(const Read& r) const noexcept {
   if (r.beyond > 0.0) return r.outside / r.beyond;
   const double dx0 = (r.v100 - r.v000) + r.f[1] * ((r.v110 - r.v010) - (r.v100 - r.v000));
   const double dx1 = (r.v101 - r.v001) + r.f[1] * ((r.v111 - r.v011) - (r.v101 - r.v001));
-  return Eigen::Vector3d((dx0 + r.f[2] * (dx1 - dx0)) * inverse_cell_,
-                         ((r.c10 - r.c00) + r.f[2] * ((r.c11 - r.c01) - (r.c10 - r.c00))) * inverse_cell_,
-                         (r.c1 - r.c0) * inverse_cell_);
+  return Eigen::Vector3d(
+      (dx0 + r.f[2] * (dx1 - dx0)) * inverse_cell_,
+      ((r.c10 - r.c00) + r.f[2] * ((r.c11 - r.c01) - (r.c10 - r.c00))) * inverse_cell_,
+      (r.c1 - r.c0) * inverse_cell_);
 }
 
 }  // namespace fahr::collision

@@ -5,8 +5,8 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 
-#include "fahr/geometry/signed_distance_field.h"
 #include "fahr/collision/field_grid.h"
+#include "fahr/geometry/signed_distance_field.h"
 
 namespace fahr::collision {
 

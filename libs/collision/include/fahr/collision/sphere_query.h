@@ -129,7 +129,8 @@ class PrePenetrationMemory {
     // Floors above kFloorCapM say no more than the cap (a floor may be
     // lower than the truth), and below it a float's rounding is under
     // kFloorRoundingM, taken off first so the stored floor never exceeds it.
-    slots_[slot].grid_floor_m = static_cast<float>(std::min(grid_floor_m, kFloorCapM) - kFloorRoundingM);
+    slots_[slot].grid_floor_m =
+        static_cast<float>(std::min(grid_floor_m, kFloorCapM) - kFloorRoundingM);
   }
   // True and the centre when remembered within max_age queries of `query`.
   // The index is kept modulo 2^32 (next_query() skips 0): at 1 kHz a
@@ -137,13 +138,16 @@ class PrePenetrationMemory {
   bool recall(std::uint32_t slot, std::uint64_t query, std::uint64_t max_age,
               Eigen::Vector3d& centre_body_m) const noexcept {
     const std::uint32_t when = slots_[slot].query_index;
-    if (when == 0 || static_cast<std::uint32_t>(static_cast<std::uint32_t>(query) - when) > max_age) return false;
+    if (when == 0 || static_cast<std::uint32_t>(static_cast<std::uint32_t>(query) - when) > max_age)
+      return false;
     centre_body_m = slots_[slot].centre_body_m;
     return true;
   }
   // The centre last remembered (any age; zero if never) and the floor of the
   // grid there (-inf if never), m.
-  const Eigen::Vector3d& last_centre_body_m(std::uint32_t slot) const noexcept { return slots_[slot].centre_body_m; }
+  const Eigen::Vector3d& last_centre_body_m(std::uint32_t slot) const noexcept {
+    return slots_[slot].centre_body_m;
+  }
   double grid_floor_m(std::uint32_t slot) const noexcept { return slots_[slot].grid_floor_m; }
   // Drops every floor (the next query reads every sphere it tests): for a
   // body whose grid changed, and for tests that compare with and without.
@@ -205,7 +209,7 @@ class PrePenetrationMemory {
 
 struct QueryStats {
   std::uint32_t nodes_visited = 0;
-  std::uint32_t spheres_tested = 0;   // reached the leaf test (read the grid at the centre)
+  std::uint32_t spheres_tested = 0;  // reached the leaf test (read the grid at the centre)
   // Remembered outside without a test: their leaf's bound proved every
   // centre outside and no sphere of it within the candidate margin.
   std::uint32_t spheres_remembered = 0;
@@ -213,11 +217,12 @@ struct QueryStats {
   // less how far they moved since, proved them beyond the candidate margin
   // (PrePenetrationMemory::remember). Not counted in spheres_tested.
   std::uint32_t spheres_bounded = 0;
-  std::uint32_t exact_queries = 0;    // reached the narrow phase (exact or grid)
-  std::uint32_t spheres_inside = 0;   // of those, centre inside the body (depth from the pre-penetration centre)
-  std::uint32_t contacts = 0;         // found (including those a full buffer dropped)
-  bool body_skipped = false;          // the root could not touch the body
-  bool overflowed = false;            // the buffer was full
+  std::uint32_t exact_queries = 0;  // reached the narrow phase (exact or grid)
+  std::uint32_t spheres_inside =
+      0;  // of those, centre inside the body (depth from the pre-penetration centre)
+  std::uint32_t contacts = 0;  // found (including those a full buffer dropped)
+  bool body_skipped = false;   // the root could not touch the body
+  bool overflowed = false;     // the buffer was full
 };
 
 // Appends the contacts of `state`'s spheres with `body` to `out` (not cleared).
@@ -233,6 +238,7 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
 // would have given them. `tree`, `body` and `settings` must be the query's,
 // the tree not refitted since. Allocation-free.
 void complete_deferred(const SphereTree& tree, const RigidBody& body, const QuerySettings& settings,
-                       ContactBuffer& contacts, const std::uint32_t* indices, std::size_t count) noexcept;
+                       ContactBuffer& contacts, const std::uint32_t* indices,
+                       std::size_t count) noexcept;
 
 }  // namespace fahr::collision

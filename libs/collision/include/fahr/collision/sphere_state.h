@@ -33,8 +33,8 @@ class SphereState {
   // squashed toward the surface and the sphere stands out of it
   // (tools/aist_bench/README.md, detection). A linked volume that collapsed
   // or inverted (V <= 0) keeps kMinVolumeScale of the rest radius rather than
-  // vanishing, and a stretch beyond kMaxVolumeScale is capped. Returns false (state unchanged past the first bad node) if a
-  // position is not finite or the span is too short.
+  // vanishing, and a stretch beyond kMaxVolumeScale is capped. Returns false (state unchanged past
+  // the first bad node) if a position is not finite or the span is too short.
   bool update(const sphere_layout::SphereLayout& layout, std::span<const double> positions_m);
 
   // Also the deformed position of each sphere's surface anchor (sum w_i x_i
@@ -51,7 +51,9 @@ class SphereState {
   const std::vector<Eigen::Vector3d>& anchors_m() const { return anchors_m_; }
   // Per sphere, m: the three deformed nodes of its anchor's face (NaN for a
   // sphere without an anchor), for QuerySettings::SurfaceProbe::kFacePoint.
-  const std::vector<std::array<Eigen::Vector3d, 3>>& anchor_faces_m() const { return anchor_faces_m_; }
+  const std::vector<std::array<Eigen::Vector3d, 3>>& anchor_faces_m() const {
+    return anchor_faces_m_;
+  }
   std::uint64_t version() const { return version_; }  // bumped by every update
 
   // The radius scale of a sphere whose linked tets are inverted or flat: a

@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "fahr/sphere_layout/sphere_layout.h"
 #include "fahr/collision/sphere_state.h"
+#include "fahr/sphere_layout/sphere_layout.h"
 
 namespace fahr::collision {
 
@@ -42,7 +42,7 @@ class SphereTree {
   // reports contacts in the same order as before: the FEM's projection
   // takes them in that order and is not order-free.
   static constexpr int kBlockSize = 4;
-  static constexpr int kMaxDepth = 64;   // traversal stack; median splits keep depth ~log2(n/16)+1
+  static constexpr int kMaxDepth = 64;  // traversal stack; median splits keep depth ~log2(n/16)+1
 
   SphereTree() = default;
   explicit SphereTree(const sphere_layout::SphereLayout& layout);
@@ -71,7 +71,8 @@ class SphereTree {
   void build(std::int32_t node, std::int32_t begin, std::int32_t end, int depth,
              const sphere_layout::SphereLayout& layout);
   // Median split of order_[begin, end) on its widest axis; returns the middle.
-  std::int32_t split(std::int32_t begin, std::int32_t end, const sphere_layout::SphereLayout& layout);
+  std::int32_t split(std::int32_t begin, std::int32_t end,
+                     const sphere_layout::SphereLayout& layout);
   // Appends order_[begin, end) to out in the walk order of kBlockSize leaves.
   void arrange_leaf(std::int32_t begin, std::int32_t end, const sphere_layout::SphereLayout& layout,
                     std::vector<std::uint32_t>& out);

@@ -24,8 +24,8 @@
 #include <span>
 #include <vector>
 
-#include "fahr/geometry/surface_mesh.h"
 #include "fahr/collision/rigid_body.h"
+#include "fahr/geometry/surface_mesh.h"
 
 namespace fahr::collision {
 
@@ -79,7 +79,7 @@ struct SurfaceContact {
   std::uint32_t body_id = 0;  // RigidBody::id
   Eigen::Vector3d tool_point_m = Eigen::Vector3d::Zero();     // the deepest sample, world frame
   Eigen::Vector3d surface_point_m = Eigen::Vector3d::Zero();  // nearest surface point, world frame
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();          // body's outward normal there, world frame
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // body's outward normal there, world frame
   double depth_m = 0.0;  // > 0 inside the body; in (-margin, 0] near it
 };
 
@@ -93,8 +93,9 @@ struct SurfaceQueryStats {
 // Appends to out[count..] the contacts of the tool at `world_from_tool` with
 // `body`, one per leaf, for samples with signed distance below margin_m.
 // Allocation-free, noexcept.
-SurfaceQueryStats query_surface_samples(const SurfaceSamples& samples, const Eigen::Isometry3d& world_from_tool,
-                                        const RigidBody& body, double margin_m, std::span<SurfaceContact> out,
-                                        std::size_t& count) noexcept;
+SurfaceQueryStats query_surface_samples(const SurfaceSamples& samples,
+                                        const Eigen::Isometry3d& world_from_tool,
+                                        const RigidBody& body, double margin_m,
+                                        std::span<SurfaceContact> out, std::size_t& count) noexcept;
 
 }  // namespace fahr::collision

@@ -34,8 +34,8 @@ class TriangleBaseline {
   // tissue: the body's boundary surface at rest (world frame, m);
   // surface_to_node[i]: the FEM node of surface vertex i. tool: tool frame, m.
   // Throws std::invalid_argument for empty or mismatched input.
-  TriangleBaseline(const geometry::SurfaceMesh& tissue, std::vector<geometry::Index> surface_to_node,
-                   const geometry::SurfaceMesh& tool);
+  TriangleBaseline(const geometry::SurfaceMesh& tissue,
+                   std::vector<geometry::Index> surface_to_node, const geometry::SurfaceMesh& tool);
   ~TriangleBaseline();
   TriangleBaseline(const TriangleBaseline&) = delete;
   TriangleBaseline& operator=(const TriangleBaseline&) = delete;
@@ -52,8 +52,8 @@ class TriangleBaseline {
                double candidate_margin_m = 0.0);
 
   std::uint64_t refit_count() const;
-  std::uint64_t rebuild_count() const;       // builds after construction: stays 0
-  std::size_t last_pair_count() const;       // box-overlapping triangle pairs of the last collide
+  std::uint64_t rebuild_count() const;  // builds after construction: stays 0
+  std::size_t last_pair_count() const;  // box-overlapping triangle pairs of the last collide
 
   // A vertex found behind a face deeper than this is not that face's contact
   // (it is another face's: a blade plate is 1.2 mm thick), m.

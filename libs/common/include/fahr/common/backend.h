@@ -62,7 +62,8 @@ class ParticipantBackend {
   virtual ~ParticipantBackend() = default;
   virtual std::unique_ptr<WriterBackend> create_writer(const EndpointSpec& spec) = 0;
   // `sink` must outlive the returned reader.
-  virtual std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec, SampleSink* sink) = 0;
+  virtual std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec,
+                                                       SampleSink* sink) = 0;
 };
 
 template <class T>

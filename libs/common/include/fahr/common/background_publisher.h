@@ -32,8 +32,9 @@ class BackgroundPublisher {
   // a slot then allocates nothing); called once per slot.
   // period: how often the thread looks for a new sample, > 0.
   template <class Make>
-    requires std::is_invocable_r_v<T, Make&>
-  BackgroundPublisher(Participant& participant, std::chrono::nanoseconds period, Make make)
+  requires std::is_invocable_r_v<T, Make&> BackgroundPublisher(Participant& participant,
+                                                               std::chrono::nanoseconds period,
+                                                               Make make)
       : publisher_(participant), buffer_(make), period_(period), thread_([this] { run(); }) {}
   ~BackgroundPublisher() {
     stop_.store(true, std::memory_order_release);

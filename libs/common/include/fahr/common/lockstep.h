@@ -27,10 +27,13 @@ namespace fahr::common {
 // The fixed read rule: the newest step s of a producer with period
 // `producer_period` (in base steps) with s < consumer_step. Empty for step
 // 0, where no producer has output yet and consumers use their initial state.
-std::optional<std::uint64_t> producer_step_for(std::uint64_t consumer_step, std::uint64_t producer_period);
+std::optional<std::uint64_t> producer_step_for(std::uint64_t consumer_step,
+                                               std::uint64_t producer_period);
 
 // True if a participant with this period executes at this base step.
-inline bool executes_at(std::uint64_t step, std::uint64_t period) { return step % period == 0; }
+inline bool executes_at(std::uint64_t step, std::uint64_t period) {
+  return step % period == 0;
+}
 
 // 64-bit FNV-1a, for output hashes.
 class OutputHash {
@@ -172,6 +175,5 @@ class StepInput {
   std::size_t next_ = 0;
   Subscriber<T> subscriber_;
 };
-
 
 }  // namespace fahr::common

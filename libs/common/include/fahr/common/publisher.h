@@ -17,7 +17,8 @@ namespace fahr::common {
 template <class T>
 class Publisher {
  public:
-  explicit Publisher(Participant& participant, QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole),
+  explicit Publisher(Participant& participant,
+                     QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole),
                      std::string_view topic_name = TopicTraits<T>::kName)
       : writer_id_(participant.writer_id()) {
     detail::EndpointSpec spec{&detail::type_support<T>(), std::string(topic_name), qos};

@@ -13,10 +13,10 @@ namespace fahr::common {
 
 // If OMP_THREAD_LIMIT is unset and FAHR_SOLVER_THREADS is not "any", sets
 // OMP_THREAD_LIMIT=1, OMP_WAIT_POLICY=passive and OPENBLAS_NUM_THREADS=1 and
-// re-executes the program (its path from /proc/self/exe) with `argv`; returns only if that is not needed
-// or failed (then it prints why and the program runs on as it is). Call
-// first in main(), before any thread starts. FAHR_SOLVER_THREADS=any keeps
-// the libraries' own threading (a station with cores to spare).
+// re-executes the program (its path from /proc/self/exe) with `argv`; returns only if that is not
+// needed or failed (then it prints why and the program runs on as it is). Call first in main(),
+// before any thread starts. FAHR_SOLVER_THREADS=any keeps the libraries' own threading (a station
+// with cores to spare).
 void run_solver_libraries_on_one_thread(char** argv);
 
 }  // namespace fahr::common

@@ -28,7 +28,8 @@ class Subscriber final : private detail::SampleSink {
 
   // `handler`, if given, sees every sample on the vendor thread; it must be
   // quick and must not call back into this subscriber.
-  explicit Subscriber(Participant& participant, QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole),
+  explicit Subscriber(Participant& participant,
+                      QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole),
                       std::string_view topic_name = TopicTraits<T>::kName, Handler handler = {})
       : handler_(std::move(handler)) {
     detail::EndpointSpec spec{&detail::type_support<T>(), std::string(topic_name), qos};

@@ -18,11 +18,11 @@ namespace fahr::common {
 template <class T>
 struct TopicTraits;
 
-#define FAHR_TOPIC(Type, role)                                           \
-  template <>                                                            \
-  struct TopicTraits<msg::Type> {                                        \
-    static constexpr std::string_view kName = "fahr/" #Type;             \
-    static constexpr TopicRole kRole = TopicRole::role;                  \
+#define FAHR_TOPIC(Type, role)                               \
+  template <>                                                \
+  struct TopicTraits<msg::Type> {                            \
+    static constexpr std::string_view kName = "fahr/" #Type; \
+    static constexpr TopicRole kRole = TopicRole::role;      \
   }
 
 // The macro only spells out the table; it keeps names and types in step.

@@ -27,7 +27,7 @@ class TripleBuffer {
   // Every slot from its own call of `make` (for values that own resources
   // no two slots may share).
   template <class Make>
-    requires std::is_invocable_r_v<T, Make&>
+  requires std::is_invocable_r_v<T, Make&>
   explicit TripleBuffer(Make make) : slots_{make(), make(), make()} {}
 
   TripleBuffer(const TripleBuffer&) = delete;
@@ -38,7 +38,8 @@ class TripleBuffer {
   T& back() { return slots_[producer_index_]; }
   // Makes back() the newest value and hands the producer another slot.
   void publish() {
-    const std::uint8_t previous = shared_.exchange(producer_index_ | kFresh, std::memory_order_acq_rel);
+    const std::uint8_t previous =
+        shared_.exchange(producer_index_ | kFresh, std::memory_order_acq_rel);
     producer_index_ = previous & kIndexMask;
     // seq_cst: Subscriber pairs this count with its waiter count (a
     // Dekker-style handshake, via LatestSample), so a waiter either sees the

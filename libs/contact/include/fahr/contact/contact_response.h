@@ -37,9 +37,10 @@ struct ResponseSettings {
   CouplingSettings coupling;
   ForceAwareSettings force_aware;
   PgsSettings pgs;
-  std::size_t max_rows = 64;       // rows solved per tick (tool vs spheres and obstacles)
-  std::size_t max_contacts = 256;  // ContactSet entries per tick, incl. held spheres and obstacle contacts
-  std::size_t max_holds = 64;      // spheres held while frozen
+  std::size_t max_rows = 64;  // rows solved per tick (tool vs spheres and obstacles)
+  std::size_t max_contacts =
+      256;  // ContactSet entries per tick, incl. held spheres and obstacle contacts
+  std::size_t max_holds = 64;  // spheres held while frozen
   // Compliance of a touching sphere whose W block the FEM did not send (it
   // was not yet a candidate), m/N, >= 0. 1e-3 m/N is a 1 kN/m tissue spring,
   // stiffer than the neonatal tongue under a ~3 mm sphere (~ 50 N/m), so the
@@ -49,13 +50,13 @@ struct ResponseSettings {
 
 // One DevicePose as the response needs it (world frame).
 struct DeviceSample {
-  std::uint64_t pose_seq = 0;                                      // DevicePose header.seq
-  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();            // stylus (after workspace mapping), m
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity(); // world_from_stylus, unit
-  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();          // m/s
-  double renderable_force_n = 3.0;  // what the device can render now, N, >= 0
+  std::uint64_t pose_seq = 0;                            // DevicePose header.seq
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // stylus (after workspace mapping), m
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // world_from_stylus, unit
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();           // m/s
+  double renderable_force_n = 3.0;    // what the device can render now, N, >= 0
   double max_stiffness_npm = 1480.0;  // highest stable stiffness, N/m, > 0 (Touch X: 1480)
-  double dt_s = 0.001;              // since the previous tick, s, > 0
+  double dt_s = 0.001;                // since the previous tick, s, > 0
 };
 
 struct TickInput {
@@ -73,12 +74,12 @@ struct TickReport {
   TrackingState state = TrackingState::kTracking;
   SolverLoadReport load;
   PgsReport pgs;
-  PgsWork pgs_work;  // all of this tick's solves
-  bool contacts_overflow = false;  // ContactSet entries dropped
-  bool holds_overflow = false;     // spheres not held while frozen
-  bool catch_up_limited = false;   // the proxy moved at the catch-up speed bound
-  bool yielded = false;            // a held proxy backed off to keep the reaction at the limit
-  bool implausible_step = false;   // the coupled solve's step was refused; the proxy held
+  PgsWork pgs_work;                   // all of this tick's solves
+  bool contacts_overflow = false;     // ContactSet entries dropped
+  bool holds_overflow = false;        // spheres not held while frozen
+  bool catch_up_limited = false;      // the proxy moved at the catch-up speed bound
+  bool yielded = false;               // a held proxy backed off to keep the reaction at the limit
+  bool implausible_step = false;      // the coupled solve's step was refused; the proxy held
   bool tissue_force_clamped = false;  // the tissue forces were scaled down to the limit
   // HeldProxy::kStay or kHoldLoad: the held tool's tissue forces were
   // scaled down to the limit (kStay's spheres stay frozen, kHoldLoad's
@@ -87,7 +88,7 @@ struct TickReport {
   // HeldProxy::kHoldLoad: the tool's entries are force only, the tissue held
   // by its load (while held, or catching up with the load scaled).
   bool tissue_held_by_load = false;
-  bool force_limited = false;      // the commanded force was scaled to the renderable force
+  bool force_limited = false;        // the commanded force was scaled to the renderable force
   double obstacle_reaction_n = 0.0;  // |force of rigid obstacles on the tool|, N
 };
 

@@ -17,10 +17,10 @@
 namespace fahr::contact {
 
 struct SolverLoadReport {
-  std::size_t rows = 0;          // rows loaded
-  bool overflow = false;         // more rows than capacity: the extra rows were dropped
-  int missing_compliance = 0;    // tissue rows without a W block: fallback compliance used
-  int degenerate_normals = 0;    // rows whose normal is not unit length: dropped
+  std::size_t rows = 0;        // rows loaded
+  bool overflow = false;       // more rows than capacity: the extra rows were dropped
+  int missing_compliance = 0;  // tissue rows without a W block: fallback compliance used
+  int degenerate_normals = 0;  // rows whose normal is not unit length: dropped
 };
 
 class ContactSolver {
@@ -86,19 +86,19 @@ class ContactSolver {
   std::size_t capacity_;
   std::size_t k_ = 0;
   std::vector<ContactRow> rows_;
-  std::vector<double> a_;       // Delassus A, capacity^2, m/N
-  std::vector<double> s_;       // system matrix of the current solve, capacity^2, m/N
-  std::vector<double> b_;       // right-hand side, m
-  std::vector<double> depth_;   // d at p0, m
-  std::vector<double> lambda_;  // N
-  std::vector<double> residual_;  // PGS workspace, m
+  std::vector<double> a_;                  // Delassus A, capacity^2, m/N
+  std::vector<double> s_;                  // system matrix of the current solve, capacity^2, m/N
+  std::vector<double> b_;                  // right-hand side, m
+  std::vector<double> depth_;              // d at p0, m
+  std::vector<double> lambda_;             // N
+  std::vector<double> residual_;           // PGS workspace, m
   std::vector<double> fallback_diagonal_;  // per row: 1 if A_ii came from the fallback
   std::vector<std::uint64_t> previous_keys_;
   std::vector<double> previous_lambda_;
   std::size_t previous_count_ = 0;
-  std::vector<std::uint32_t> active_;  // rows of the active set (local stiffness)
-  std::vector<double> factor_;         // capacity^2
-  std::vector<double> columns_;        // 3 x capacity right-hand sides
+  std::vector<std::uint32_t> active_;         // rows of the active set (local stiffness)
+  std::vector<double> factor_;                // capacity^2
+  std::vector<double> columns_;               // 3 x capacity right-hand sides
   std::vector<std::uint32_t> obstacle_rows_;  // project_on_obstacles: its rows, matrix, rhs, mu
   std::vector<double> projection_s_;
   std::vector<double> projection_b_;

@@ -19,16 +19,17 @@ struct CouplingSettings {
 // i.e. K_eff (x_t - p) = N lambda with
 //   K_eff = K_c + B/dt,   x_t = (K_c x_d + B v_d + (B/dt) p_prev) / K_eff.
 struct EffectiveCoupling {
-  double stiffness_npm = 0.0;            // K_c after clamping, N/m
-  double damping_nspm = 0.0;             // B after clamping, N s/m
-  double effective_stiffness_npm = 0.0;  // K_eff, N/m
+  double stiffness_npm = 0.0;                          // K_c after clamping, N/m
+  double damping_nspm = 0.0;                           // B after clamping, N s/m
+  double effective_stiffness_npm = 0.0;                // K_eff, N/m
   Eigen::Vector3d target_m = Eigen::Vector3d::Zero();  // x_t, m
 };
 
 // max_stiffness_npm: what the device renders stably now (DevicePose), > 0.
 // dt_s: tick period, > 0.
-EffectiveCoupling effective_coupling(const CouplingSettings& settings, double max_stiffness_npm, double dt_s,
-                                     const Eigen::Vector3d& device_m, const Eigen::Vector3d& device_velocity_mps,
+EffectiveCoupling effective_coupling(const CouplingSettings& settings, double max_stiffness_npm,
+                                     double dt_s, const Eigen::Vector3d& device_m,
+                                     const Eigen::Vector3d& device_velocity_mps,
                                      const Eigen::Vector3d& previous_proxy_m);
 
 }  // namespace fahr::contact

@@ -10,8 +10,8 @@
 #include <span>
 #include <vector>
 
-#include "fahr/contact/contact_row.h"
 #include "fahr/contact/contact_response.h"
+#include "fahr/contact/contact_row.h"
 #include "fahr/contact/force_output.h"
 #include "fahr/fem/sphere_links.h"
 
@@ -33,7 +33,8 @@ class PenaltyResponse {
   explicit PenaltyResponse(const PenaltySettings& settings);
 
   // rows: measured with the tool at the device pose.
-  const ForceOutput& tick(const DeviceSample& device, std::span<const ContactRow> rows, std::uint64_t fem_step);
+  const ForceOutput& tick(const DeviceSample& device, std::span<const ContactRow> rows,
+                          std::uint64_t fem_step);
 
   std::span<const SphereForce> sphere_forces() const { return {forces_.data(), force_count_}; }
   bool overflow() const { return overflow_; }

@@ -46,7 +46,7 @@ struct PgsWork {
 // s: k x k, symmetric, row stride `stride` (>= k), m/N. b: k, m. lambda: k,
 // N, holds the warm start on entry and the solution on exit. residual: k
 // doubles of workspace (b - S lambda on exit).
-PgsReport solve_pgs(const double* s, std::size_t stride, std::size_t k, const double* b, double* lambda,
-                    double* residual, const PgsSettings& settings);
+PgsReport solve_pgs(const double* s, std::size_t stride, std::size_t k, const double* b,
+                    double* lambda, double* residual, const PgsSettings& settings);
 
 }  // namespace fahr::contact

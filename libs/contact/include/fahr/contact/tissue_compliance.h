@@ -25,7 +25,8 @@ struct TissueCompliance {
   bool along_normals() const { return !normals.empty(); }
   bool valid() const {
     const std::size_t k = sphere_ids.size();
-    return along_normals() ? normals.size() >= 3 * k && w_mpn.size() >= 3 * k * k : w_mpn.size() >= 9 * k * k;
+    return along_normals() ? normals.size() >= 3 * k && w_mpn.size() >= 3 * k * k
+                           : w_mpn.size() >= 9 * k * k;
   }
   // n_s^T W_st n_t, m/N.
   double normal_compliance(std::size_t s, const Eigen::Vector3d& n_s, std::size_t t,

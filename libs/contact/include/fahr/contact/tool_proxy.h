@@ -11,9 +11,9 @@
 namespace fahr::contact {
 
 struct ToolProxy {
-  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();           // tool frame origin, world, m
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity(); // world_from_tool, unit
-  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();         // of the last tick, m/s
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();             // tool frame origin, world, m
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // world_from_tool, unit
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();           // of the last tick, m/s
 };
 
 }  // namespace fahr::contact

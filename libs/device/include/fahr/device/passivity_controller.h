@@ -52,7 +52,8 @@ class PassivityController {
   Vec3 apply(const Vec3& force_n, const Vec3& velocity_mps, std::chrono::duration<double> dt);
   // Updates the observer with the force actually rendered (after safety
   // limits), so the account is of what the hand really received.
-  void account(const Vec3& rendered_force_n, const Vec3& velocity_mps, std::chrono::duration<double> dt);
+  void account(const Vec3& rendered_force_n, const Vec3& velocity_mps,
+               std::chrono::duration<double> dt);
 
   // Energy the port has absorbed, J (>= 0 when passive, up to the cap).
   double observed_energy_j() const { return energy_j_; }

@@ -102,8 +102,8 @@ class SafetyGate {
   Vec3 rate_limit(const Vec3& target_n);
 
   SafetyConfig config_;
-  double max_step_n_;       // force change allowed per tick, N
-  double ramp_step_;        // ramp factor decrement per tick, (0, 1]
+  double max_step_n_;  // force change allowed per tick, N
+  double ramp_step_;   // ramp factor decrement per tick, (0, 1]
   SafetyState state_ = SafetyState::kForceDisabled;
   std::uint32_t ticks_since_command_ = 0;
   std::uint32_t small_ticks_ = 0;

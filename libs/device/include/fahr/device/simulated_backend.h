@@ -48,7 +48,7 @@ class SimulatedBackend final : public Backend {
   Vec3 half_workspace_m_;
   double period_s_;
   double time_s_ = 0.0;
-  Vec3 position_m_;           // device frame
+  Vec3 position_m_;  // device frame
   Vec3 velocity_mps_ = Vec3::Zero();
   Quat orientation_;
 };

@@ -14,9 +14,9 @@
 namespace fahr::device {
 
 struct Keyframe {
-  double time_s = 0.0;          // s since the script started, increasing
-  Vec3 tip_m = Vec3::Zero();    // blade tip target, world frame, m
-  double pitch_deg = 0.0;       // blade pitch about +z, degrees
+  double time_s = 0.0;        // s since the script started, increasing
+  Vec3 tip_m = Vec3::Zero();  // blade tip target, world frame, m
+  double pitch_deg = 0.0;     // blade pitch about +z, degrees
 };
 
 struct TrajectoryPoint {
@@ -53,6 +53,7 @@ Trajectory intubation_script();
 // depth at which the hand spring pulls with `overshoot_factor` times
 // `peak_force_n` against anything that stops the blade at the pressing pose;
 // holds 5 s and releases.
-Trajectory overshoot_script(double peak_force_n, double hand_stiffness_npm, double overshoot_factor = 3.0);
+Trajectory overshoot_script(double peak_force_n, double hand_stiffness_npm,
+                            double overshoot_factor = 3.0);
 
 }  // namespace fahr::device

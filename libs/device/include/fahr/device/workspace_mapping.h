@@ -9,9 +9,9 @@
 namespace fahr::device {
 
 struct WorkspaceMapping {
-  Vec3 translation_m = Vec3::Zero();     // world_from_device translation, m
-  Quat rotation = Quat::Identity();      // world_from_device rotation, unit
-  double motion_scale = 1.0;             // (0, 100]
+  Vec3 translation_m = Vec3::Zero();  // world_from_device translation, m
+  Quat rotation = Quat::Identity();   // world_from_device rotation, unit
+  double motion_scale = 1.0;          // (0, 100]
 
   bool is_identity() const;
   // Fills the pose fields of `pose` from a device-frame reading.

@@ -22,7 +22,8 @@ class SystemAssembly {
   // Builds the pattern of all node pairs sharing a tet (3x3 blocks) and the
   // map from element blocks to non-zeros. fixed_dof[k] != 0 decouples DOF k:
   // its row and column are zero apart from a positive diagonal.
-  void build(std::size_t node_count, const ElementRest& rest, std::span<const std::uint8_t> fixed_dof);
+  void build(std::size_t node_count, const ElementRest& rest,
+             std::span<const std::uint8_t> fixed_dof);
 
   // Writes A = mass_scale diag(m) + stiffness_scale sum_e s_e R_e K0_e R_e^T.
   // mass_per_dof_kg has one entry per DOF. element_scales: s_e, one per
@@ -30,7 +31,8 @@ class SystemAssembly {
   // material, computed exactly as without scales). No allocation.
   void assemble(const ElementRest& rest, std::span<const Eigen::Matrix3d> rotations,
                 const LameParameters& lame, std::span<const double> mass_per_dof_kg,
-                double mass_scale, double stiffness_scale, std::span<const double> element_scales = {});
+                double mass_scale, double stiffness_scale,
+                std::span<const double> element_scales = {});
 
   // Adds k n n^T to the diagonal block of `node`, with k = ratio times the
   // mean of the block's three diagonal entries as they are now (so the

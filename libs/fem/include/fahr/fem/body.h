@@ -42,8 +42,8 @@ namespace fahr::fem {
 
 struct BodySettings {
   Material material = neonatal_tongue();
-  std::chrono::duration<double> time_step{0.002};             // h, s, > 0
-  Eigen::Vector3d gravity_m_per_s2{0.0, -9.81, 0.0};           // m/s^2, body frame
+  std::chrono::duration<double> time_step{0.002};     // h, s, > 0
+  Eigen::Vector3d gravity_m_per_s2{0.0, -9.81, 0.0};  // m/s^2, body frame
   SolverSettings solver;
   ProjectionSettings projection;
   SleepSettings sleep;
@@ -54,14 +54,14 @@ struct BodySettings {
 };
 
 struct StepReport {
-  std::uint64_t step = 0;    // steps taken so far, this one included
-  double time_s = 0.0;       // simulated time after the step, s
-  bool asleep = false;       // no solve was done
-  bool refactorised = false; // a numeric factorisation happened this step
-  bool solve_failed = false; // non-finite or failed solve: state kept, v = 0
-  int solver_iterations = 0; // CG iterations (0 for a direct solve)
+  std::uint64_t step = 0;     // steps taken so far, this one included
+  double time_s = 0.0;        // simulated time after the step, s
+  bool asleep = false;        // no solve was done
+  bool refactorised = false;  // a numeric factorisation happened this step
+  bool solve_failed = false;  // non-finite or failed solve: state kept, v = 0
+  int solver_iterations = 0;  // CG iterations (0 for a direct solve)
   double solver_relative_residual = 0.0;
-  int inverted_elements = 0; // det F <= 0 at the start of the step
+  int inverted_elements = 0;  // det F <= 0 at the start of the step
   bool contacts_applied = false;
   bool contacts_stale = false;
   bool contacts_invalid = false;  // links reference nodes this body lacks
@@ -95,7 +95,8 @@ class Body {
   // Set-up: rest data, lumped mass, sparsity pattern, symbolic analysis and
   // the first factorisation. rest_positions_m: one per node, m. tets: four
   // node indices each, positive volume. fixed_nodes: never move.
-  static BodyOrError create(const BodySettings& settings, std::span<const Eigen::Vector3d> rest_positions_m,
+  static BodyOrError create(const BodySettings& settings,
+                            std::span<const Eigen::Vector3d> rest_positions_m,
                             std::span<const Tet> tets, std::span<const std::uint32_t> fixed_nodes);
 
   // Switches the linear solve (a comparison of solvers on one running body,
@@ -114,11 +115,13 @@ class Body {
   // W = h^2 J A^-1 J^T for the listed spheres, (3k x 3k) row-major float,
   // m/N, from the solver's factorisation: exact when it was refactorised this
   // step (kCholmod with refactor_period 1), the lagged A otherwise.
-  bool compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links, std::span<float> out);
+  bool compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links,
+                  std::span<float> out);
   // The same W along one normal a sphere (ComplianceBlock::compute_along):
   // (3k x k), entry (3s + d, t) = (W_st n_t)_d.
-  bool compliance_along(std::span<const std::uint32_t> spheres, std::span<const Eigen::Vector3d> normals,
-                        const SphereLinks& links, std::span<float> out);
+  bool compliance_along(std::span<const std::uint32_t> spheres,
+                        std::span<const Eigen::Vector3d> normals, const SphereLinks& links,
+                        std::span<float> out);
 
   // Nodes the static anatomy holds (obstacle_support.h): from the next step
   // on, each gets a spring of stiffness_ratio times its diagonal of A along
@@ -148,11 +151,21 @@ class Body {
   std::size_t node_count() const { return mass_kg_.size(); }
   std::size_t element_count() const { return rest_.size(); }
   const ElementRest& element_rest() const { return rest_; }
-  std::span<const double> positions_m() const { return {x_.data(), static_cast<std::size_t>(x_.size())}; }
-  std::span<const double> velocities_m_per_s() const { return {v_.data(), static_cast<std::size_t>(v_.size())}; }
-  Eigen::Vector3d position(std::uint32_t node) const { return x_.segment<3>(3 * Eigen::Index{node}); }
-  Eigen::Vector3d rest_position(std::uint32_t node) const { return rest_x_.segment<3>(3 * Eigen::Index{node}); }
-  std::span<const double> rest_positions_m() const { return {rest_x_.data(), static_cast<std::size_t>(rest_x_.size())}; }
+  std::span<const double> positions_m() const {
+    return {x_.data(), static_cast<std::size_t>(x_.size())};
+  }
+  std::span<const double> velocities_m_per_s() const {
+    return {v_.data(), static_cast<std::size_t>(v_.size())};
+  }
+  Eigen::Vector3d position(std::uint32_t node) const {
+    return x_.segment<3>(3 * Eigen::Index{node});
+  }
+  Eigen::Vector3d rest_position(std::uint32_t node) const {
+    return rest_x_.segment<3>(3 * Eigen::Index{node});
+  }
+  std::span<const double> rest_positions_m() const {
+    return {rest_x_.data(), static_cast<std::size_t>(rest_x_.size())};
+  }
   std::span<const double> mass_kg() const { return mass_kg_; }
   std::span<const double> inverse_mass_per_kg() const { return inverse_mass_; }
   bool fixed(std::uint32_t node) const { return inverse_mass_[node] == 0.0; }
@@ -170,15 +183,16 @@ class Body {
 
  private:
   Body() = default;
-  std::string initialise(std::span<const Eigen::Vector3d> rest_positions_m, std::span<const Tet> tets,
-                         std::span<const std::uint32_t> fixed_nodes);
+  std::string initialise(std::span<const Eigen::Vector3d> rest_positions_m,
+                         std::span<const Tet> tets, std::span<const std::uint32_t> fixed_nodes);
   // Rotations, elastic forces into force_ (accumulated), inverted count.
   int update_rotations_and_forces(bool accumulate_energy, double* elastic_energy_j);
   // The stages of step().
   void compute_forces(StepReport& report);
   void prepare_system(StepReport& report);
   void solve_velocity(StepReport& report);
-  void integrate_and_project(const ContactSet* contacts, const SphereLinks* links, StepReport& report);
+  void integrate_and_project(const ContactSet* contacts, const SphereLinks* links,
+                             StepReport& report);
   void finish_step(StepReport& report);
   void assemble_system();
   bool refactorise();
@@ -196,9 +210,9 @@ class Body {
   double h_ = 0.0;
   LameParameters lame_;
   ElementRest rest_;
-  std::vector<double> mass_kg_;        // per node
-  std::vector<double> inverse_mass_;   // per node, 0 when fixed
-  std::vector<double> mass_per_dof_;   // per DOF, massless nodes get the mean
+  std::vector<double> mass_kg_;       // per node
+  std::vector<double> inverse_mass_;  // per node, 0 when fixed
+  std::vector<double> mass_per_dof_;  // per DOF, massless nodes get the mean
   std::vector<std::uint8_t> fixed_dof_;
   double total_mass_kg_ = 0.0;
 

@@ -34,12 +34,14 @@ class CgSolver {
   // |b - A x| <= relative_tolerance |b| or after max_iterations. `factor`
   // (with its warp) is used with kLaggedCholesky and must be factorised.
   // No allocation.
-  CgResult solve(const SparseMatrix& a, std::span<const int> diagonal_index, std::span<const double> b,
-                 std::span<double> x, double relative_tolerance, int max_iterations,
-                 CgPreconditioner preconditioner, CholmodSolver* factor, WarpedFactor* warp);
+  CgResult solve(const SparseMatrix& a, std::span<const int> diagonal_index,
+                 std::span<const double> b, std::span<double> x, double relative_tolerance,
+                 int max_iterations, CgPreconditioner preconditioner, CholmodSolver* factor,
+                 WarpedFactor* warp);
 
  private:
-  void apply_preconditioner(CgPreconditioner preconditioner, CholmodSolver* factor, WarpedFactor* warp);
+  void apply_preconditioner(CgPreconditioner preconditioner, CholmodSolver* factor,
+                            WarpedFactor* warp);
 
   Eigen::VectorXd r_, z_, p_, q_, inverse_diagonal_;
 };

@@ -34,8 +34,9 @@ class ComplianceBlock {
   // factor is warped: its rotations change every step). J has three rows per
   // sphere, holding the weights w_i on the x, y and z DOFs of its free nodes
   // (fixed DOFs do not move). Returns false if k exceeds the capacity, `out`
-  // is too small, a sphere is unknown, or the factor is missing. Block (s, t) is the motion of sphere s per unit force on sphere
-  // t. No allocation (CHOLMOD's solve buffers are kept per chunk size).
+  // is too small, a sphere is unknown, or the factor is missing. Block (s, t) is the motion of
+  // sphere s per unit force on sphere t. No allocation (CHOLMOD's solve buffers are kept per chunk
+  // size).
   bool compute(std::span<const std::uint32_t> spheres, const SphereLinks& links,
                std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor, WarpedFactor& warp,
                double time_step_s, std::span<float> out);
@@ -47,8 +48,9 @@ class ComplianceBlock {
   // (n_s . W_st n_t) for a third of the solves, if it uses these normals.
   // Nothing is kept between calls. Same failures as compute(); no
   // allocation.
-  bool compute_along(std::span<const std::uint32_t> spheres, std::span<const Eigen::Vector3d> normals,
-                     const SphereLinks& links, std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
+  bool compute_along(std::span<const std::uint32_t> spheres,
+                     std::span<const Eigen::Vector3d> normals, const SphereLinks& links,
+                     std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
                      WarpedFactor& warp, double time_step_s, std::span<float> out);
 
   // Spheres whose columns the last compute() solved (the others were kept).
@@ -65,8 +67,11 @@ class ComplianceBlock {
   // a free (least recently used, not in this request) slot marked for it.
   std::size_t slot_for(std::uint32_t sphere, std::uint64_t factorisation, bool& cached);
   void solve_chunk(std::span<const std::size_t> slots, const SphereLinks& links,
-                   std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor, WarpedFactor& warp);
-  const double* column(std::size_t slot, std::size_t d) const { return columns_.data() + dofs_ * (3 * slot + d); }
+                   std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
+                   WarpedFactor& warp);
+  const double* column(std::size_t slot, std::size_t d) const {
+    return columns_.data() + dofs_ * (3 * slot + d);
+  }
 
   std::size_t dofs_ = 0;
   std::size_t max_spheres_ = 0;

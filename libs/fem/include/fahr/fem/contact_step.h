@@ -92,7 +92,8 @@ class ContactStep {
   // object) the body keeps out of by itself in every step, ContactSet or
   // not; the ContactSet's kObstacle entries are then not projected.
   // Allocates: call at set-up.
-  void set_obstacles(std::span<const ObstacleField* const> fields, const ObstacleProjectionSettings& settings = {});
+  void set_obstacles(std::span<const ObstacleField* const> fields,
+                     const ObstacleProjectionSettings& settings = {});
   bool has_obstacles() const { return obstacles_ != nullptr; }
 
   // Experimental: the tool as an obstacle the whole body is kept out of,
@@ -134,7 +135,8 @@ class ContactStep {
   // ContactSet's, a resultant where a sphere had two pushing contacts);
   // empty for the 3x3 blocks.
   std::span<const Eigen::Vector3d> compliance_normals() const {
-    return along_normals() ? std::span<const Eigen::Vector3d>(normals_) : std::span<const Eigen::Vector3d>();
+    return along_normals() ? std::span<const Eigen::Vector3d>(normals_)
+                           : std::span<const Eigen::Vector3d>();
   }
   std::span<const Eigen::Vector3d> free_centres() const { return free_centres_; }
   // Positions after the implicit step, before the projection (3 per node, m).
@@ -161,11 +163,11 @@ class ContactStep {
   const SphereLinks& links_;
   ContactStepSettings settings_;
   bool fixed_spheres_ = false;
-  std::vector<double> carry_n_;         // carried Algorithm 1 correction, N per DOF
-  std::vector<double> force_n_;         // this step's contact and carried force, N per DOF
-  std::vector<double> free_positions_;  // x_free, m per DOF
-  std::vector<double> projected_;       // projection workspace, m per DOF
-  std::vector<double> start_positions_; // x^n, where the step started, m per DOF
+  std::vector<double> carry_n_;          // carried Algorithm 1 correction, N per DOF
+  std::vector<double> force_n_;          // this step's contact and carried force, N per DOF
+  std::vector<double> free_positions_;   // x_free, m per DOF
+  std::vector<double> projected_;        // projection workspace, m per DOF
+  std::vector<double> start_positions_;  // x^n, where the step started, m per DOF
   std::vector<std::uint32_t> spheres_;
   std::vector<std::int32_t> slot_of_sphere_;  // fixed spheres: index in spheres_, or -1
   // Contact force applied per compliance sphere: magnitude along a unit
@@ -184,9 +186,10 @@ class ContactStep {
   const ObstacleField* tool_field_ = nullptr;
   std::unique_ptr<ObstacleProjection> tool_pass_;
   Eigen::Isometry3d tool_motion_ = Eigen::Isometry3d::Identity();
-  std::vector<double> tool_start_;  // the step's start positions carried by the tool's motion, 3 per node, m
+  std::vector<double>
+      tool_start_;  // the step's start positions carried by the tool's motion, 3 per node, m
   std::unique_ptr<ObstacleSupport> supports_;  // with obstacles_ and a ratio > 0
-  std::unique_ptr<VolumeFloor> volume_floor_;   // with a floor ratio > 0
+  std::unique_ptr<VolumeFloor> volume_floor_;  // with a floor ratio > 0
   ProjectionReport projection_;
 };
 

@@ -132,21 +132,23 @@ class ObstacleProjection {
 
  private:
   enum class NodeOutcome { kClear, kMoved, kUnresolved, kNonFinite };
-  NodeOutcome project_node(std::size_t node, const Eigen::Vector3d* start, const Eigen::Vector3d* rest,
-                           Eigen::Vector3d& x, ProjectionReport& report);
+  NodeOutcome project_node(std::size_t node, const Eigen::Vector3d* start,
+                           const Eigen::Vector3d* rest, Eigen::Vector3d& x,
+                           ProjectionReport& report);
   // Whether the segment a -> b comes within `level` of the field (sphere
   // traced); `if_undecided` when the trace runs out of samples or the field
   // cannot answer.
-  bool segment_enters(const ObstacleField& field, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                      double level_m, bool if_undecided) const;
+  bool segment_enters(const ObstacleField& field, const Eigen::Vector3d& a,
+                      const Eigen::Vector3d& b, double level_m, bool if_undecided) const;
   // Follows the path start -> x; if it meets the margin, moves x (and its
   // sample s) there and returns how far, else returns 0.
-  double enter_along_path(const ObstacleField& field, const Eigen::Vector3d& start, Eigen::Vector3d& x,
-                          ObstacleSample& s, ProjectionReport& report) const;
+  double enter_along_path(const ObstacleField& field, const Eigen::Vector3d& start,
+                          Eigen::Vector3d& x, ObstacleSample& s, ProjectionReport& report) const;
   // The point of the segment start -> x where the field's distance is
   // `level` (start at or above it, x below it), by regula falsi.
-  Eigen::Vector3d entry_point(const ObstacleField& field, const Eigen::Vector3d& start, double start_distance_m,
-                              const Eigen::Vector3d& x, double distance_m, double level_m) const;
+  Eigen::Vector3d entry_point(const ObstacleField& field, const Eigen::Vector3d& start,
+                              double start_distance_m, const Eigen::Vector3d& x, double distance_m,
+                              double level_m) const;
   // Lowers every clearance of `node` by `distance_m` (it moved that far).
   void spend_clearance(std::size_t node, double distance_m);
 

@@ -44,7 +44,8 @@ class ObstacleSupport {
   // positions at the start of the step and after its implicit solve, before
   // any projection. Returns true if the held set or a normal changed. No
   // allocation.
-  bool update(const ObstacleProjection& anatomy, std::span<const double> start_m, std::span<const double> free_m);
+  bool update(const ObstacleProjection& anatomy, std::span<const double> start_m,
+              std::span<const double> free_m);
   // Lets every node go (a reset); returns true if any was held.
   bool clear();
 

@@ -62,21 +62,22 @@ struct ProjectionSettings {
 
 struct ProjectionReport {
   int sweeps = 0;
-  int constraints = 0;          // active or frozen contacts projected
-  int unmovable = 0;            // constraints whose nodes are all fixed
-  int degenerate_normals = 0;   // active contacts with a zero normal, skipped
-  int unknown_spheres = 0;      // sphere ids not in the links, skipped
-  double last_correction_m = 0; // largest |dc| of the last sweep, m
+  int constraints = 0;           // active or frozen contacts projected
+  int unmovable = 0;             // constraints whose nodes are all fixed
+  int degenerate_normals = 0;    // active contacts with a zero normal, skipped
+  int unknown_spheres = 0;       // sphere ids not in the links, skipped
+  double last_correction_m = 0;  // largest |dc| of the last sweep, m
   bool converged = true;
   // The body's own anatomy projection (obstacle_projection.h); all 0 when
   // the body has no obstacles.
-  int obstacle_rounds = 0;         // tool / anatomy alternations this step
-  int obstacle_nodes = 0;          // distinct nodes moved out of the anatomy
-  int obstacle_unresolved = 0;     // nodes left inside the margin by the last pass
-  int obstacle_non_finite = 0;     // nodes with a non-finite position or sample, left alone
-  double obstacle_deepest_m = 0.0; // deepest node inside an obstacle before its move, m (>= 0)
-  int obstacle_supported = 0;      // nodes held by a support spring from the next step on (obstacle_support.h)
-  int tool_nodes = 0;              // node moves out of the tool obstacle (ContactStep::set_tool_obstacle)
+  int obstacle_rounds = 0;          // tool / anatomy alternations this step
+  int obstacle_nodes = 0;           // distinct nodes moved out of the anatomy
+  int obstacle_unresolved = 0;      // nodes left inside the margin by the last pass
+  int obstacle_non_finite = 0;      // nodes with a non-finite position or sample, left alone
+  double obstacle_deepest_m = 0.0;  // deepest node inside an obstacle before its move, m (>= 0)
+  int obstacle_supported =
+      0;               // nodes held by a support spring from the next step on (obstacle_support.h)
+  int tool_nodes = 0;  // node moves out of the tool obstacle (ContactStep::set_tool_obstacle)
   // Nodes beyond a bone this step (obstacle_projection.h): let back through
   // it on their way home, and left alone by it.
   int obstacle_returned = 0;
@@ -109,6 +110,7 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
 // its nodes are fixed (nothing can move).
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
                         std::span<const double> inverse_mass_per_node, const Eigen::Vector3d& dc_m,
-                        std::span<double> positions_m, SphereSpread spread = SphereSpread::kMassWeighted);
+                        std::span<double> positions_m,
+                        SphereSpread spread = SphereSpread::kMassWeighted);
 
 }  // namespace fahr::fem

@@ -63,14 +63,16 @@ class VolumeFloor {
 
   // Moves positions_m (3 per node, m) so every tet keeps its floor, as far
   // as the sweeps allow. No allocation.
-  VolumeFloorReport project(std::span<double> positions_m, std::span<const double> inverse_mass_per_kg);
+  VolumeFloorReport project(std::span<double> positions_m,
+                            std::span<const double> inverse_mass_per_kg);
 
   const VolumeFloorSettings& settings() const { return settings_; }
 
  private:
   // One tet's move toward its floor; false if it was not below (slack
   // included).
-  bool open(std::size_t tet, std::span<double> positions_m, std::span<const double> inverse_mass_per_kg) const;
+  bool open(std::size_t tet, std::span<double> positions_m,
+            std::span<const double> inverse_mass_per_kg) const;
 
   const ElementRest& rest_;
   VolumeFloorSettings settings_;

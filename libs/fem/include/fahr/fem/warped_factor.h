@@ -34,7 +34,8 @@ class WarpedFactor {
 
   // Node rotations: the polar rotation of the volume-weighted sum of the
   // rotations of the elements around each node. No allocation.
-  void update_rotations(const ElementRest& rest, std::span<const Eigen::Matrix3d> element_rotations);
+  void update_rotations(const ElementRest& rest,
+                        std::span<const Eigen::Matrix3d> element_rotations);
   // The factor was just computed at the current rotations.
   void mark_factorised();
 
@@ -45,7 +46,7 @@ class WarpedFactor {
   void solve_columns(CholmodSolver& factor, std::span<double> b, std::span<double> x, int columns);
 
  private:
-  void rotate_to_factor_frame(const double* in, double* out) const;  // Q^T
+  void rotate_to_factor_frame(const double* in, double* out) const;   // Q^T
   void rotate_to_current_frame(const double* in, double* out) const;  // Q
 
   bool enabled_ = true;

@@ -5,8 +5,8 @@
 #pragma once
 
 #include "fahr/geometry/tet_mesh.h"
-#include "fahr/sphere_layout/fill_settings.h"
 #include "fahr/scene/body.h"
+#include "fahr/sphere_layout/fill_settings.h"
 
 namespace fahr::runtime {
 

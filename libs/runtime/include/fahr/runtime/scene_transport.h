@@ -12,7 +12,8 @@ namespace fahr::runtime {
 
 // Throws common::ConfigError naming the flag, variable or value at fault.
 common::TransportConfig transport_for(const scene::Scene& scene, const std::string& dds_flag,
-                                      const std::string& domain_flag, const std::string& profile_flag,
+                                      const std::string& domain_flag,
+                                      const std::string& profile_flag,
                                       std::string participant_name);
 
 }  // namespace fahr::runtime

@@ -5,6 +5,7 @@
 
 namespace fahr::runtime {
 
-int run_service_main(const char* service_name, int (*run)(int argc, char** argv), int argc, char** argv);
+int run_service_main(const char* service_name, int (*run)(int argc, char** argv), int argc,
+                     char** argv);
 
 }  // namespace fahr::runtime

@@ -12,10 +12,10 @@ namespace fahr::runtime {
 
 struct ServiceOptions {
   std::string scene_path;
-  std::string dds;      // empty: FAHR_DDS, else the scene
-  std::string domain;   // empty: FAHR_DOMAIN_ID, else the scene
-  std::string profile;  // empty: FAHR_DDS_PROFILE, else none
-  std::string mode;     // empty: the scene's run.mode
+  std::string dds;           // empty: FAHR_DDS, else the scene
+  std::string domain;        // empty: FAHR_DOMAIN_ID, else the scene
+  std::string profile;       // empty: FAHR_DDS_PROFILE, else none
+  std::string mode;          // empty: the scene's run.mode
   double duration_s = -1.0;  // < 0: the scene's run.duration_s; 0: until SIGINT/SIGTERM
   std::string cpus;          // empty: wherever the kernel puts it (cpu_pinning.h)
 

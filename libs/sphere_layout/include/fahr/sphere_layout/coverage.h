@@ -27,7 +27,7 @@ struct CoverageSettings {
   // Voxel edge of the flood fill that finds the union's outer surface, m, > 0;
   // gaps narrower than this between spheres count as closed.
   double voxel_size_m = 0.25e-3;
-  std::size_t max_voxels = std::size_t{48} << 20;   // memory guard, 1 byte each
+  std::size_t max_voxels = std::size_t{48} << 20;  // memory guard, 1 byte each
   std::size_t max_samples_per_sphere = 4096;
 };
 
@@ -39,7 +39,7 @@ struct CoverageReport {
   double union_to_boundary_mean_m = 0.0;  // m
   double hausdorff_m() const {
     return boundary_to_union_max_m > union_to_boundary_max_m ? boundary_to_union_max_m
-                                                              : union_to_boundary_max_m;
+                                                             : union_to_boundary_max_m;
   }
   std::size_t boundary_samples = 0;
   std::size_t union_samples = 0;  // outer-surface samples used

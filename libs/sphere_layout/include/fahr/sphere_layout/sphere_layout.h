@@ -23,9 +23,9 @@ enum class SphereOrigin : std::uint8_t {
 
 struct SphereRecord {
   Eigen::Vector3d rest_centre_m = Eigen::Vector3d::Zero();  // m, = sum w_i x_i at rest
-  double rest_radius_m = 0.0;                                // m, > 0
-  double rest_linked_volume_m3 = 0.0;                        // rest volume of the linked tets, m^3
-  std::uint32_t first_link = 0;  // into link_nodes / link_weights
+  double rest_radius_m = 0.0;                               // m, > 0
+  double rest_linked_volume_m3 = 0.0;                       // rest volume of the linked tets, m^3
+  std::uint32_t first_link = 0;                             // into link_nodes / link_weights
   std::uint32_t link_count = 0;
   std::uint32_t first_tet = 0;  // into linked_tets
   std::uint32_t tet_count = 0;
@@ -42,10 +42,10 @@ struct SphereRecord {
 // spheres at their rest radius while the tissue under a blade is squashed,
 // so they stand out of the deformed surface; the anchor lies on it.
 struct SurfaceAnchor {
-  std::array<std::uint32_t, 3> nodes{};  // the face's nodes
-  std::array<double, 3> weights{};       // >= 0, sum 1
+  std::array<std::uint32_t, 3> nodes{};                    // the face's nodes
+  std::array<double, 3> weights{};                         // >= 0, sum 1
   Eigen::Vector3d rest_point_m = Eigen::Vector3d::Zero();  // = sum w_i x_i at rest, m
-  std::array<Eigen::Vector3d, 3> rest_face_m{};             // the nodes at rest, m
+  std::array<Eigen::Vector3d, 3> rest_face_m{};            // the nodes at rest, m
 };
 
 class SphereLayout {
@@ -96,9 +96,9 @@ class SphereLayout {
   std::vector<std::uint32_t> link_nodes_;
   std::vector<double> link_weights_;
   std::vector<std::uint32_t> linked_tets_;
-  std::vector<geometry::Tet> tets_;  // the mesh's tets, for the volume of the linked ones
-  std::vector<SurfaceAnchor> anchors_;     // per sphere, or empty
-  std::vector<std::uint8_t> has_anchor_;   // per sphere, or empty
+  std::vector<geometry::Tet> tets_;       // the mesh's tets, for the volume of the linked ones
+  std::vector<SurfaceAnchor> anchors_;    // per sphere, or empty
+  std::vector<std::uint8_t> has_anchor_;  // per sphere, or empty
   std::size_t node_count_ = 0;
   int finest_level_ = 0;
   double coarse_radius_m_ = 0.0;

@@ -14,16 +14,16 @@
 
 #include "contact_set.h"
 #include "device_pose.h"
-#include "fahr/contact/contact_response.h"
-#include "fahr/contact/penalty_response.h"
 #include "fahr/collision/contact_buffer.h"
 #include "fahr/collision/deepest_contacts.h"
 #include "fahr/collision/rigid_body.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/surface_samples.h"
-#include "force_command.h"
+#include "fahr/contact/contact_response.h"
+#include "fahr/contact/penalty_response.h"
 #include "fahr/haptic_service/haptic_setup.h"
 #include "fahr/haptic_service/tissue_snapshot.h"
+#include "force_command.h"
 
 namespace fahr::haptic_service {
 
@@ -31,18 +31,20 @@ namespace fahr::haptic_service {
 // each is a single value, no invariant ties them together).
 struct LoopMetrics {
   std::atomic<std::uint64_t> ticks{0};
-  std::atomic<std::uint64_t> snapshots{0};          // distinct FEM states the ticks used
-  std::atomic<std::uint32_t> tool_rows{0};          // tissue rows of the last tick (touching and candidates)
-  std::atomic<std::uint32_t> anatomy_rows{0};       // tool vs rigid anatomy rows of the last tick
-  std::atomic<std::uint32_t> active_contacts{0};    // rows with lambda > 0, last tick
-  std::atomic<std::uint64_t> rows_dropped{0};       // tool contacts beyond the row budget, total
-  std::atomic<std::uint64_t> query_overflows{0};    // contact buffer full, total
-  std::atomic<std::uint32_t> missing_compliance{0}; // rows on the fallback compliance, last tick
+  std::atomic<std::uint64_t> snapshots{0};  // distinct FEM states the ticks used
+  std::atomic<std::uint32_t> tool_rows{
+      0};  // tissue rows of the last tick (touching and candidates)
+  std::atomic<std::uint32_t> anatomy_rows{0};        // tool vs rigid anatomy rows of the last tick
+  std::atomic<std::uint32_t> active_contacts{0};     // rows with lambda > 0, last tick
+  std::atomic<std::uint64_t> rows_dropped{0};        // tool contacts beyond the row budget, total
+  std::atomic<std::uint64_t> query_overflows{0};     // contact buffer full, total
+  std::atomic<std::uint32_t> missing_compliance{0};  // rows on the fallback compliance, last tick
   std::atomic<std::uint64_t> lost_track_ticks{0};
   std::atomic<std::uint64_t> lost_track_episodes{0};
-  std::atomic<double> reaction_n{0.0};              // last tissue reaction, N
-  std::atomic<double> obstacle_reaction_n{0.0};     // last reaction of the rigid anatomy on the tool, N
-  std::atomic<double> peak_force_n{0.0};            // largest |F_k| commanded, N
+  std::atomic<double> reaction_n{0.0};  // last tissue reaction, N
+  std::atomic<double> obstacle_reaction_n{
+      0.0};                               // last reaction of the rigid anatomy on the tool, N
+  std::atomic<double> peak_force_n{0.0};  // largest |F_k| commanded, N
   // Work time of a tick (query, solve, messages): largest since the last
   // report (the reporter resets it) and over the whole run, us.
   std::atomic<double> tick_us_max{0.0};
@@ -84,7 +86,8 @@ class HapticLoop {
   std::size_t select_rows(const TissueSnapshot& tissue);
   void collect_triangle_rows(const TissueSnapshot& tissue);
   void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
-  const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device, const TissueSnapshot& tissue);
+  const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device,
+                                           const TissueSnapshot& tissue);
 
   const HapticSetup& setup_;
   double nominal_period_s_;
@@ -99,8 +102,10 @@ class HapticLoop {
   collision::QuerySettings tool_query_;
   collision::PrePenetrationMemory tool_memory_;
   collision::ContactBuffer tool_contacts_;
-  std::vector<std::uint32_t> order_;  // indices into tool_contacts_, deepest first when over capacity
-  std::vector<double> row_key_;       // per contact: select_rows' key (RowCompliance other than kDeepest)
+  std::vector<std::uint32_t>
+      order_;  // indices into tool_contacts_, deepest first when over capacity
+  std::vector<double>
+      row_key_;  // per contact: select_rows' key (RowCompliance other than kDeepest)
   // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
   std::vector<collision::TriangleContact> triangle_contacts_;
   std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1

@@ -10,17 +10,17 @@
 #include <string_view>
 #include <vector>
 
+#include "fahr/collision/field_grid.h"
+#include "fahr/collision/surface_samples.h"
 #include "fahr/contact/contact_response.h"
 #include "fahr/contact/penalty_response.h"
 #include "fahr/geometry/signed_distance_field.h"
 #include "fahr/geometry/surface_mesh.h"
 #include "fahr/geometry/tet_mesh.h"
-#include "fahr/collision/field_grid.h"
-#include "fahr/sphere_layout/fill_settings.h"
-#include "fahr/sphere_layout/sphere_layout.h"
-#include "fahr/collision/surface_samples.h"
 #include "fahr/runtime/rigid_field.h"
 #include "fahr/scene/scene.h"
+#include "fahr/sphere_layout/fill_settings.h"
+#include "fahr/sphere_layout/sphere_layout.h"
 
 namespace fahr::haptic_service {
 

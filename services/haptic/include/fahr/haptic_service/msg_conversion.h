@@ -16,7 +16,9 @@
 
 namespace fahr::haptic_service {
 
-inline Eigen::Vector3d to_eigen(const msg::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+inline Eigen::Vector3d to_eigen(const msg::Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 inline void put(const Eigen::Vector3d& v, msg::Vec3& out) {
   out.x(v.x());
@@ -29,7 +31,8 @@ Eigen::Quaterniond to_eigen(const msg::Quat& q);
 
 void put(const Eigen::Quaterniond& q, msg::Quat& out);
 
-void fill_command(const contact::ForceOutput& output, std::uint32_t device_id, msg::ForceCommand& out);
+void fill_command(const contact::ForceOutput& output, std::uint32_t device_id,
+                  msg::ForceCommand& out);
 
 // Contacts in the response's order. Tool contacts name `tool_body_id`;
 // obstacle contacts take their body from `obstacle_body_ids`, in order (the

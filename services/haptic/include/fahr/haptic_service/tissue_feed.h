@@ -27,9 +27,9 @@ struct FeedMetrics {
   std::atomic<std::uint64_t> bad_states{0};         // wrong size or non-finite: ignored
   std::atomic<std::uint32_t> obstacle_contacts{0};  // tongue vs anatomy, newest state
   std::atomic<std::uint64_t> obstacle_overflows{0};
-  std::atomic<bool> free_centres{false};            // the newest state carried free-motion centres
-  std::atomic<double> digest_us_max{0.0};           // since the last report, us
-  std::atomic<double> digest_us_peak{0.0};          // whole run, us
+  std::atomic<bool> free_centres{false};    // the newest state carried free-motion centres
+  std::atomic<double> digest_us_max{0.0};   // since the last report, us
+  std::atomic<double> digest_us_peak{0.0};  // whole run, us
 };
 
 class TissueFeed {

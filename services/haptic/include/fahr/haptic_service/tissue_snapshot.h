@@ -13,15 +13,15 @@
 #include <vector>
 
 #include "deformation_state.h"
-#include "fahr/contact/contact_row.h"
-#include "fahr/contact/tissue_compliance.h"
-#include "fahr/fem/contact_set.h"
 #include "fahr/collision/contact_buffer.h"
 #include "fahr/collision/rigid_body.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_state.h"
 #include "fahr/collision/sphere_tree.h"
 #include "fahr/collision/triangle_baseline.h"
+#include "fahr/contact/contact_row.h"
+#include "fahr/contact/tissue_compliance.h"
+#include "fahr/fem/contact_set.h"
 #include "fahr/haptic_service/haptic_setup.h"
 
 namespace fahr::haptic_service {
@@ -64,7 +64,9 @@ struct TissueSnapshot {
   double digest_us = 0.0;  // wall time the digest took, us
 
   contact::TissueCompliance compliance() const;
-  std::span<const fem::Contact> tissue_obstacle_contacts() const { return {obstacle_contacts.data(), obstacle_count}; }
+  std::span<const fem::Contact> tissue_obstacle_contacts() const {
+    return {obstacle_contacts.data(), obstacle_count};
+  }
   std::span<const std::uint32_t> tissue_obstacle_body_ids() const {
     return {obstacle_body_ids.data(), obstacle_count};
   }

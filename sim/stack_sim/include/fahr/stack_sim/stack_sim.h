@@ -19,18 +19,18 @@
 #include "device_pose.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/contact/force_aware.h"
-#include "fahr/metrics/duration_histogram.h"
 #include "fahr/device/servo_core.h"
 #include "fahr/device/simulated_backend.h"
 #include "fahr/device/trajectory.h"
 #include "fahr/fem_service/anatomy_fields.h"
 #include "fahr/fem_service/fem_body_setup.h"
 #include "fahr/fem_service/service_step.h"
-#include "fahr/scene/scene.h"
-#include "force_command.h"
 #include "fahr/haptic_service/haptic_loop.h"
 #include "fahr/haptic_service/haptic_setup.h"
 #include "fahr/haptic_service/tissue_snapshot.h"
+#include "fahr/metrics/duration_histogram.h"
+#include "fahr/scene/scene.h"
+#include "force_command.h"
 
 namespace fahr::stack_sim {
 

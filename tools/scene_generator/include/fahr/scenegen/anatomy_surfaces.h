@@ -18,8 +18,7 @@ ParamBox palate_box(const PalateParameters& p, double resolution_mm);
 // The jaw is a solid trough: the floor of the mouth just under the tongue's
 // attachment plane, the mandibular bodies beside the tongue, the lower gum
 // ridge in front of its tip.
-TriangleMesh make_jaw(const JawParameters& p, const TongueParameters& tongue,
-                      double resolution_mm);
+TriangleMesh make_jaw(const JawParameters& p, const TongueParameters& tongue, double resolution_mm);
 // The parameter box behind make_jaw, for folded_box_tets.
 ParamBox jaw_box(const JawParameters& p, const TongueParameters& tongue, double resolution_mm);
 

@@ -4,10 +4,10 @@
 // mid-sagittal plane) followed by a translation of the tool origin (the tip).
 #pragma once
 
-#include "fahr/scenegen/geometry_types.h"
-
 #include <string>
 #include <vector>
+
+#include "fahr/scenegen/geometry_types.h"
 
 namespace fahr::scenegen {
 

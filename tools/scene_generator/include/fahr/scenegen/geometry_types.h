@@ -5,7 +5,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross products
-
 #include <array>
 #include <vector>
 

@@ -3,10 +3,10 @@
 // by the test and by the renderer's statistics.
 #pragma once
 
-#include "fahr/scenegen/geometry_types.h"
-
 #include <array>
 #include <string>
+
+#include "fahr/scenegen/geometry_types.h"
 
 namespace fahr::scenegen {
 

@@ -3,9 +3,9 @@
 // line and element) live in services/geometry.
 #pragma once
 
-#include "fahr/scenegen/geometry_types.h"
-
 #include <string>
+
+#include "fahr/scenegen/geometry_types.h"
 
 namespace fahr::scenegen {
 

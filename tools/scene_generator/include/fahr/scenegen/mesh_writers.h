@@ -3,10 +3,10 @@
 // the same mesh always gives the same bytes.
 #pragma once
 
-#include "fahr/scenegen/geometry_types.h"
-
 #include <string>
 #include <vector>
+
+#include "fahr/scenegen/geometry_types.h"
 
 namespace fahr::scenegen {
 

@@ -4,9 +4,9 @@
 // so callers need not care about the handedness of their parametrisation.
 #pragma once
 
-#include "fahr/scenegen/geometry_types.h"
-
 #include <functional>
+
+#include "fahr/scenegen/geometry_types.h"
 
 namespace fahr::scenegen {
 

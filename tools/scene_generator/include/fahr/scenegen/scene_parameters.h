@@ -18,36 +18,36 @@ struct TongueParameters {
   double ventral_depth_mm = 12.0;  // mid-line down to the floor attachment, mid-tongue
   double tip_x_mm = -9.0;          // anterior tip, behind the lower gum ridge
   double tip_y_mm = -2.5;
-  double floor_y_at_x15_mm = -9.5;  // attachment plane (floor of mouth) height at x = -15 mm
-  double floor_slope = 0.42;        // dy/dx of the attachment plane (rises anteriorly)
-  double snap_min_dihedral_deg = 8.0;    // boundary snapping never goes below this
-  double snap_min_volume_fraction = 0.1; // ... nor below this fraction of a grid tet
+  double floor_y_at_x15_mm = -9.5;        // attachment plane (floor of mouth) height at x = -15 mm
+  double floor_slope = 0.42;              // dy/dx of the attachment plane (rises anteriorly)
+  double snap_min_dihedral_deg = 8.0;     // boundary snapping never goes below this
+  double snap_min_volume_fraction = 0.1;  // ... nor below this fraction of a grid tet
 };
 
 struct PalateParameters {
-  double front_x_mm = -1.5;        // labial face of the upper gum ridge
-  double length_mm = 26.0;         // hard palate, incisive point to posterior margin
+  double front_x_mm = -1.5;  // labial face of the upper gum ridge
+  double length_mm = 26.0;   // hard palate, incisive point to posterior margin
   double front_half_width_mm = 9.0;
   double back_half_width_mm = 15.0;
-  double gum_ridge_y_mm = 7.5;     // crest of the upper gum ridge
-  double vault_depth_mm = 2.0;     // rise of the palatal vault above the ridge line
-  double top_y_mm = 17.0;          // top of the (solid) maxilla block
+  double gum_ridge_y_mm = 7.5;  // crest of the upper gum ridge
+  double vault_depth_mm = 2.0;  // rise of the palatal vault above the ridge line
+  double top_y_mm = 17.0;       // top of the (solid) maxilla block
 };
 
 struct JawParameters {
-  double front_x_mm = -1.0;        // labial face of the lower gum ridge
-  double length_mm = 34.0;         // chin to gonial angle along x
+  double front_x_mm = -1.0;  // labial face of the lower gum ridge
+  double length_mm = 34.0;   // chin to gonial angle along x
   double front_half_width_mm = 10.0;
-  double back_half_width_mm = 31.8;  // half the intergonial width
-  double ridge_y_mm = -5.5;        // crest of the lower gum ridge
-  double bottom_y_mm = -24.0;      // inferior border of the mandible
-  double floor_gap_mm = 0.4;       // clearance below the tongue's attachment plane
+  double back_half_width_mm = 31.8;        // half the intergonial width
+  double ridge_y_mm = -5.5;                // crest of the lower gum ridge
+  double bottom_y_mm = -24.0;              // inferior border of the mandible
+  double floor_gap_mm = 0.4;               // clearance below the tongue's attachment plane
   double wall_inner_half_width_mm = 14.5;  // inner face of the mandibular bodies
 };
 
 struct FaceParameters {
-  double mouth_half_width_mm = 11.0;   // half the opening between the lip commissures
-  double mouth_half_height_mm = 8.0;   // half the lip opening during laryngoscopy
+  double mouth_half_width_mm = 11.0;  // half the opening between the lip commissures
+  double mouth_half_height_mm = 8.0;  // half the lip opening during laryngoscopy
   double mouth_centre_y_mm = 0.5;
   double face_half_width_mm = 38.0;
   double face_half_height_mm = 36.0;
@@ -57,7 +57,7 @@ struct FaceParameters {
 };
 
 struct AirwayParameters {
-  double inlet_x_mm = -62.0;       // centre of the laryngeal inlet
+  double inlet_x_mm = -62.0;  // centre of the laryngeal inlet
   double inlet_y_mm = -30.0;
   double tilt_deg = 8.0;           // axis leans posteriorly going down
   double larynx_length_mm = 18.0;  // inlet to the first tracheal ring
@@ -65,13 +65,13 @@ struct AirwayParameters {
   double inlet_lumen_radius_mm = 3.8;
   double trachea_lumen_radius_mm = 2.3;  // ~4.6 mm lumen diameter
   double wall_thickness_mm = 1.5;
-  double epiglottis_height_mm = 12.0;    // free edge above the inlet rim
-  double epiglottis_flare_mm = 2.0;      // forward curl of its tip
+  double epiglottis_height_mm = 12.0;  // free edge above the inlet rim
+  double epiglottis_flare_mm = 2.0;    // forward curl of its tip
 };
 
 struct BladeParameters {
   std::string name;
-  double length_mm = 0.0;       // tip to heel along the spatula
+  double length_mm = 0.0;  // tip to heel along the spatula
   double tip_width_mm = 0.0;
   double heel_width_mm = 0.0;
   double tip_web_height_mm = 0.0;

@@ -5,18 +5,18 @@
 // refused when it would invert a tet or push it below the quality floor.
 #pragma once
 
-#include "fahr/scenegen/geometry_types.h"
-#include "fahr/scenegen/tongue_shape.h"
-
 #include <string>
 #include <vector>
+
+#include "fahr/scenegen/geometry_types.h"
+#include "fahr/scenegen/tongue_shape.h"
 
 namespace fahr::scenegen {
 
 struct TetMesherSettings {
   double cell_mm = 2.0;
-  double min_dihedral_deg = 8.0;       // snapping keeps every touched tet above this
-  double min_volume_fraction = 0.1;    // ... and above this fraction of a grid tet's volume
+  double min_dihedral_deg = 8.0;     // snapping keeps every touched tet above this
+  double min_volume_fraction = 0.1;  // ... and above this fraction of a grid tet's volume
   int snap_passes = 3;
 };
 

@@ -5,10 +5,10 @@
 // value approximates the distance to the surface in mm near the surface.
 #pragma once
 
+#include <vector>
+
 #include "fahr/scenegen/geometry_types.h"
 #include "fahr/scenegen/scene_parameters.h"
-
-#include <vector>
 
 namespace fahr::scenegen {
 

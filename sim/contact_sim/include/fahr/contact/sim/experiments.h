@@ -28,27 +28,29 @@ double fem_static_stiffness(double punch_radius_m);
 // Presses the punch to `depth_m` (device target; the proxy stops a coupling
 // stretch short) and holds for 0.6 s of simulated time. fem_static_npm: from
 // fem_static_stiffness, for the FEM's own error.
-PunchResult run_punch_experiment(double fem_hz, double punch_radius_m, double depth_m, double fem_static_npm);
+PunchResult run_punch_experiment(double fem_hz, double punch_radius_m, double depth_m,
+                                 double fem_static_npm);
 
 struct OvershootResult {
   Method method = Method::kForceAware;
   double limit_n = 0.0;
   double coupling_npm = 0.0;
-  double max_commanded_n = 0.0;         // largest K_c |x_d - p| (force-aware) or |k_p sum d n| (penalty), N
-  double max_reaction_lost_n = 0.0;     // largest tissue reaction while lost track, N
-  double max_reaction_n = 0.0;          // largest tissue reaction overall, N
-  double strain_at_1x = 0.0;            // max Green strain when the command first reached the limit
-  double strain_at_3x = 0.0;            // ... when it reached 3x (or the deepest point)
-  double max_gap_error_m = 0.0;         // | |gap| - (F_cmd - L)/K_c - L/K_c | while lost track, m
-  double max_reengage_step_n = 0.0;     // largest |dF| per tick within 50 ms of re-engagement, N
-  double max_tick_step_n = 0.0;         // largest |dF| per tick of the whole run, N
+  double max_commanded_n =
+      0.0;  // largest K_c |x_d - p| (force-aware) or |k_p sum d n| (penalty), N
+  double max_reaction_lost_n = 0.0;  // largest tissue reaction while lost track, N
+  double max_reaction_n = 0.0;       // largest tissue reaction overall, N
+  double strain_at_1x = 0.0;         // max Green strain when the command first reached the limit
+  double strain_at_3x = 0.0;         // ... when it reached 3x (or the deepest point)
+  double max_gap_error_m = 0.0;      // | |gap| - (F_cmd - L)/K_c - L/K_c | while lost track, m
+  double max_reengage_step_n = 0.0;  // largest |dF| per tick within 50 ms of re-engagement, N
+  double max_tick_step_n = 0.0;      // largest |dF| per tick of the whole run, N
   double displacement_1s_after_release_m = 0.0;
-  double max_penetration_m = 0.0;       // deepest row penetration into the tissue, m
+  double max_penetration_m = 0.0;  // deepest row penetration into the tissue, m
   int max_inverted = 0;
   double max_elastic_energy_j = 0.0;
   double final_elastic_energy_j = 0.0;
   bool finite = true;
-  double deepest_device_y_m = 0.0;      // for the penalty run to follow the same path
+  double deepest_device_y_m = 0.0;  // for the penalty run to follow the same path
   std::uint64_t lost_track_ticks = 0;
 };
 
@@ -58,11 +60,11 @@ OvershootResult run_overshoot_experiment(Method method, double limit_n, double d
 
 struct SmoothnessResult {
   Method method = Method::kForceAware;
-  double line_n = 0.0;        // 50 Hz line amplitude of |F|, N
-  double mean_force_n = 0.0;  // over the window, N
+  double line_n = 0.0;          // 50 Hz line amplitude of |F|, N
+  double mean_force_n = 0.0;    // over the window, N
   double tick_median_us = 0.0;  // response tick wall time over the window, us
   double tick_p99_us = 0.0;
-  double mean_sweeps = 0.0;     // PGS sweeps per tick over the window
+  double mean_sweeps = 0.0;  // PGS sweeps per tick over the window
 };
 
 // Steady pressing at 5 mm/s with the FEM at 50 Hz; the window is 1 s.

@@ -43,9 +43,12 @@ class FemDriver {
  public:
   // compliance_spheres: the candidate spheres whose W is published (<= the
   // body's max_compliance_spheres). Returns null and sets `error` on failure.
-  static std::unique_ptr<FemDriver> create(const FemDriverSettings& settings, const fem::TetMesh& mesh,
-                                           std::span<const std::uint32_t> fixed_nodes, fem::SphereLinks links,
-                                           std::span<const std::uint32_t> compliance_spheres, std::string& error);
+  static std::unique_ptr<FemDriver> create(const FemDriverSettings& settings,
+                                           const fem::TetMesh& mesh,
+                                           std::span<const std::uint32_t> fixed_nodes,
+                                           fem::SphereLinks links,
+                                           std::span<const std::uint32_t> compliance_spheres,
+                                           std::string& error);
 
   // One FEM step with the given contacts (may be null) and external nodal
   // forces (3 per node, N; empty for none).
@@ -60,7 +63,9 @@ class FemDriver {
   std::span<const Eigen::Vector3d> centres() const { return centres_; }
   std::span<const double> radii() const { return radii_; }
   std::span<const std::int32_t> compliance_index() const { return compliance_index_; }
-  std::span<const std::uint32_t> compliance_spheres() const { return contact_step_->compliance_spheres(); }
+  std::span<const std::uint32_t> compliance_spheres() const {
+    return contact_step_->compliance_spheres();
+  }
   std::span<const float> compliance() const { return contact_step_->compliance(); }
   const fem::ContactStep& contact_step() const { return *contact_step_; }
   std::uint64_t step_index() const { return body_->step_index(); }

@@ -13,12 +13,12 @@
 namespace fahr::contact::sim {
 
 struct GradedBlockSpec {
-  double half_width_m = 0.05;       // x and z extent either side of the centre, m, > 0
-  double depth_m = 0.05;            // y extent below the top face, m, > 0
-  double fine_half_width_m = 0.008; // uniform region either side of the centre, m
-  double fine_depth_m = 0.008;      // uniform region below the top face, m
-  double fine_cell_m = 0.0016;      // cell size there, m, > 0
-  double growth = 1.35;             // ratio of neighbouring cell sizes outside, >= 1
+  double half_width_m = 0.05;        // x and z extent either side of the centre, m, > 0
+  double depth_m = 0.05;             // y extent below the top face, m, > 0
+  double fine_half_width_m = 0.008;  // uniform region either side of the centre, m
+  double fine_depth_m = 0.008;       // uniform region below the top face, m
+  double fine_cell_m = 0.0016;       // cell size there, m, > 0
+  double growth = 1.35;              // ratio of neighbouring cell sizes outside, >= 1
 };
 
 struct BlockScene {

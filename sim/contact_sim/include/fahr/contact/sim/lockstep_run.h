@@ -28,8 +28,8 @@ struct LockstepConfig {
   PenaltySettings penalty;
   ToolShape tool;
   std::vector<PlaneObstacle> obstacles;
-  double renderable_force_n = 3.0;   // N
-  double max_stiffness_npm = 1480.0; // N/m
+  double renderable_force_n = 3.0;    // N
+  double max_stiffness_npm = 1480.0;  // N/m
 };
 
 struct TickRecord {
@@ -44,8 +44,8 @@ struct TickRecord {
   bool lost_track = false;
   Eigen::Vector3d gap_m = Eigen::Vector3d::Zero();
   std::uint32_t active = 0;
-  bool fem_stepped = false;      // the FEM stepped at this tick (after the haptic tick)
-  FemStepReport fem;             // valid when fem_stepped
+  bool fem_stepped = false;  // the FEM stepped at this tick (after the haptic tick)
+  FemStepReport fem;         // valid when fem_stepped
   // Largest penetration of an active tool constraint after the FEM's
   // projection of this step, m (valid when fem_stepped).
   double active_penetration_m = 0.0;
@@ -84,8 +84,8 @@ class LockstepRun {
   ContactResponse response_;
   PenaltyResponse penalty_;
   std::vector<ContactRow> rows_;
-  fem::ContactSet pending_;   // output of the last haptic tick
-  fem::ContactSet applied_;   // what the FEM step reads
+  fem::ContactSet pending_;  // output of the last haptic tick
+  fem::ContactSet applied_;  // what the FEM step reads
   std::vector<double> pending_forces_, applied_forces_;
   std::uint64_t fem_state_step_ = 0;  // lockstep step that produced the FEM's newest output
   std::uint64_t tick_ = 0;

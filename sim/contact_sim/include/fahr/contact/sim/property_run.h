@@ -32,11 +32,11 @@ struct PropertyLimits {
 struct PropertyRunResult {
   int run = 0;
   std::uint64_t seed = 0;
-  double limit_n = 0.0;            // renderable force of the run, N
-  bool finite = true;              // no NaN or infinity in force, proxy or FEM
-  bool froze = false;              // lost track at least once
-  double max_reaction_n = 0.0;     // largest tissue reaction, N
-  double max_command_n = 0.0;      // largest |ForceCommand force|, N
+  double limit_n = 0.0;         // renderable force of the run, N
+  bool finite = true;           // no NaN or infinity in force, proxy or FEM
+  bool froze = false;           // lost track at least once
+  double max_reaction_n = 0.0;  // largest tissue reaction, N
+  double max_command_n = 0.0;   // largest |ForceCommand force|, N
   // Largest penetration an active constraint kept for more than
   // persistent_steps consecutive FEM steps (the smallest depth over such a
   // window), m; 0 when none lasted.
@@ -44,7 +44,7 @@ struct PropertyRunResult {
   // Largest penetration of a force-only tool contact (TickRecord), m:
   // reported, not a property (no constraint keeps it out).
   double max_force_only_penetration_m = 0.0;
-  std::string failure;             // the first property broken; empty when all held
+  std::string failure;  // the first property broken; empty when all held
   bool ok() const { return failure.empty(); }
 };
 
@@ -65,6 +65,7 @@ inline constexpr double kPropertyRunSeconds = 2.0;
 
 std::uint64_t property_seed(int run);
 
-PropertyRunResult run_property(int run, double seconds, PropertyScenes& scenes, const PropertyLimits& limits = {});
+PropertyRunResult run_property(int run, double seconds, PropertyScenes& scenes,
+                               const PropertyLimits& limits = {});
 
 }  // namespace fahr::contact::sim

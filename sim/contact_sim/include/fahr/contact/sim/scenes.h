@@ -23,7 +23,7 @@ struct PunchScene {
   // Area-equivalent radius of the nodes under the punch, m: each fine top
   // node carries s^2 of surface, so a_eff = s sqrt(N / pi). The FEM's punch.
   double effective_radius_m = 0.0;
-  double sphere_radius_m = 0.0002;          // node spheres, m
+  double sphere_radius_m = 0.0002;  // node spheres, m
   std::unique_ptr<FemDriver> fem;
 };
 
@@ -42,7 +42,8 @@ inline constexpr PunchMesh kSmallPunchMesh{2.5, 4.0, 1.5};
 // recompute_compliance: refactorise every step, so W (which follows the
 // factorisation) is exact every step instead of the rest W.
 PunchScene make_punch_scene(double punch_radius_m, double fem_period_s, std::string& error,
-                            const PunchMesh& mesh = kAccuratePunchMesh, bool recompute_compliance = false);
+                            const PunchMesh& mesh = kAccuratePunchMesh,
+                            bool recompute_compliance = false);
 
 // The ~500-tet scene of the property tests: a 20 x 8 x 20 mm block of
 // 6 x 2 x 6 cells (432 tets), 1 mm node spheres on its 49 top nodes, all

@@ -13,8 +13,8 @@
 namespace fahr::contact::sim {
 
 struct SphereView {
-  std::span<const Eigen::Vector3d> centres_m;   // per sphere, m
-  std::span<const double> radii_m;              // per sphere, m
+  std::span<const Eigen::Vector3d> centres_m;      // per sphere, m
+  std::span<const double> radii_m;                 // per sphere, m
   std::span<const std::int32_t> compliance_index;  // per sphere: index in W or kNoCompliance
 };
 
@@ -39,7 +39,8 @@ struct ToolShape {
 
 // Appends the rows of the tool at `tool_position_m` against every sphere and
 // obstacle into `rows` (cleared first; capacity reserved by the caller).
-void collect_rows(const ToolShape& tool, const Eigen::Vector3d& tool_position_m, const SphereView& spheres,
-                  std::span<const PlaneObstacle> obstacles, std::vector<ContactRow>& rows);
+void collect_rows(const ToolShape& tool, const Eigen::Vector3d& tool_position_m,
+                  const SphereView& spheres, std::span<const PlaneObstacle> obstacles,
+                  std::vector<ContactRow>& rows);
 
 }  // namespace fahr::contact::sim
