@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "fahr/common/background_publisher.h"
 #include "fahr/common/config_error.h"
@@ -226,6 +227,11 @@ TEST(BackgroundPublisher, WritesTheNewestAndAccountsForEverySample) {
     }
     ASSERT_EQ(sub.newest().haptic_tick(), kSamples);
     EXPECT_EQ(sub.newest().contacts().size(), kSamples % 64);
+    // The thread counts a write after the write returns, so the reader can see
+    // the sample first (seen under load): wait, bounded, for the count.
+    while (pub.written() < sub.newest_info().seq && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
     handed = pub.handed();
     written = pub.written();
     EXPECT_EQ(pub.refused(), 0U);
