@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The intubation benchmark of issue 6 (the paper's Figure 6 setting): the
+# The intubation benchmark (the paper's Figure 6 setting): the
 # whole stack in real time (deployment/run_local.sh: gateway with the
 # simulated hand on the intubation script, FEM service, haptic service, as
 # separate processes over DDS) for S seconds, once with the AIST and once
@@ -8,8 +8,8 @@
 # max over the whole run) and the number of tick periods longer than 1.5 ms,
 # then each run's tick parts as the haptic service prints them.
 #
-#   tools/intubation_bench.sh [BUILD_DIR] [--seconds 60] [--dds cyclonedds] [--scene FILE]
-#                             [--cpus-fem LIST --cpus-haptic LIST] [--only aist|triangle]
+#   bench/intubation.sh [BUILD_DIR] [--seconds 60] [--dds cyclonedds] [--scene FILE]
+#                       [--cpus-fem LIST --cpus-haptic LIST] [--only aist|triangle]
 #
 # The script lasts 13 s; the gateway repeats it. Numbers depend on what
 # else the machine runs (three processes share its cores): compare the two

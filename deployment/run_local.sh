@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The first end-to-end run (issue 7, part 6): the device gateway (simulated
+# The end-to-end run on one machine: the device gateway (simulated
 # hand on the scripted intubation), the FEM service and the haptic service as
 # separate processes on one DDS vendor and domain, with fahr_run_summary
 # listening for the run's duration; then stops them and prints the summary.
@@ -13,9 +13,9 @@
 # --haptic-collision triangle: the haptic service finds the blade's contacts
 # with the tongue by the triangle-level baseline instead of the AIST.
 # --fem-tool-obstacle: the FEM service keeps the whole tongue out of the
-# tool at the ContactSet's tool pose (experimental; services/fem/main/README.md).
+# tool at the ContactSet's tool pose (experimental; services/fem/README.md).
 # --cpus-fem / --cpus-haptic: run that service on these CPUs only (its
-# --cpus, services/runtime cpu_pinning.h), e.g. --cpus-fem 1 --cpus-haptic 0
+# --cpus, libs/runtime cpu_pinning.h), e.g. --cpus-fem 1 --cpus-haptic 0
 # keeps the FEM's steps off the core the haptic tick runs on.
 # --mode lockstep: the services advance together in simulated time under
 # fahr_lockstep_clock (duration-s of simulated time, as fast as the machine

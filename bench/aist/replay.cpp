@@ -127,7 +127,7 @@ struct ReplayVariant {
   std::uint32_t tested_max = 0, contacts_max = 0, inside_max = 0;
 };
 
-// The haptic tick's row selection (services/haptic/main/haptic_loop.cpp)
+// The haptic tick's row selection (services/haptic/src/haptic_loop.cpp)
 // for a variant that keeps rows; returns how many.
 std::size_t select_rows(const collision::SphereTree& tree, const collision::RigidBody& blade,
                         ReplayVariant& v) {
@@ -202,7 +202,7 @@ void replay_states(const Scene& scene, const Options& options, const std::string
   bench.surface_probe = options.surface_probe;
   collision::QuerySettings bench_grid = bench;
   bench_grid.exact_narrow_phase = false;
-  // As services/haptic/main/haptic_loop.cpp sets it: grid narrow phase, 1 mm candidates.
+  // As services/haptic/src/haptic_loop.cpp sets it: grid narrow phase, 1 mm candidates.
   collision::QuerySettings service = bench_grid;
   service.candidate_margin_m = 1e-3;
   collision::QuerySettings service_plain = service;

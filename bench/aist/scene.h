@@ -37,9 +37,9 @@ struct Scene {
 // field has `blade_cell_m` cells.
 std::unique_ptr<Scene> load_scene(double blade_cell_m, const std::string& dir);
 
-// The scripted trajectory, s in [0, 1]. The README's initial pose (tip
+// The scripted trajectory, s in [0, 1]. meshes/neonatal/README.md's initial pose (tip
 // (12, 0.5, 0) mm) and pressing pose (tip x -33 mm, pitch 8 deg) set where it
-// starts and ends; the README's pressing height cuts 5 mm into the rest
+// starts and ends; that README's pressing height cuts 5 mm into the rest
 // tongue, so the blade is instead slid in at pitch 0 -> 8 deg with its
 // underside 0.2 mm above the rest dorsum (first 50%), then pressed down by
 // lever_depth_m (to 80%), then levered: pitch up 4 deg more about the tip

@@ -39,7 +39,8 @@ int run_overshoot() {
   row("final elastic energy", 1e3 * fa.final_elastic_energy_j, 1e3 * pe.final_elastic_energy_j,
       "mJ");
   row("finite throughout (1 = yes)", fa.finite, pe.finite, "");
-  // Re-engagement bound (README): per tick |dF| <= K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c).
+  // Re-engagement bound (docs/design/force-aware-decision.md): per tick
+  // |dF| <= K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c).
   const double bound = fa.coupling_npm * (0.02 * 0.001 + 0.05 * 0.001) + 1.0 * (0.02 + 0.05);
   int failures = 0;
   auto check = [&](const char* what, bool ok) {

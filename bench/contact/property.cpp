@@ -1,5 +1,5 @@
 // contact_bench property [--runs N] [--seconds S] [--threads T] [--first R]:
-// the 10,000 property runs (sim/property_run.h), one table.
+// the 10,000 property runs (sim/property_run.h), one table.
 #include <algorithm>
 #include <atomic>
 #include <chrono>

@@ -198,8 +198,11 @@ int main(int argc, char** argv) {
   TetMesh mesh;
   const std::string error = read_tetgen(stem, mesh);
   if (!error.empty()) {
-    std::printf("ArtiSynth tongue not available (%s): nothing to compare.\n", error.c_str());
-    return 0;
+    std::fprintf(stderr,
+                 "fem_bullet_peer: cannot read the ArtiSynth tongue at %s (%s); "
+                 "../shared/meshes/artisynth-tongue must be beside the checkout\n",
+                 stem.c_str(), error.c_str());
+    return 1;
   }
   // Centre on the origin (Bullet's pitfall) and fix the lowest 10 mm (+y up).
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();

@@ -1,5 +1,5 @@
 // Minimal TetGen .node/.ele reader for the benchmarks (the shared loaders of
-// services/geometry will replace it). Fixes tet orientation to positive volume.
+// libs/geometry could replace it). Fixes tet orientation to positive volume.
 #pragma once
 
 #include <string>

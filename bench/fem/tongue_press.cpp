@@ -3,7 +3,7 @@
 // refactorised every step, W exact), in the whole loop.
 //
 // Every configuration runs its own in-process lockstep stack
-// (services/stack_sim: gateway with the scripted hand, haptic service, FEM
+// (sim/stack_sim: gateway with the scripted hand, haptic service, FEM
 // service) from the same scene, side by side, one base step each in turn,
 // so all see the same hand and the same machine load at the same moment;
 // the FEM's solver is switched after set-up (Body::set_solver). The loop is

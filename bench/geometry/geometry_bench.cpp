@@ -1,8 +1,8 @@
 // geometry_bench: for each mesh, SDF build time, query time (exact band and
 // far field, ns/query) and max error against the brute-force closest point
 // over all triangles (signed by the winding number). Meshes: the ArtiSynth tongue boundary and jaw
-// (when
-// ../shared exists) and meshes/neonatal/*.obj (when generated).
+// (../shared/meshes/artisynth-tongue beside the checkout; the bench fails without them) and
+// meshes/neonatal/*.obj.
 //
 // usage: geometry_bench [--cell-mm C] [--neonatal-unit U] [--queries N] [extra.obj ...]
 //   C: grid cell (mm, default 1); U: unit of the neonatal OBJ files in metres
@@ -215,15 +215,18 @@ int main(int argc, char** argv) {
 
   std::vector<Input> inputs;
   const std::filesystem::path artisynth = FAHR_ARTISYNTH_DIR;
-  if (std::filesystem::exists(artisynth / "tongue.1.node")) {
-    inputs.push_back({"artisynth tongue (boundary)",
-                      fahr::geometry::load_tetgen(artisynth / "tongue.1", 1.0).boundary_surface()});
-  } else {
-    std::printf("ArtiSynth meshes absent (%s): skipped\n", artisynth.c_str());
+  for (const char* name : {"tongue.1.node", "jaw.obj"}) {
+    if (!std::filesystem::exists(artisynth / name)) {
+      std::fprintf(stderr,
+                   "geometry_bench: ArtiSynth mesh not found at %s "
+                   "(../shared/meshes/artisynth-tongue must be beside the checkout)\n",
+                   (artisynth / name).c_str());
+      return 1;
+    }
   }
-  if (std::filesystem::exists(artisynth / "jaw.obj")) {
-    load_into(inputs, "artisynth ", artisynth / "jaw.obj", 0.001);
-  }
+  inputs.push_back({"artisynth tongue (boundary)",
+                    fahr::geometry::load_tetgen(artisynth / "tongue.1", 1.0).boundary_surface()});
+  load_into(inputs, "artisynth ", artisynth / "jaw.obj", 0.001);
   const std::filesystem::path neonatal = FAHR_NEONATAL_DIR;
   std::vector<std::filesystem::path> neonatal_files;
   if (std::filesystem::is_directory(neonatal)) {

@@ -2,7 +2,7 @@
 // simulated hand (the gateway's overshoot script) presses the blade into the
 // tongue until its pull reaches 3x the device's peak force, holds 5 s and
 // lets go; the whole loop (gateway, haptic service, FEM service) runs in
-// lockstep in this process (services/stack_sim). Printed side by side: the
+// lockstep in this process (sim/stack_sim). Printed side by side: the
 // force-aware response and the penalty baseline on the same script.
 //
 //   fahr_overshoot_bench [--scene FILE] [--factor 3] [--response both|force-aware|penalty]
@@ -17,20 +17,20 @@
 // --fem-anatomy off: the FEM leaves the anatomy to the haptic side's
 // obstacle contacts (as before the FEM kept its own nodes out of bone).
 // --sphere-spread: how the FEM shares a tool contact's correction among the
-// sphere's nodes (services/fem projection.h), instead of the service's choice.
+// sphere's nodes (libs/fem projection.h), instead of the service's choice.
 // --frozen-target: where the FEM holds a frozen sphere (projection.h
 // FrozenTarget): its centre at the step's start (the service's) or the
 // haptic side's hold centre (before).
 // --fem-anatomy-slide: the FEM's anatomy pass slides a node along the bone
 // after its path enters the margin instead of stopping it there
-// (services/fem obstacle_projection.h slide_after_entry).
+// (libs/fem obstacle_projection.h slide_after_entry).
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
-// (services/fem compression_stiffening.h; 0: off), instead of the scene's.
+// (libs/fem compression_stiffening.h; 0: off), instead of the scene's.
 // --trace: one CSV line per FEM step of each run (FILE with the response's
 // name appended): inversions and where they are, the anatomy projection,
 // the tool's contacts.
 //
-// --check: exit 1 unless the force-aware run meets the targets
+// --check: exit 1 unless the force-aware run meets the targets
 // (no NaN, no inverted tet, tissue reaction within the limit + 5 % while
 // lost track, no strain growth from 1x to 3x, the published gap equal to
 // (commanded - limit) / K_c, the re-engagement force step within the
@@ -56,10 +56,10 @@ namespace {
 
 using namespace fahr;
 
-// The overshoot script's keyframes (services/device_gateway/src/trajectory.cpp).
+// The overshoot script's keyframes (libs/device/src/trajectory.cpp).
 constexpr double kHoldEndS = 10.5;  // the hand starts to let go
 constexpr double kScriptEndS = 14.5;
-// Re-engagement: the bound of services/contact/README.md ("Catching up"),
+// Re-engagement: the catching-up bound of docs/design/force-aware-decision.md,
 // K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c) for the scene's coupling and a
 // hand at the script's speed; recomputed here from the run's own figures.
 constexpr double kCatchUpSpeedMps = 0.05;
@@ -547,7 +547,7 @@ int main(int argc, char** argv) {
       "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
   app.add_option(
          "--fem-anatomy-rounds", choices.fem_anatomy_rounds,
-         "the FEM's tool/anatomy alternation rounds per step (services/fem obstacle_projection.h "
+         "the FEM's tool/anatomy alternation rounds per step (libs/fem obstacle_projection.h "
          "max_rounds); default the FEM's")
       ->check(CLI::Range(1, 1000));
   app.add_option("--response", response, "which response to run")
@@ -589,12 +589,12 @@ int main(int argc, char** argv) {
   app.add_flag("--fem-tool-obstacle", choices.fem_tool_obstacle,
                "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose, "
                "not only the "
-               "ContactSet's spheres (services/fem contact_step.h set_tool_obstacle)");
+               "ContactSet's spheres (libs/fem contact_step.h set_tool_obstacle)");
   app.add_option("--row-compliance", choices.row_compliance,
                  "experimental: which rows get W when the blade touches more spheres than the FEM "
                  "sends W for: "
                  "scene (its solver.compliance_columns decides), deepest, keep or free "
-                 "(services/haptic/main haptic_setup.h "
+                 "(services/haptic haptic_setup.h "
                  "RowCompliance)")
       ->check(CLI::IsMember({"scene", "deepest", "keep", "free"}));
   app.add_option("--w-normals", choices.w_normals,

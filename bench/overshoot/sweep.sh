@@ -2,9 +2,9 @@
 # The overshoot on the neonatal tongue across the choices that decide it:
 # the tongue's Young's modulus, the FEM's anatomy support springs, whether
 # the tool stops at bone and the tongue's compression stiffening (Yeoh
-# C20/C10; 0: off, 0.47: the tongue's fit, services/fem material.cpp). One force-aware run per line (about 75 s each on
+# C20/C10; 0: off, 0.47: the tongue's fit, libs/fem material.cpp). One force-aware run per line (about 75 s each on
 # this machine), one Markdown table at the end.
-#   bash tools/overshoot_bench/sweep.sh [BUILD_DIR] [--quick]
+#   bash bench/overshoot/sweep.sh [BUILD_DIR] [--quick]
 # --quick: only the shipped modulus, with and without the support springs,
 # each with and without stiffening.
 set -euo pipefail

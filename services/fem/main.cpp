@@ -108,7 +108,7 @@ int run(int argc, char** argv) {
   app.add_flag("--tool-obstacle", tool_obstacle,
                "experimental: keep the whole body out of the tool at the ContactSet's tool pose, "
                "not only the "
-               "set's spheres (services/fem contact_step.h set_tool_obstacle)");
+               "set's spheres (libs/fem contact_step.h set_tool_obstacle)");
   CLI11_PARSE(app, argc, argv);
   runtime::pin_to_cpus(options.cpus);
 

@@ -1,5 +1,5 @@
 // fahr_stack_sim_run: the whole loop (gateway with a simulated hand, haptic
-// service, FEM service) in lockstep in this process (services/stack_sim)
+// service, FEM service) in lockstep in this process (sim/stack_sim)
 // for a number of simulated seconds; prints each service's output hash as
 // fahr_lockstep_clock does for the same run over DDS, and a few figures.
 // Equal hashes show that the in-process run is the distributed one.
@@ -11,7 +11,7 @@
 //                      [--seconds 4]
 //
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
-// (services/fem compression_stiffening.h; 0: off), instead of the scene's.
+// (libs/fem compression_stiffening.h; 0: off), instead of the scene's.
 // --w-normals N: W along the ContactSet's normals for N spheres (the
 // scene's solver.compliance_columns: normals), with rows by free depth.
 #include <CLI/CLI.hpp>
@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
   int fem_anatomy_rounds = 0;
   app.add_option(
          "--fem-anatomy-rounds", fem_anatomy_rounds,
-         "the FEM's tool/anatomy alternation rounds per step (services/fem obstacle_projection.h "
+         "the FEM's tool/anatomy alternation rounds per step (libs/fem obstacle_projection.h "
          "max_rounds); default the FEM's")
       ->check(CLI::Range(1, 1000));
   bool fem_tool_obstacle = false;
@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
   app.add_option("--row-compliance", row_compliance,
                  "which rows the haptic tick keeps: scene (its solver.compliance_columns decides), "
                  "deepest, keep or "
-                 "free (services/haptic/main haptic_setup.h RowCompliance)")
+                 "free (services/haptic haptic_setup.h RowCompliance)")
       ->check(CLI::IsMember({"scene", "deepest", "keep", "free"}));
   int w_normals = 0;
   app.add_option("--w-normals", w_normals,

@@ -18,7 +18,7 @@ namespace {
 // Weights are formed from a handful of terms in double precision: the centre
 // they give matches the stored one to rounding of millimetre coordinates.
 constexpr double kCentreToleranceM = 1e-12;
-// The coverage target on the ~40 mm neonatal tongue.
+// The AIST's coverage target on the ~40 mm neonatal tongue.
 constexpr double kCoverageTargetM = 0.5e-3;
 
 void expect_weights_valid(const sphere_layout::SphereLayout& layout,

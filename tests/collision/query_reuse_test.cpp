@@ -61,7 +61,7 @@ Press& press() {
   return p;
 }
 
-// The haptic service's settings (services/haptic/main/haptic_loop.cpp).
+// The haptic service's settings (services/haptic/src/haptic_loop.cpp).
 QuerySettings service_settings() {
   QuerySettings s;
   s.exact_narrow_phase = false;

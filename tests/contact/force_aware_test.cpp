@@ -80,8 +80,9 @@ TEST(ForceAware, FreezesPastTheLimitHoldsAndCatchesUpSmoothly) {
     EXPECT_EQ(t.proxy_drift_lost, 0.0);
     EXPECT_EQ(t.frozen_contacts, held == HeldProxy::kBackOff ? 4 : 0);
     EXPECT_EQ(t.force_only_contacts, held == HeldProxy::kHoldLoad ? 4 : 0);
-    // Bound (README): K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c); the device's
-    // turn-around changes v_d by 0.02 m/s in one tick.
+    // Bound (docs/design/force-aware-decision.md):
+    // K_c (|dx_d| + v_c dt) + B (|dv_d| + v_c); the device's turn-around
+    // changes v_d by 0.02 m/s in one tick.
     const double bound = 400.0 * (1e-5 + 0.05 * 0.001) + 1.0 * (0.02 + 0.05);
     EXPECT_LE(t.max_step, bound);
   }
@@ -187,7 +188,7 @@ TEST(ForceAware, AStayingProxyMeetsALowerLimitByScalingNotBySlipping) {
 // along it makes one row deeper: no back-off within the rows' depth brings it
 // under the limit. A held proxy must not be thrown there in one tick (with
 // the bracket "deepest row + 1 mm" it was: 23 mm here, and through the
-// tongue in tools/overshoot_bench).
+// tongue in bench/overshoot).
 TEST(ForceAware, ATickNeverThrowsAHeldToolFartherThanAFastHandMoves) {
   const double radius = 1e-3, compliance = 1e-3;  // m, m/N: a 1 kN/m tissue spring
   ContactRow below, above;

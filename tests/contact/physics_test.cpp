@@ -1,4 +1,4 @@
-// The physics targets, on the shared experiments the bench prints.
+// The physics targets, on the shared experiments the bench prints.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Property runs (issue 6): 1,000 lockstep runs of 2 s on the 432-tet block
+// Property runs: 1,000 lockstep runs of 2 s on the 432-tet block
 // with random, bounded device trajectories (fixed seeds, sim/property_run.h).
 // Never NaN, never a force above the limit (ForceCommand and tissue
 // reaction), never a persistent penetration of an active constraint. The

@@ -92,9 +92,9 @@ std::vector<std::uint32_t> tongue_base(const TetMesh& mesh) {
 
 TEST(Tongue, StepsStablyUnderGravity) {
   const std::string stem = tongue_stem();
-  if (!std::filesystem::exists(stem + ".node")) {
-    GTEST_SKIP() << "ArtiSynth tongue not found at " << stem << ".node (../shared absent)";
-  }
+  ASSERT_TRUE(std::filesystem::exists(stem + ".node"))
+      << "ArtiSynth tongue not found at " << stem
+      << ".node: ../shared/meshes/artisynth-tongue must be beside the checkout";
   TetMesh mesh;
   std::string error;
   ASSERT_TRUE(read_tetgen(stem, mesh, error)) << error;
@@ -138,9 +138,9 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
   // lifts the blade). The lagged direct solve must stay finite and
   // uninverted, refactorise on rotation, and let the tongue spring back.
   const std::string stem = tongue_stem();
-  if (!std::filesystem::exists(stem + ".node")) {
-    GTEST_SKIP() << "ArtiSynth tongue not found at " << stem << ".node (../shared absent)";
-  }
+  ASSERT_TRUE(std::filesystem::exists(stem + ".node"))
+      << "ArtiSynth tongue not found at " << stem
+      << ".node: ../shared/meshes/artisynth-tongue must be beside the checkout";
   TetMesh mesh;
   std::string error;
   ASSERT_TRUE(read_tetgen(stem, mesh, error)) << error;

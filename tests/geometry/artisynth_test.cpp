@@ -1,5 +1,6 @@
 // The real ArtiSynth tongue (TetGen, metres) and jaw (OBJ, millimetres):
-// external input the loaders must read. Skipped when ../shared is absent.
+// external input the loaders must read. Without ../shared/meshes/artisynth-tongue
+// beside the checkout these tests fail, naming the path.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -42,9 +43,9 @@ double winding_number(const SurfaceMesh& mesh, const Eigen::Vector3d& p) {
 
 TEST(ArtiSynth, TongueLoadsWithQualityStatistics) {
   const auto stem = artisynth_dir() / "tongue.1";
-  if (!std::filesystem::exists(stem.string() + ".node")) {
-    GTEST_SKIP() << "ArtiSynth tongue not found at " << stem << " (../shared absent)";
-  }
+  ASSERT_TRUE(std::filesystem::exists(stem.string() + ".node"))
+      << "ArtiSynth tongue not found at " << stem.string()
+      << ".node: ../shared/meshes/artisynth-tongue must be beside the checkout";
   const TetMesh mesh = load_tetgen(stem, 1.0);
   const TetQualityStats& q = mesh.quality();
   std::printf(
@@ -70,9 +71,9 @@ TEST(ArtiSynth, TongueLoadsWithQualityStatistics) {
 
 TEST(ArtiSynth, TongueSurfaceSdf) {
   const auto stem = artisynth_dir() / "tongue.1";
-  if (!std::filesystem::exists(stem.string() + ".node")) {
-    GTEST_SKIP() << "ArtiSynth tongue not found at " << stem << " (../shared absent)";
-  }
+  ASSERT_TRUE(std::filesystem::exists(stem.string() + ".node"))
+      << "ArtiSynth tongue not found at " << stem.string()
+      << ".node: ../shared/meshes/artisynth-tongue must be beside the checkout";
   const SurfaceMesh surface = load_tetgen(stem, 1.0).boundary_surface();
   SdfOptions options;
   options.cell_size_m = 0.001;
@@ -110,9 +111,9 @@ TEST(ArtiSynth, TongueSurfaceSdf) {
 
 TEST(ArtiSynth, JawObjLoads) {
   const auto jaw = artisynth_dir() / "jaw.obj";
-  if (!std::filesystem::exists(jaw)) {
-    GTEST_SKIP() << "ArtiSynth jaw not found at " << jaw << " (../shared absent)";
-  }
+  ASSERT_TRUE(std::filesystem::exists(jaw))
+      << "ArtiSynth jaw not found at " << jaw.string()
+      << ": ../shared/meshes/artisynth-tongue must be beside the checkout";
   const SurfaceMesh mesh = load_surface(jaw, 0.001);
   const SurfaceTopology& t = mesh.topology();
   std::printf(

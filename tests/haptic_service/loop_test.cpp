@@ -26,7 +26,7 @@ namespace {
 const Eigen::Vector3d kPressTipM(-0.033, -0.0005, 0.0);
 constexpr double kPressPitchDeg = 8.0;
 // The intubation script's keyframe "insert between the lips, tip over the
-// tongue" (services/device_gateway/src/trajectory.cpp).
+// tongue" (libs/device/src/trajectory.cpp).
 constexpr double kInsertedS = 3.5;
 constexpr double kInsertedPitchDeg = 4.0;
 
@@ -142,7 +142,7 @@ TEST(HapticLoop, EmbeddedStartStaysBounded) {
   std::printf("embedded start: largest proxy step %.2f mm, largest force %.2f N\n",
               1e3 * largest_jump, largest_force);
   // A tick moves the proxy by the hand's pull plus the deepest row plus
-  // 1 mm at most (services/contact); rows here are at most a few mm deep.
+  // 1 mm at most (libs/contact); rows here are at most a few mm deep.
   EXPECT_LT(largest_jump, 10e-3);
 }
 

@@ -14,7 +14,7 @@ namespace fahr::collision {
 namespace {
 
 // Error bound of the field's trilinear grid distance: sqrt(3) cells (the
-// field's own bound, services/geometry). Pruning subtracts it so no node
+// field's own bound, libs/geometry). Pruning subtracts it so no node
 // that may touch is dropped.
 constexpr double kGridErrorCells = 1.7320508075688772;
 

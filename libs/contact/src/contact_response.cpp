@@ -32,7 +32,7 @@ constexpr double kGrippedLoadShare = 0.25;
 // a block) are not a grip.
 constexpr double kBehindCosine = 0.5;
 // A tissue reaction above this multiple of the limit is not the force-aware
-// decision's rounding but a wedge (see tick()): the 5 % band.
+// decision's rounding but a wedge (see tick()): the targets' 5 % band.
 constexpr double kWedgeBand = 1.05;
 // Relative band around the limit the back-off aims for: 0.1 %, far below
 // what the 5 % target allows and what a hand feels.

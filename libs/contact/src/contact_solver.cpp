@@ -21,7 +21,7 @@ constexpr double kUnitNormalTolerance = 1e-3;
 // Smallest pivot of the active-set factorisation, m/N: A + N^T N/K_c is
 // singular only for redundant rigid rows (more than three obstacle normals);
 // 1e-12 m/N there means a 1e12 N/m direction that the final clamp to K_c
-// (README) makes harmless.
+// (docs/design/force-aware-decision.md) makes harmless.
 constexpr double kMinPivotMpn = 1e-12;
 
 std::uint64_t row_key(const ContactRow& row) {

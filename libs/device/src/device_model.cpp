@@ -1,5 +1,5 @@
 // Device limits. Where the figures come from, and which are estimates, is in
-// the folder README ("Device figures").
+// libs/device/README.md ("Device figures").
 #include "fahr/device/device_model.h"
 
 #include <cmath>

@@ -93,7 +93,7 @@ Material parse_material(const MapReader& body_map) {
   map.read("density_kg_per_m3", open_closed(0.0, 1.0e5), m.density_kg_per_m3);
   map.read("rayleigh_mass_per_s", closed(0.0, 1.0e4), m.rayleigh_mass_per_s);
   map.read("rayleigh_stiffness_s", closed(0.0, 10.0), m.rayleigh_stiffness_s);
-  // The FEM's own bound (services/fem material.h, kMaxYeohC20OverC10).
+  // The FEM's own bound (libs/fem material.h, kMaxYeohC20OverC10).
   map.read("yeoh_c20_over_c10", closed(0.0, 100.0), m.yeoh_c20_over_c10);
   return m;
 }

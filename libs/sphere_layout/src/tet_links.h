@@ -1,5 +1,5 @@
 // Ties a sphere to the tets it overlaps and gives its node weights
-// (DESIGN.md, "Sphere to tissue"), internal.
+// (docs/design/contact-contract.md, sphere to tissue), internal.
 #pragma once
 
 #include <Eigen/Core>

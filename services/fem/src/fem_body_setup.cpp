@@ -46,7 +46,7 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
                       : fem::LinearSolver::kConjugateGradient;
   // Reuse one factorisation and refresh it when an element has turned
   // 0.1 rad: 681 steps/s on a 5k-tet body where refactorising every step
-  // gives 116 (tools/fem_bench, `fem_bench target`); the force stays exact,
+  // gives 116 (bench/fem, `fem_bench target`); the force stays exact,
   // so the equilibrium does not change.
   s.solver.refactor_period = 0;
   if (s.solver.kind == fem::LinearSolver::kConjugateGradient) {
@@ -59,7 +59,7 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
     // the CG iterations and W's new columns eat the saving; the springs
     // refresh it whenever the held set changes (most pressed steps), so W
     // feels them. cholmod stays the neonatal scene's solver
-    // (services/fem/README.md, "Solver choice", fem_tongue_press).
+    // (docs/design/fem-step-and-solvers.md, fem_tongue_press).
     s.solver.preconditioner = fem::CgPreconditioner::kLaggedCholesky;
     s.solver.refactor_rotation_rad = 0.0;
     s.solver.refactor_stiffening_change = 0.0;

@@ -174,8 +174,9 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
     row.compliance_index = tissue.compliance_index[s.sphere_id];
     row.other_point_m = tissue.spheres.centres_m()[s.sphere_id];
     if (free_centres && row.compliance_index >= 0) {
-      // Penetration on the free-motion centre (services/contact README,
-      // "Which centre"): the projected one reads zero at a steady contact.
+      // Penetration on the free-motion centre (which centre:
+      // docs/design/contact-contract.md): the projected one reads zero at a
+      // steady contact.
       const float* c = tissue.free_centres_m.data() + 3 * row.compliance_index;
       row.other_point_m = Eigen::Vector3d(c[0], c[1], c[2]);
     }

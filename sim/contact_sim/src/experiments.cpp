@@ -1,4 +1,4 @@
-// The experiments on the shared scenes.
+// The contact experiments on the shared scenes.
 #include "fahr/contact/sim/experiments.h"
 
 #include <algorithm>

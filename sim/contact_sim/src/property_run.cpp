@@ -1,5 +1,5 @@
 // One property run: a random bounded device trajectory against the small
-// block, and the checks of issue 6.
+// block, and the checks of property_run.h.
 #include "fahr/contact/sim/property_run.h"
 
 #include <algorithm>

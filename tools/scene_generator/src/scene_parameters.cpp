@@ -87,7 +87,7 @@ std::string format_number(double v) {
 
 SceneParameters default_scene_parameters() {
   SceneParameters p;
-  // Miller 0 and 1: lengths and widths are estimates (see the README).
+  // Miller 0 and 1: lengths and widths are estimates (meshes/neonatal/README.md).
   p.miller0 = miller_blade("miller0", 77.0, 8.0, 10.0, 2.0, 5.0);
   p.miller1 = miller_blade("miller1", 102.0, 9.0, 12.0, 2.5, 6.5);
   return p;

@@ -30,7 +30,7 @@ struct SphereContact {
   // detects, the deformed surface measures. A sphere keeps its rest radius
   // while the nearly incompressible tissue under a tool is squashed, so its
   // depth_m exceeds the tissue's penetration by the amount it stands out of
-  // the deformed surface (tools/aist_bench/README.md, detection: 0.6 mm
+  // the deformed surface (docs/design/aist-layout.md; aist_bench detection: 0.6 mm
   // median). surface_point_m, world frame, m: a point of the deformed tissue
   // surface on the sphere's anchor face (sphere_layout::SurfaceAnchor; with
   // QuerySettings::SurfaceProbe::kFacePoint, the default, the point of that

@@ -17,7 +17,7 @@ struct RigidBody {
   Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
   // Optional, borrowed like the field: a FieldGrid of that field. With it the
   // queries read the grid there (the grid narrow phase one cell per sphere
-  // instead of seven, tools/aist_bench/README.md); without it, the field's own.
+  // instead of seven, docs/design/aist-layout.md); without it, the field's own.
   const FieldGrid* grid = nullptr;
 };
 

@@ -4,7 +4,7 @@
 // per sphere the nearest surface point q, the normal from the pre-penetration
 // centre and the depth. Allocation-free and noexcept: the 1 kHz path.
 //
-// The pre-penetration centre (DESIGN.md, n = (c - q)/|c - q|): while a
+// The pre-penetration centre (docs/design/contact-contract.md, n = (c - q)/|c - q|): while a
 // sphere's centre is outside the body, it is its own pre-penetration centre
 // and n is the field's outward normal. Once the centre is inside (a deep
 // press, or a thin blade), the field's normal can point through the plate, so
@@ -60,7 +60,7 @@ struct QuerySettings {
   // the surface. The FEM side must then clear r + skin too.
   double contact_skin_m = 0.0;
   // Candidates, m, >= 0: spheres within this gap of the body (depth in
-  // (-margin, 0]) are reported too, flagged candidate (DESIGN.md: near, not
+  // (-margin, 0]) are reported too, flagged candidate (contact contract: near, not
   // touching; the contact solve wants their compliance, and a response that
   // has just cleared a sphere leaves it at depth 0, still resting on the tool).
   double candidate_margin_m = 0.0;
@@ -81,7 +81,7 @@ struct QuerySettings {
   // where the body touches; one closest point on a triangle); kAnchor: its
   // fixed anchor (sphere_layout::SurfaceAnchor). On aist_bench detection the fixed anchor
   // can lie ~1 mm from where a blade's rim cuts the face
-  // (tools/aist_bench/README.md). kNone: no surface point (has_surface
+  // (docs/design/aist-layout.md). kNone: no surface point (has_surface
   // false): for callers that use depth_m only (the haptic service's rows),
   // which then skip a face read and a closest point per reported sphere.
   enum class SurfaceProbe : std::uint8_t { kAnchor, kFacePoint, kNone };
@@ -105,7 +105,7 @@ inline constexpr std::size_t kMaxDeepest = 256;
 // body's frame. Capacity fixed at construction. Indexed by the sphere's slot
 // in SphereTree::order(), not its id: the query visits spheres leaf by leaf,
 // so memory kept by id (in separate arrays) cost cache misses at random
-// (tools/aist_bench/README.md). A memory therefore belongs to one tree. The
+// (docs/design/aist-layout.md). A memory therefore belongs to one tree. The
 // centre, its query index and a floor of the grid there, which every
 // visited sphere writes, take 32 bytes, two spheres a cache line; the
 // nearest point, which only the exact narrow phase reads, is kept apart.

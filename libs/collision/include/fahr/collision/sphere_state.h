@@ -31,7 +31,7 @@ class SphereState {
   // so the sphere stays inside its rest sphere's image. Soft tissue keeps its
   // volume, so under a blade the volume rule keeps r0 while the tissue is
   // squashed toward the surface and the sphere stands out of it
-  // (tools/aist_bench/README.md, detection). A linked volume that collapsed
+  // (docs/design/aist-layout.md, radius rules). A linked volume that collapsed
   // or inverted (V <= 0) keeps kMinVolumeScale of the rest radius rather than
   // vanishing, and a stretch beyond kMaxVolumeScale is capped. Returns false (state unchanged past
   // the first bad node) if a position is not finite or the span is too short.

@@ -35,7 +35,7 @@ class SphereTree {
   // grid read at the box's middle, a bound, a push) exceeds its cost per
   // sphere tested, so fewer, larger leaves were faster though they test more
   // spheres (aist_bench replay: grid query warm p99.9 -10 % at 8, -12 % at
-  // 16; tools/aist_bench/README.md "Query time").
+  // 16; docs/design/aist-layout.md).
   static constexpr int kLeafSize = 16;
   // Within a leaf the spheres are in the order the former tree of 4-sphere
   // leaves visited them (its median splits, right half first), so the query

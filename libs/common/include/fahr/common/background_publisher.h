@@ -2,7 +2,7 @@
 // 1 kHz haptic tick builds its ContactSet in place (back()), hands it over
 // (publish(): wait-free, no system call) and goes on; this thread pays for
 // the DDS write, the sample's serialisation and send, which took the tick
-// tens of microseconds of CPU (tools/intubation_bench.sh prints the tick's
+// tens of microseconds of CPU (bench/intubation.sh prints the tick's
 // parts). The thread looks for a new sample every `period`: waking it on
 // each hand-over instead costs the tick a futex wake, a system call whose
 // tail showed in the tick's publishing part on this machine. A sample

@@ -10,7 +10,7 @@ namespace fahr::common {
 enum class Reliability { kBestEffort, kReliable };
 enum class Durability { kVolatile, kTransientLocal };
 
-// The roles of DESIGN.md's topic table.
+// The roles of the topic table in docs/design/topics-and-qos.md.
 enum class TopicRole {
   kServoStream,  // DevicePose, ForceCommand: 1 kHz, newest wins, never retransmit
   kStateStream,  // ContactSet, DeformationState: reliable, newest wins

@@ -24,7 +24,7 @@ namespace fahr::contact {
 
 enum class ResponseMode : std::uint8_t {
   // Rows yield with the FEM's compliance W; force-aware. The rows' tissue
-  // centres must be the FEM's free-motion centres (README, "Which centre").
+  // centres must be the FEM's free-motion centres (docs/design/contact-contract.md).
   kCompliance,
   // The naive loop for comparison: the same solve with W = 0 on the newest
   // FEM positions (the published, projected centres), the tissue pushed by

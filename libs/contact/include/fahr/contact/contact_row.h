@@ -27,8 +27,9 @@ struct ContactRow {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
   // q: nearest tool point with the tool at the reference pose p0, m.
   Eigen::Vector3d tool_point_m = Eigen::Vector3d::Zero();
-  // Tissue: the sphere centre of the FEM's free motion (see README, "Which
-  // centre"), m. Obstacle: the nearest obstacle surface point, m.
+  // Tissue: the sphere centre of the FEM's free motion, m (which centre:
+  // docs/design/contact-contract.md). Obstacle: the nearest obstacle
+  // surface point, m.
   Eigen::Vector3d other_point_m = Eigen::Vector3d::Zero();
   // Sphere radius r, m, >= 0; 0 for obstacles.
   double radius_m = 0.0;

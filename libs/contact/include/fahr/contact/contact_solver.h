@@ -2,7 +2,7 @@
 // Delassus matrix A_ij = n_i^T W_ij n_j of the rows, solves for lambda >= 0
 // with projected Gauss-Seidel (warm-started per row key), and gives the local
 // stiffness of the active set. Capacities are fixed at construction; nothing
-// allocates afterwards. The formulation is derived in ../../../README.md.
+// allocates afterwards. The formulation is derived in docs/design/force-aware-decision.md.
 #pragma once
 
 #include <Eigen/Core>

@@ -35,7 +35,7 @@ enum class HeldProxy : std::uint8_t {
   // grew under them). It releases, and holds again while catching up, on
   // the hand's pull along the push it froze with, never backs off, and
   // keeps the load scaled and force only while catching up past the limit
-  // (tools/overshoot_bench/README.md, "A proxy held by its load").
+  // (docs/design/force-aware-decision.md, the held proxy).
   kHoldLoad,
   // A diagnostic, not a response: stays, and the tissue gets whatever the
   // pinned solve asks, unclamped, so a bench can see whether the frozen

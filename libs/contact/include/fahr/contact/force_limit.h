@@ -1,5 +1,5 @@
 // The ForceCommand never asks for more than the device can render now
-// (issue 6: "never a force above the limit"). Past the limit the proxy has
+// (never a force above the limit). Past the limit the proxy has
 // lost track and the coupling spring (or a rigid obstacle) would ask for
 // more; the command is scaled to the limit along the same direction, as the
 // gateway would, and the local stiffness becomes the Jacobian of that scaled

@@ -1,7 +1,7 @@
 // The limits of a haptic device: what it can push, how far it reaches, how
 // finely it measures and how stiff a spring it renders stably. The Touch X
 // figures are the defaults; other devices are configurations of the same
-// struct (see README.md for the sources and which figures are estimates).
+// struct (libs/device/README.md, "Device figures": sources and estimates).
 #pragma once
 
 #include <string>

@@ -1,8 +1,8 @@
 // The gateway's half of the fastest loop: from the newest ForceCommand (force
 // F_k at the answered pose x_k, local stiffness K_k) it renders, at every
 // servo tick, F = F_k - K_k (x_now - x_k), so a command that is a period or
-// more old is corrected for where the stylus is now (DESIGN.md, "The gateway
-// closes the fastest loop").
+// more old is corrected for where the stylus is now
+// (docs/design/servo-rendering-and-passivity.md).
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
-// Contact compliance W = h^2 J A^-1 J^T of candidate spheres (DESIGN.md,
-// "Tissue resistance at 1 kHz"): how far sphere centres move in one step per
+// Contact compliance W = h^2 J A^-1 J^T of candidate spheres
+// (docs/design/contact-contract.md): how far sphere centres move in one step per
 // newton of force on them, with the tissue's inertia, damping and stiffness.
 //
 // The solved columns A^-1 J_s^T of each sphere are kept, tagged with the

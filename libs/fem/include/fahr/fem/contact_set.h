@@ -1,5 +1,5 @@
-// The library-side view of the haptic-to-FEM contact contract (DESIGN.md,
-// "The contact contract"): absolute constraints, not deltas.
+// The library-side view of the haptic-to-FEM contact contract
+// (docs/design/contact-contract.md): absolute constraints, not deltas.
 #pragma once
 
 #include <Eigen/Core>
@@ -12,7 +12,7 @@ enum class ContactKind : std::uint8_t {
   kTool,      // force-aware: active or frozen as the haptic side decides
   kObstacle,  // palate, jaw: always a hard non-penetration constraint
   // force_n along n, never projected: the penalty baseline's tool (Figure
-  // 7a), and a force-aware tool wedged past the limit (services/contact).
+  // 7a), and a force-aware tool wedged past the limit (libs/contact).
   kForceOnly,
 };
 

@@ -1,6 +1,6 @@
-// One FEM step under the contact contract (DESIGN.md, "The contact
-// contract"; services/contact/README.md, "Which centre" and "What the FEM
-// must do with lambda"). The FEM service and the in-process lockstep harness
+// One FEM step under the contact contract (docs/design/contact-contract.md:
+// which centre, and what the FEM must do with lambda). The FEM service and
+// the in-process lockstep harness
 // both step their body through this:
 //   1. the haptic solve's contact forces (lambda along n, through each
 //      sphere's node weights) and the carried Algorithm 1 correction act as
@@ -50,7 +50,7 @@ struct ContactStepSettings {
   // Apply the ContactSet's lambda as external forces before the projection.
   // false: the projection alone, as Algorithm 1 is written; its fixed point
   // displaces only the constrained spheres' nodes when the step is
-  // quasi-static (services/contact/README.md), kept for that comparison.
+  // quasi-static (docs/design/contact-contract.md), kept for that comparison.
   bool apply_contact_forces = true;
   // Spheres in the compliance block at most (a DeformationState carries 64).
   std::size_t max_compliance_spheres = 64;
@@ -100,8 +100,9 @@ class ContactStep {
   // beside the ContactSet's spheres (which carry the force). The ContactSet
   // names at most a few dozen spheres (the contact solve's rows and the
   // held ones) while a pressed blade touches hundreds; the others would
-  // otherwise flow into the blade (tools/overshoot_bench/README.md, "Held
-  // still"). `field` (null: off) is the tool where the haptic side put it:
+  // otherwise flow into the blade (the tool obstacle:
+  // docs/design/anatomy-contact.md). `field` (null: off) is the tool where
+  // the haptic side put it:
   // the caller moves it before each step and tells the step how it moved
   // (set_tool_motion), so no clearance is kept from one step to the next.
   // Its pass runs after the spheres' projection in each round, before the

@@ -1,6 +1,6 @@
 // What the FEM needs to know of a static rigid obstacle (jaw, palate) to
 // keep its nodes out of it: a signed distance and the direction out. An
-// interface, so fahr::fem stays free of services/geometry: the FEM service
+// interface, so fahr::fem stays free of libs/geometry: the FEM service
 // adapts the scene's signed distance fields (fem_service/anatomy_fields.h),
 // tests use analytic shapes.
 #pragma once

@@ -4,7 +4,7 @@
 // this very step. The haptic side's sphere contacts against the anatomy are
 // one FEM step late and see spheres, not the surface; pressed by the blade,
 // the tongue tunnelled through the jaw between two such steps
-// (services/fem/README.md, "The anatomy"). Nodes are enough: the tongue's
+// (docs/design/anatomy-contact.md). Nodes are enough: the tongue's
 // surface is its boundary nodes, and a face between two nodes that stay out
 // of the bone can only dip into it where the bone is sharper than an element.
 //
@@ -67,8 +67,8 @@ struct ObstacleProjectionSettings {
   // volume floor and the bone disagree: 4 ran out in 500 of the 3,200 FEM
   // steps of the 100 kPa overshoot and left 3 thin tets by the bone
   // inverted; 32 leaves none there and none in the 20 s intubation, for a
-  // FEM step p99 of 54 ms against 37 (services/fem/README.md, "The
-  // anatomy's rounds").
+  // FEM step p99 of 54 ms against 37 (docs/design/anatomy-contact.md,
+  // the anatomy's rounds).
   int max_rounds = 32;
   // Nodes the anatomy moved are held by a spring along the bone's normal in
   // the next steps' system matrix (obstacle_support.h), this many times
@@ -87,8 +87,8 @@ struct ObstacleProjectionSettings {
   // surface (frictionless). Stopped, a node whose path clips a bone's corner
   // by micrometres can stay put for seconds; sliding, the tongue recovers
   // from an overshoot with fewer tets left inverted, but at 100 kPa its
-  // strain grew under the held blade (tools/overshoot_bench/README.md,
-  // "Frozen spheres held where the step found them"). Off until that is
+  // strain grew under the held blade (bench/overshoot;
+  // docs/design/anatomy-contact.md). Off until that is
   // settled.
   bool slide_after_entry = false;
 };

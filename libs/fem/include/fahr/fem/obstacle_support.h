@@ -8,7 +8,7 @@
 // the tool in as if the tongue could move away, the FEM's step moves it into
 // the jaw, the anatomy pass puts it back under the blade, and the tissue
 // between is flattened until the tets invert and the blade passes through
-// (tools/overshoot_bench, services/fem/README.md "The anatomy"). A spring
+// (bench/overshoot, docs/design/anatomy-contact.md). A spring
 // k n n^T on a held node's diagonal block makes A, the free motion and W
 // feel the support: pushing a tongue onto the jaw compresses it.
 //

@@ -53,7 +53,7 @@ struct ProjectionSettings {
   // spheres against planes the haptic side found one FEM step earlier.
   bool project_obstacle_contacts = true;
   // kMassWeighted is the contract's; kTranslation made the neonatal
-  // overshoot run diverge (README, "The anatomy") and is kept to compare.
+  // overshoot run diverge (docs/design/anatomy-contact.md) and is kept to compare.
   SphereSpread spread = SphereSpread::kMassWeighted;
   // kStepStart needs the step's start positions (project_contacts'
   // step_start_m); without them a frozen contact uses its hold centre.

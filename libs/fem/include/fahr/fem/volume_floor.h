@@ -7,8 +7,8 @@
 // touch, along their own normals, and nothing in them resists a layer of
 // tissue being pressed to nothing between the two; the implicit step's
 // linearised corotational force, with the large velocities those moves
-// carry, then inverts it (tools/overshoot_bench/README.md, "At 10 kPa the
-// tongue is crushed against bone at 2 N"). Soft tissue is nearly
+// carry, then inverts it (docs/design/anatomy-contact.md,
+// the volume floor; bench/overshoot). Soft tissue is nearly
 // incompressible (the tongue's nu is 0.45): no load the device can apply
 // takes a piece of it below half its volume. Projecting the floor gives the
 // squeezed layer the way real tissue takes: sideways, out from between the

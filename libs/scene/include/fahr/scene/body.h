@@ -53,7 +53,7 @@ struct FixedNodes {
   std::optional<Aabb> box;
 };
 
-// Adaptive inner sphere tree settings (issue 5).
+// Adaptive inner sphere tree settings (docs/design/aist-layout.md).
 struct AistSettings {
   // Coarse sphere volume over mean tet volume, (0, 1000].
   double sphere_tet_volume_ratio = kDefaultSphereTetVolumeRatio;

@@ -1,4 +1,4 @@
-// Contact response and tool coupling (issue 6), and which body pairs the
+// Contact response and tool coupling, and which body pairs the
 // scene includes or excludes from contact testing by declaration.
 #pragma once
 

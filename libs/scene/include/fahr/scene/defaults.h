@@ -1,6 +1,6 @@
 // Every default of the scene format, in one place. A scene file that omits a
 // key gets the value here (the struct members are initialised from these);
-// deployment/scenes/README.md documents the same values for users.
+// deployment/scenes/format.md documents the same values for users.
 #pragma once
 
 #include <chrono>
@@ -12,7 +12,7 @@ namespace fahr::scene {
 // No published stiffness of neonatal tongue was found; adult in-vivo MR
 // elastography gives a storage shear modulus of about 2.7 kPa (E = 2 G (1 + nu)
 // ~ 8 kPa), ultrasound shear-wave studies of head and neck muscle ~10 kPa.
-// Sources: deployment/scenes/README.md, "Material values".
+// Sources: deployment/scenes/format.md, "Material values".
 inline constexpr double kDefaultYoungsModulusPa = 10.0e3;
 // Tissue is nearly incompressible; 0.45 rather than 0.49 because linear tets
 // lock (grow artificially stiff) as nu approaches 0.5.
@@ -24,7 +24,7 @@ inline constexpr double kDefaultDensityKgPerM3 = 1040.0;
 // lowest modes lie; alpha is small so slow, rigid-like motion is not braked.
 inline constexpr double kDefaultRayleighMassPerS = 0.1;
 inline constexpr double kDefaultRayleighStiffnessS = 0.01;
-// Compression stiffening, the Yeoh ratio C20/C10 (services/fem
+// Compression stiffening, the Yeoh ratio C20/C10 (libs/fem
 // compression_stiffening.h): 0 is the linear corotational material. Off by
 // default so a scene without the key behaves as before the key existed.
 inline constexpr double kDefaultYeohC20OverC10 = 0.0;

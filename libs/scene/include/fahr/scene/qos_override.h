@@ -1,5 +1,5 @@
 // Per-topic QoS overrides. Only the fields a scene sets replace the transport's
-// profile of that topic (DESIGN.md, "Topics and QoS").
+// profile of that topic (docs/design/topics-and-qos.md).
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// FEM solver choices (issue 4): linear solver, Algorithm 1 projection, and
+// FEM solver choices: linear solver, Algorithm 1 projection, and
 // the contact compliance the haptic loop solves on.
 #pragma once
 
@@ -45,7 +45,7 @@ struct FemSolverSettings {
   std::chrono::nanoseconds max_contact_age = kDefaultMaxContactAge;
   double sleep_speed_mps = kDefaultSleepSpeedMps;  // m/s, [0, 1]
   // No tet ends a FEM step below this share of its rest volume
-  // (services/fem volume_floor.h), [0, 0.9]; 0: no floor.
+  // (libs/fem volume_floor.h), [0, 0.9]; 0: no floor.
   double volume_floor_ratio = 0.0;
 };
 

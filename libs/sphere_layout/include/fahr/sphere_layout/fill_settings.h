@@ -46,7 +46,7 @@ struct FillSettings {
   // the surface above it is pressed in, and its nearest boundary face is
   // then usually that surface: on aist_bench detection anchoring every
   // sphere gave a lower depth error than 0.5 mm (the coverage target)
-  // or 2 mm (tools/aist_bench/README.md).
+  // or 2 mm (docs/design/aist-layout.md).
   double anchor_gap_m = std::numeric_limits<double>::infinity();
   // false: no sphere gets an anchor, whatever anchor_gap_m says. For a
   // caller that never asks for the surface point (QuerySettings::

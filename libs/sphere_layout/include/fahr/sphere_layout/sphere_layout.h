@@ -1,6 +1,6 @@
 // The immutable part of an adaptive inner sphere tree: rest centres, rest
 // radii, refinement level and, per sphere, the tets it is tied to and the
-// node weights that carry its centre (DESIGN.md, "Sphere to tissue"):
+// node weights that carry its centre (docs/design/contact-contract.md, sphere to tissue):
 //   c = sum_i w_i x_i,  w_i >= 0,  sum_i w_i = 1.
 // Built once from a tet mesh (fill_spheres), shared read-only by every state.
 #pragma once

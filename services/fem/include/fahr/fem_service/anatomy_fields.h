@@ -1,6 +1,6 @@
 // The scene's rigid anatomy as the FEM body sees it: each obstacle the body
 // is held out of (the scene plan's hard pairs) as a fem::ObstacleField over
-// the same signed distance field the haptic service builds (services/runtime),
+// the same signed distance field the haptic service builds (libs/runtime),
 // so the FEM keeps its own nodes out of bone in every step. The same adapter,
 // moved each step, gives the tool as an obstacle (ContactStep::set_tool_obstacle).
 #pragma once

@@ -27,7 +27,7 @@ struct FemBodySetup {
   fem::SphereLinks links;
   std::unique_ptr<fem::Body> body;
   // The obstacles of the scene's hard pairs with this body (world frame),
-  // enforced by the FEM step itself (services/fem/README.md, "The anatomy").
+  // enforced by the FEM step itself (docs/design/anatomy-contact.md).
   std::vector<std::unique_ptr<AnatomyField>> anatomy;
   fem::ObstacleProjectionSettings anatomy_settings;
   // false: the step leaves the anatomy to the ContactSet's obstacle entries
@@ -39,7 +39,7 @@ struct FemBodySetup {
   fem::FrozenTarget frozen_target = fem::FrozenTarget::kStepStart;
   // The scene's solver.compliance_columns: normals (ContactStepSettings).
   bool compliance_along_normals = false;
-  // The scene's solver.volume_floor_ratio (services/fem volume_floor.h).
+  // The scene's solver.volume_floor_ratio (libs/fem volume_floor.h).
   fem::VolumeFloorSettings volume_floor{};
   // Experimental (null: off): the tool's field, which the step moves to the
   // ContactSet's tool pose and keeps the whole body out of

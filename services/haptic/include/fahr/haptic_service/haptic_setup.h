@@ -25,7 +25,7 @@
 namespace fahr::haptic_service {
 
 // A rigid body's surface and its field, built as the FEM service builds the
-// same anatomy's (services/runtime).
+// same anatomy's (libs/runtime).
 using RigidField = runtime::RigidField;
 
 // How the tool's contacts with the deformable body are found.

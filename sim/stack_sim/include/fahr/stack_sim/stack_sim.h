@@ -2,7 +2,7 @@
 // gateway's servo tick (a simulated hand following a script), the haptic
 // service's tissue digest and tick, the FEM service's step; no transport.
 // Each base step k (1 ms) follows the read rule of the distributed lockstep
-// (services/common/include/fahr/common/lockstep.h): every service reads
+// (libs/common/include/fahr/common/lockstep.h): every service reads
 // what the others produced before step k, so a run here is the run
 // `deployment/run_local.sh --mode lockstep` makes over DDS, minus the wire,
 // and the same on every machine. Tests and benchmarks that need the whole

@@ -1,5 +1,5 @@
 // Suggested poses of a blade's tool frame in the head frame, shared by the
-// README, the renderer and the generator's own collision check. A pose is a
+// meshes/neonatal/README.md, the renderer and the generator's own collision check. A pose is a
 // rotation about the head frame's z axis (the blade stays in the
 // mid-sagittal plane) followed by a translation of the tool origin (the tip).
 #pragma once

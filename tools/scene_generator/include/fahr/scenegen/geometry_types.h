@@ -1,5 +1,5 @@
 // Plain mesh containers shared by the scene generator, its renderer and its
-// test. Deliberately minimal: the real mesh types live in services/geometry;
+// test. Deliberately minimal: the real mesh types live in libs/geometry;
 // these only carry what the generator writes.
 #pragma once
 

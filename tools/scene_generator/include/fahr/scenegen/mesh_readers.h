@@ -1,6 +1,6 @@
 // Minimal readers for the files the generator writes, for its test and its
 // renderer only. The project's real loaders (with error reporting by file,
-// line and element) live in services/geometry.
+// line and element) live in libs/geometry.
 #pragma once
 
 #include <string>

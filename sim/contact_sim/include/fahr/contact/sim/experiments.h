@@ -1,5 +1,5 @@
-// The experiments as functions returning numbers, so the tests
-// assert on exactly what tools/contact_bench prints.
+// The contact experiments as functions returning numbers, so the tests
+// assert on exactly what bench/contact prints (docs/design/experiments.md).
 #pragma once
 
 #include <cstdint>

@@ -25,9 +25,10 @@ namespace fahr::contact::sim {
 struct FemDriverSettings {
   fem::BodySettings body;
   // Apply the ContactSet's forces (lambda along n, through the sphere
-  // weights) in the implicit step before the projection (README, "What the
-  // FEM must do with lambda"). false: the projection alone, as Algorithm 1.
-  // W follows the factorisation (recomputed when it is refreshed).
+  // weights) in the implicit step before the projection (what the FEM must
+  // do with lambda: docs/design/contact-contract.md). false: the projection
+  // alone, as Algorithm 1. W follows the factorisation (recomputed when it
+  // is refreshed).
   bool apply_contact_forces = true;
 };
 

@@ -1,4 +1,4 @@
-// The property runs of issue 6: lockstep runs on the ~500-tet block with a
+// The property runs: lockstep runs on the ~500-tet block with a
 // random, bounded device trajectory each (fixed seed per run index), checked
 // for: never NaN, never a force above the limit (the ForceCommand's force
 // against what the device can render, and the tissue reaction), never a
@@ -23,7 +23,7 @@ struct PropertyLimits {
   double penetration_tolerance_m = 1e-5;
   int persistent_steps = 2;
   // The tissue reaction while lost track may exceed the limit by what one
-  // tick's FEM update adds (the issue's 5 %).
+  // tick's FEM update adds (the targets' 5 %).
   double reaction_slack = 1.05;
   // The ForceCommand's force may exceed the limit by rounding only.
   double command_slack = 1.0 + 1e-9;

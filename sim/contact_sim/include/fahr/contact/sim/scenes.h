@@ -1,4 +1,4 @@
-// Scenes shared by tests/contact and tools/contact_bench.
+// Scenes shared by tests/contact and bench/contact.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 // Rigid tool shapes of the test scenes and the contact rows they produce
 // against tissue spheres (and a rigid plane obstacle), standing in for the
-// AIST queries (services/haptic) behind the same ContactRow interface.
+// AIST queries (libs/collision) behind the same ContactRow interface.
 #pragma once
 
 #include <Eigen/Core>
