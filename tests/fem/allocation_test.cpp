@@ -42,7 +42,7 @@ std::vector<Mode> modes() {
 
 TEST(Allocation, StepAllocatesNothing) {
   test::hook_suitesparse_allocations();
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   // Every mode with the linear material and with compression stiffening.
   for (const double stiffening : {0.0, kTongueYeohC20OverC10})
     for (const Mode& mode : modes()) {
@@ -98,7 +98,7 @@ TEST(Allocation, StepAllocatesNothing) {
 // kept, and allocates nothing once each chunk size has been seen.
 TEST(Allocation, ComplianceOfChangingSpheresAllocatesNothing) {
   test::hook_suitesparse_allocations();
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.solver.refactor_period = 0;
   settings.solver.refactor_rotation_rad = 0.0;

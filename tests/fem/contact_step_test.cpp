@@ -13,7 +13,7 @@ namespace {
 
 // The bar's free-end top nodes, one sphere each (weight 1).
 struct Bar {
-  TetMesh mesh = test::bar_mesh(2);
+  BodyMesh mesh = test::bar_mesh(2);
   std::vector<std::uint32_t> top;
   SphereLinks links;
   Bar() {

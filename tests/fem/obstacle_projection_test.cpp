@@ -71,7 +71,7 @@ BodySettings tongue_like() {
 // The 30 x 10 x 10 mm bar, its x = 0 face fixed; one sphere (weight 1,
 // radius 0) on each top node of the free half, which the tool presses.
 struct PressedBar {
-  TetMesh mesh = test::bar_mesh(2);
+  BodyMesh mesh = test::bar_mesh(2);
   std::vector<std::uint32_t> fixed = test::fixed_x0(mesh);
   std::vector<std::uint32_t> top;
   SphereLinks links;

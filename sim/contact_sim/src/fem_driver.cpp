@@ -16,7 +16,7 @@ fem::SphereLinks make_node_spheres(std::span<const std::uint32_t> nodes, double 
 }
 
 std::unique_ptr<FemDriver> FemDriver::create(const FemDriverSettings& settings,
-                                             const fem::TetMesh& mesh,
+                                             const fem::BodyMesh& mesh,
                                              std::span<const std::uint32_t> fixed_nodes,
                                              fem::SphereLinks links,
                                              std::span<const std::uint32_t> compliance_spheres,

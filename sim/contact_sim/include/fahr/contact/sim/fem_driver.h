@@ -44,7 +44,7 @@ class FemDriver {
   // compliance_spheres: the candidate spheres whose W is published (<= the
   // body's max_compliance_spheres). Returns null and sets `error` on failure.
   static std::unique_ptr<FemDriver> create(const FemDriverSettings& settings,
-                                           const fem::TetMesh& mesh,
+                                           const fem::BodyMesh& mesh,
                                            std::span<const std::uint32_t> fixed_nodes,
                                            fem::SphereLinks links,
                                            std::span<const std::uint32_t> compliance_spheres,
