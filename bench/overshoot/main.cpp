@@ -48,6 +48,7 @@
 #include <vector>
 
 #include "fahr/common/solver_threads.h"
+#include "fahr/common/wire_eigen.h"
 #include "fahr/fem/strain.h"
 #include "fahr/geometry/tet_deformation.h"
 #include "fahr/geometry/tet_quality.h"
@@ -163,10 +164,6 @@ double max_displacement_m(const fem::Body& body) {
   return largest;
 }
 
-Eigen::Vector3d vec(const msg::Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
 // Inverted tets now, and how many of them lie within `near_m` of the
 // anatomy (a node that close to a bone's surface, or inside) and of the
 // blade at the proxy's pose (the tet's centroid).
@@ -183,9 +180,8 @@ Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
   const fem::Body& body = sim.body();
   const geometry::TetMesh& mesh = sim.tongue_mesh();
   const auto& proxy = sim.command().world_from_proxy();
-  const Eigen::Quaterniond q(proxy.orientation().w(), proxy.orientation().x(),
-                             proxy.orientation().y(), proxy.orientation().z());
-  const Eigen::Vector3d t = vec(proxy.position_m());
+  const Eigen::Quaterniond q = common::to_eigen(proxy.orientation());
+  const Eigen::Vector3d t = common::to_eigen(proxy.position_m());
   const auto& blade = *sim.haptic_setup().tool->sdf;
   const fem::ElementRest& elements = body.element_rest();
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
@@ -365,14 +361,14 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     const msg::DevicePose& pose = sim.pose();
     const double limit = pose.renderable_force_n();
     r.limit_n = std::max(r.limit_n, limit);
-    const Eigen::Vector3d force = vec(c.force_n());
-    const Eigen::Vector3d gap = vec(c.device_minus_proxy_m());
-    const Eigen::Vector3d hand = vec(c.answered_position_m());
+    const Eigen::Vector3d force = common::to_eigen(c.force_n());
+    const Eigen::Vector3d gap = common::to_eigen(c.device_minus_proxy_m());
+    const Eigen::Vector3d hand = common::to_eigen(c.answered_position_m());
     r.finite = r.finite && force.allFinite() && gap.allFinite();
     const double commanded = penalty ? force.norm() : k_c * gap.norm();
     r.max_commanded_n = std::max(r.max_commanded_n, commanded);
     if (tick_trace != nullptr) {
-      const Eigen::Vector3d proxy = vec(c.world_from_proxy().position_m());
+      const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
       std::fprintf(tick_trace,
                    "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,"
@@ -401,11 +397,12 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
       }
       if (c.lost_track()) {
         ++r.lost_ticks;
-        if (!was_lost) freeze_proxy = vec(c.world_from_proxy().position_m());
+        if (!was_lost) freeze_proxy = common::to_eigen(c.world_from_proxy().position_m());
         r.max_reaction_lost_ratio =
             std::max(r.max_reaction_lost_ratio, c.tissue_reaction_n() / limit);
-        r.max_held_drift_m = std::max(
-            r.max_held_drift_m, (vec(c.world_from_proxy().position_m()) - freeze_proxy).norm());
+        r.max_held_drift_m =
+            std::max(r.max_held_drift_m,
+                     (common::to_eigen(c.world_from_proxy().position_m()) - freeze_proxy).norm());
         // |gap| = L/K_c + (F_cmd - L)/K_c with F_cmd = K_c |x_d - p_freeze|:
         // the proxy stays where it froze. That holds while the device can
         // render its peak force; once the gateway lowers the limit (the Touch
@@ -424,7 +421,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
         reengaged_step = k;
       }
       was_lost = c.lost_track();
-      const Eigen::Vector3d hand_v = vec(pose.linear_velocity_mps());
+      const Eigen::Vector3d hand_v = common::to_eigen(pose.linear_velocity_mps());
       if (reengaged && k >= reengaged_step && k < reengaged_step + 50) {
         r.max_reengage_step_n = std::max(r.max_reengage_step_n, (force - previous_force).norm());
         const double bound = k_c * ((hand - previous_hand).norm() + kCatchUpSpeedMps * 1e-3) +
