@@ -25,8 +25,8 @@ int run_overshoot() {
   row("largest tissue reaction", fa.max_reaction_n, pe.max_reaction_n, "N");
   row("largest tissue reaction while lost track", fa.max_reaction_lost_n, 0.0, "N");
   row("ticks lost track", static_cast<double>(fa.lost_track_ticks), 0.0, "");
-  row("max Green strain at 1x", fa.strain_at_1x, pe.strain_at_1x, "");
-  row("max Green strain at 3x (deepest)", fa.strain_at_3x, pe.strain_at_3x, "");
+  row("largest principal Green strain at 1x", fa.strain_at_1x, pe.strain_at_1x, "");
+  row("largest principal Green strain at 3x (deepest)", fa.strain_at_3x, pe.strain_at_3x, "");
   row("published gap error while lost track", 1e3 * fa.max_gap_error_m, 0.0, "mm");
   row("largest force step, 50 ms after re-engaging", fa.max_reengage_step_n, 0.0, "N/tick");
   row("largest force step of the run", fa.max_tick_step_n, pe.max_tick_step_n, "N/tick");

@@ -99,7 +99,7 @@ SolverCase cg_lagged(int period, double tolerance, int max_iterations) {
   return c;
 }
 
-std::vector<std::uint32_t> nodes_where_y_below(const TetMesh& mesh, double y_m) {
+std::vector<std::uint32_t> nodes_where_y_below(const BodyMesh& mesh, double y_m) {
   std::vector<std::uint32_t> nodes;
   for (std::size_t i = 0; i < mesh.nodes_m.size(); ++i) {
     if (mesh.nodes_m[i].y() < y_m) nodes.push_back(static_cast<std::uint32_t>(i));

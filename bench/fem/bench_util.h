@@ -35,7 +35,7 @@ SolverCase cholmod_lagged(int period);
 SolverCase cg_jacobi(double tolerance, int max_iterations);
 SolverCase cg_lagged(int period, double tolerance, int max_iterations);
 
-std::vector<std::uint32_t> nodes_where_y_below(const TetMesh& mesh, double y_m);
+std::vector<std::uint32_t> nodes_where_y_below(const BodyMesh& mesh, double y_m);
 
 struct StepTiming {
   double mean_cpu_ms = 0.0;

@@ -55,7 +55,7 @@ struct PeerResult {
   std::string trace;  // max displacement, mm, every 25 steps
 };
 
-PeerResult run_fahr(const std::string& name, const TetMesh& mesh,
+PeerResult run_fahr(const std::string& name, const BodyMesh& mesh,
                     const std::vector<std::uint32_t>& fixed, const SolverSettings& solver,
                     int steps) {
   BodySettings settings;
@@ -82,7 +82,7 @@ PeerResult run_fahr(const std::string& name, const TetMesh& mesh,
 }
 
 // Linear static reference: one undamped step of h = 1000 s from rest.
-double linear_static_sag_mm(const TetMesh& mesh, const std::vector<std::uint32_t>& fixed) {
+double linear_static_sag_mm(const BodyMesh& mesh, const std::vector<std::uint32_t>& fixed) {
   BodySettings settings;
   settings.material = peer_material();
   settings.material.rayleigh_mass_per_s = 0.0;
@@ -96,7 +96,7 @@ double linear_static_sag_mm(const TetMesh& mesh, const std::vector<std::uint32_t
   return 1e3 * max_displacement(mesh.nodes_m, now);
 }
 
-PeerResult run_bullet(const TetMesh& mesh, const std::vector<std::uint32_t>& fixed, int steps) {
+PeerResult run_bullet(const BodyMesh& mesh, const std::vector<std::uint32_t>& fixed, int steps) {
   PeerResult result;
   result.name = "Bullet 3.24 btDeformableMultiBodyDynamicsWorld + linear elasticity (float64)";
   const Material material = peer_material();
@@ -195,7 +195,7 @@ int main(int argc, char** argv) {
   }
   const int steps = argc > 1 ? std::atoi(argv[1]) : 150;
   const std::string stem = std::string(FAHR_TONGUE_DIR) + "/tongue.1";
-  TetMesh mesh;
+  BodyMesh mesh;
   const std::string error = read_tetgen(stem, mesh);
   if (!error.empty()) {
     std::fprintf(stderr,

@@ -40,7 +40,7 @@ struct Row {
   bool pareto = false;
 };
 
-TetMesh beam(int n) {
+BodyMesh beam(int n) {
   return make_box_mesh({10 * n, n, n}, Eigen::Vector3d(kLength_m, kSide_m, kSide_m));
 }
 
@@ -54,7 +54,7 @@ Material beam_material(double rayleigh_mass) {
   return m;
 }
 
-std::unique_ptr<Body> loaded_beam(const TetMesh& mesh, const BodySettings& settings,
+std::unique_ptr<Body> loaded_beam(const BodyMesh& mesh, const BodySettings& settings,
                                   std::vector<std::uint32_t>& tip) {
   std::vector<std::uint32_t> fixed;
   tip.clear();
@@ -85,7 +85,7 @@ double euler_bernoulli() {
 
 // Linear static solution: one implicit step of h = 1000 s from rest without
 // damping, which is K u = f up to a relative M / (h^2 K) ~ 1e-9.
-double static_deflection(const TetMesh& mesh, double& ms) {
+double static_deflection(const BodyMesh& mesh, double& ms) {
   BodySettings settings;
   settings.material = beam_material(0.0);
   settings.gravity_m_per_s2.setZero();
@@ -137,7 +137,7 @@ void run_cantilever(int max_dynamic_n, int max_static_n, int steps) {
   std::vector<double> cells, errors, deflections;
   std::vector<int> ns;
   for (int n = 2; n <= max_static_n; n += 2) {
-    const TetMesh mesh = beam(n);
+    const BodyMesh mesh = beam(n);
     double ms = 0.0;
     const double d = static_deflection(mesh, ms);
     const double error = 100.0 * (d - reference) / reference;
@@ -189,7 +189,7 @@ void run_cantilever(int max_dynamic_n, int max_static_n, int steps) {
   std::vector<Row> rows;
   for (const int n : {2, 4, 6, 8, 12, 16}) {
     if (n > max_dynamic_n) break;
-    const TetMesh mesh = beam(n);
+    const BodyMesh mesh = beam(n);
     for (const SolverCase& c : n > 8 ? fine_cases : cases) {
       BodySettings settings;
       settings.material = beam_material(2.0 * omega1);

@@ -17,13 +17,14 @@ struct Size {
   int steps;
 };
 
-TetMesh block(const Size& size) {
+BodyMesh block(const Size& size) {
   const double cell = kBoxSide_m / size.cells[0];
   return make_box_mesh(size.cells,
                        Eigen::Vector3d(kBoxSide_m, cell * size.cells[1], cell * size.cells[2]));
 }
 
-std::unique_ptr<Body> block_body(const TetMesh& mesh, const SolverSettings& solver, double step_s) {
+std::unique_ptr<Body> block_body(const BodyMesh& mesh, const SolverSettings& solver,
+                                 double step_s) {
   BodySettings settings;
   settings.time_step = std::chrono::duration<double>(step_s);
   settings.solver = solver;
@@ -35,7 +36,7 @@ std::unique_ptr<Body> block_body(const TetMesh& mesh, const SolverSettings& solv
 }
 
 // Spheres on the top layer: one per top tet (weights 1/4), in order.
-SphereLinks top_spheres(const TetMesh& mesh, std::size_t count) {
+SphereLinks top_spheres(const BodyMesh& mesh, std::size_t count) {
   double top = -1e9;
   for (const auto& p : mesh.nodes_m) top = std::max(top, p.y());
   SphereLinks links;
@@ -99,7 +100,7 @@ void run_scale(bool quick) {
       "it/step | refactorisations |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Size& size : sizes(quick)) {
-    const TetMesh mesh = block(size);
+    const BodyMesh mesh = block(size);
     for (const SolverCase& c : scale_cases()) {
       const auto start = Clock::now();
       auto body = block_body(mesh, c.solver, 0.002);
@@ -122,7 +123,7 @@ void run_compliance(bool quick) {
   std::printf("| mesh | tets | k spheres | W size | CPU ms per block |\n|---|---|---|---|---|\n");
   for (const Size& size : sizes(quick)) {
     if (std::string(size.label) == "80k") continue;
-    const TetMesh mesh = block(size);
+    const BodyMesh mesh = block(size);
     auto body = block_body(mesh, cholmod_exact().solver, 0.002);
     const SphereLinks links = top_spheres(mesh, 64);
     body->step();
@@ -150,7 +151,7 @@ void run_compliance(bool quick) {
       "| factor (CG to 1e-10 on the current A, so the trajectories agree) | relative Frobenius "
       "error of W | "
       "worst diagonal error %% |\n|---|---|---|\n");
-  const TetMesh mesh = block(sizes(true)[1]);
+  const BodyMesh mesh = block(sizes(true)[1]);
   const SphereLinks links = top_spheres(mesh, 8);
   std::vector<std::uint32_t> ids(links.size());
   for (std::size_t s = 0; s < ids.size(); ++s) ids[s] = static_cast<std::uint32_t>(s);
@@ -209,7 +210,7 @@ void run_target() {
       "| solver | CPU ms/step | wall ms/step | max wall ms | steps/s (CPU) | CG it/step | "
       "refactorisations | "
       "L non-zeros | meets 500/s |\n|---|---|---|---|---|---|---|---|---|\n");
-  const TetMesh mesh = block(sizes(true)[1]);
+  const BodyMesh mesh = block(sizes(true)[1]);
   const SphereLinks links = top_spheres(mesh, 8);
   for (const SolverCase& c : target_cases()) {
     auto body = block_body(mesh, c.solver, 0.002);

@@ -25,8 +25,8 @@ bool next_line(std::ifstream& in, std::istringstream& line, int& line_number) {
 
 }  // namespace
 
-std::string read_tetgen(const std::string& stem, TetMesh& mesh) {
-  mesh = TetMesh{};
+std::string read_tetgen(const std::string& stem, BodyMesh& mesh) {
+  mesh = BodyMesh{};
   const std::string node_path = stem + ".node";
   const std::string ele_path = stem + ".ele";
   std::ifstream nodes(node_path);

@@ -10,6 +10,6 @@ namespace fahr::fem::bench {
 
 // Reads <stem>.node and <stem>.ele; returns an error naming file and line, or
 // empty on success.
-std::string read_tetgen(const std::string& stem, TetMesh& mesh);
+std::string read_tetgen(const std::string& stem, BodyMesh& mesh);
 
 }  // namespace fahr::fem::bench

@@ -37,6 +37,7 @@
 #include "fahr/common/clock.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/solver_threads.h"
+#include "fahr/common/wire_eigen.h"
 #include "fahr/fem_service/fem_body_setup.h"
 #include "fahr/fem_service/service_step.h"
 #include "fahr/scene/load_scene.h"
@@ -206,15 +207,11 @@ bool blade_touches(const fahr::msg::ContactSet& set) {
 }
 
 double force_norm(const fahr::msg::ForceCommand& c) {
-  const auto& f = c.force_n();
-  return std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z());
+  return fahr::common::to_eigen(c.force_n()).norm();
 }
 
 double force_difference(const fahr::msg::ForceCommand& a, const fahr::msg::ForceCommand& b) {
-  const double dx = a.force_n().x() - b.force_n().x();
-  const double dy = a.force_n().y() - b.force_n().y();
-  const double dz = a.force_n().z() - b.force_n().z();
-  return std::sqrt(dx * dx + dy * dy + dz * dz);
+  return (fahr::common::to_eigen(a.force_n()) - fahr::common::to_eigen(b.force_n())).norm();
 }
 
 double largest_node_distance_mm(const fahr::fem::Body& a, const fahr::fem::Body& b) {

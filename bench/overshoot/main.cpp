@@ -36,7 +36,7 @@
 // (commanded - limit) / K_c, the re-engagement force step within the
 // bound, the tongue within 1 mm of rest 1 s after the blade leaves it).
 #include <CLI/CLI.hpp>
-#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -48,6 +48,9 @@
 #include <vector>
 
 #include "fahr/common/solver_threads.h"
+#include "fahr/common/wire_eigen.h"
+#include "fahr/fem/strain.h"
+#include "fahr/geometry/tet_deformation.h"
 #include "fahr/geometry/tet_quality.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
@@ -110,16 +113,14 @@ std::size_t radius_ratio_class(double ratio) {
   return c;
 }
 
-// Marks the tets inverted in the body's current state.
-void mark_inverted(const fem::Body& body, const geometry::TetMesh& mesh,
-                   std::vector<std::uint8_t>& marks) {
-  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
-    const auto& tet = mesh.tets()[e];
-    Eigen::Matrix3d ds;
-    const Eigen::Vector3d x0 = body.position(tet[0]);
-    for (int c = 0; c < 3; ++c)
-      ds.col(c) = body.position(tet[static_cast<std::size_t>(c) + 1]) - x0;
-    if ((ds * mesh.rest_data()[e].dm_inverse).determinant() <= 0.0) marks[e] = 1;
+// Marks the tets inverted in the body's current state (its elements are the
+// mesh's tets, in order).
+void mark_inverted(const fem::Body& body, std::vector<std::uint8_t>& marks) {
+  const fem::ElementRest& rest = body.element_rest();
+  const double* x = body.positions_m().data();
+  for (std::size_t e = 0; e < rest.size(); ++e) {
+    if (geometry::deformation_gradient(x, rest.tets[e], rest.dm_inv[e]).determinant() <= 0.0)
+      marks[e] = 1;
   }
 }
 
@@ -155,32 +156,12 @@ void print_radius_ratio_table(const Result& r) {
   }
 }
 
-// Largest principal Green strain over the tets, |E| = |(F^T F - I) / 2|.
-double max_green_strain(const fem::Body& body, const geometry::TetMesh& mesh) {
-  double largest = 0.0;
-  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
-    const auto& t = mesh.tets()[e];
-    const Eigen::Vector3d x0 = body.position(t[0]);
-    Eigen::Matrix3d ds;
-    for (int c = 0; c < 3; ++c) ds.col(c) = body.position(t[static_cast<std::size_t>(c) + 1]) - x0;
-    const Eigen::Matrix3d f = ds * mesh.rest_data()[e].dm_inverse;
-    const Eigen::Matrix3d green = 0.5 * (f.transpose() * f - Eigen::Matrix3d::Identity());
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(green, Eigen::EigenvaluesOnly);
-    largest = std::max(largest, eigen.eigenvalues().cwiseAbs().maxCoeff());
-  }
-  return largest;
-}
-
 double max_displacement_m(const fem::Body& body) {
   double largest = 0.0;
   for (std::uint32_t n = 0; n < body.node_count(); ++n) {
     largest = std::max(largest, (body.position(n) - body.rest_position(n)).norm());
   }
   return largest;
-}
-
-Eigen::Vector3d vec(const msg::Vec3& v) {
-  return {v.x(), v.y(), v.z()};
 }
 
 // Inverted tets now, and how many of them lie within `near_m` of the
@@ -199,17 +180,16 @@ Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
   const fem::Body& body = sim.body();
   const geometry::TetMesh& mesh = sim.tongue_mesh();
   const auto& proxy = sim.command().world_from_proxy();
-  const Eigen::Quaterniond q(proxy.orientation().w(), proxy.orientation().x(),
-                             proxy.orientation().y(), proxy.orientation().z());
-  const Eigen::Vector3d t = vec(proxy.position_m());
+  const Eigen::Quaterniond q = common::to_eigen(proxy.orientation());
+  const Eigen::Vector3d t = common::to_eigen(proxy.position_m());
   const auto& blade = *sim.haptic_setup().tool->sdf;
+  const fem::ElementRest& elements = body.element_rest();
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     const auto& tet = mesh.tets()[e];
-    Eigen::Matrix3d ds;
-    const Eigen::Vector3d x0 = body.position(tet[0]);
-    for (int c = 0; c < 3; ++c)
-      ds.col(c) = body.position(tet[static_cast<std::size_t>(c) + 1]) - x0;
-    if ((ds * mesh.rest_data()[e].dm_inverse).determinant() > 0.0) continue;
+    if (geometry::deformation_gradient(body.positions_m().data(), elements.tets[e],
+                                       elements.dm_inv[e])
+            .determinant() > 0.0)
+      continue;
     ++out.count;
     const auto& rest = mesh.rest_positions();
     out.worst_rest_radius_ratio = std::min(
@@ -232,19 +212,8 @@ Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
 // Inverted tets of the FEM's free motion (the implicit step before any
 // projection): inversions the projection did not make.
 int inverted_free(const stack_sim::StackSim& sim) {
-  const auto x = sim.fem().contact_step().free_positions_m();
-  const geometry::TetMesh& mesh = sim.tongue_mesh();
-  const auto at = [&](std::size_t n) {
-    return Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]);
-  };
-  int count = 0;
-  for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
-    const auto& tet = mesh.tets()[e];
-    Eigen::Matrix3d ds;
-    for (int c = 0; c < 3; ++c) ds.col(c) = at(tet[static_cast<std::size_t>(c) + 1]) - at(tet[0]);
-    if ((ds * mesh.rest_data()[e].dm_inverse).determinant() <= 0.0) ++count;
-  }
-  return count;
+  return fem::inverted_element_count(sim.body().element_rest(),
+                                     sim.fem().contact_step().free_positions_m());
 }
 
 struct ToolContacts {
@@ -392,14 +361,14 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     const msg::DevicePose& pose = sim.pose();
     const double limit = pose.renderable_force_n();
     r.limit_n = std::max(r.limit_n, limit);
-    const Eigen::Vector3d force = vec(c.force_n());
-    const Eigen::Vector3d gap = vec(c.device_minus_proxy_m());
-    const Eigen::Vector3d hand = vec(c.answered_position_m());
+    const Eigen::Vector3d force = common::to_eigen(c.force_n());
+    const Eigen::Vector3d gap = common::to_eigen(c.device_minus_proxy_m());
+    const Eigen::Vector3d hand = common::to_eigen(c.answered_position_m());
     r.finite = r.finite && force.allFinite() && gap.allFinite();
     const double commanded = penalty ? force.norm() : k_c * gap.norm();
     r.max_commanded_n = std::max(r.max_commanded_n, commanded);
     if (tick_trace != nullptr) {
-      const Eigen::Vector3d proxy = vec(c.world_from_proxy().position_m());
+      const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
       std::fprintf(tick_trace,
                    "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,"
@@ -423,15 +392,17 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     if (!penalty) {
       if (!seen_1x && commanded >= limit && limit > 0.0) {
         seen_1x = true;
-        r.strain_1x = max_green_strain(sim.body(), sim.tongue_mesh());
+        r.strain_1x =
+            fem::max_principal_green_strain(sim.body().element_rest(), sim.body().positions_m());
       }
       if (c.lost_track()) {
         ++r.lost_ticks;
-        if (!was_lost) freeze_proxy = vec(c.world_from_proxy().position_m());
+        if (!was_lost) freeze_proxy = common::to_eigen(c.world_from_proxy().position_m());
         r.max_reaction_lost_ratio =
             std::max(r.max_reaction_lost_ratio, c.tissue_reaction_n() / limit);
-        r.max_held_drift_m = std::max(
-            r.max_held_drift_m, (vec(c.world_from_proxy().position_m()) - freeze_proxy).norm());
+        r.max_held_drift_m =
+            std::max(r.max_held_drift_m,
+                     (common::to_eigen(c.world_from_proxy().position_m()) - freeze_proxy).norm());
         // |gap| = L/K_c + (F_cmd - L)/K_c with F_cmd = K_c |x_d - p_freeze|:
         // the proxy stays where it froze. That holds while the device can
         // render its peak force; once the gateway lowers the limit (the Touch
@@ -450,7 +421,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
         reengaged_step = k;
       }
       was_lost = c.lost_track();
-      const Eigen::Vector3d hand_v = vec(pose.linear_velocity_mps());
+      const Eigen::Vector3d hand_v = common::to_eigen(pose.linear_velocity_mps());
       if (reengaged && k >= reengaged_step && k < reengaged_step + 50) {
         r.max_reengage_step_n = std::max(r.max_reengage_step_n, (force - previous_force).norm());
         const double bound = k_c * ((hand - previous_hand).norm() + kCatchUpSpeedMps * 1e-3) +
@@ -462,11 +433,12 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
     previous_force = force;
     previous_hand = hand;
     if (sim.time_s() >= kHoldEndS && r.strain_3x == 0.0)
-      r.strain_3x = max_green_strain(sim.body(), sim.tongue_mesh());
+      r.strain_3x =
+          fem::max_principal_green_strain(sim.body().element_rest(), sim.body().positions_m());
     if (sim.fem_stepped()) {
       const fem::StepReport& report = sim.fem().last_report();
       r.max_inverted = std::max(r.max_inverted, report.inverted_elements);
-      mark_inverted(sim.body(), sim.tongue_mesh(), r.ever_inverted);
+      mark_inverted(sim.body(), r.ever_inverted);
       r.max_elastic_j = std::max(r.max_elastic_j, sim.body().energy().elastic_j);
       r.max_anatomy_depth_m = std::max(r.max_anatomy_depth_m, report.projection.obstacle_deepest_m);
       if (trace != nullptr) {
@@ -510,7 +482,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   if (trace != nullptr) std::fclose(trace);
   if (tick_trace != nullptr) std::fclose(tick_trace);
   r.inverted_at_end.assign(sim.tongue_mesh().tet_count(), 0);
-  mark_inverted(sim.body(), sim.tongue_mesh(), r.inverted_at_end);
+  mark_inverted(sim.body(), r.inverted_at_end);
   count_by_radius_ratio(sim.tongue_mesh(), r);
   r.divergence_resets = sim.fem().divergence_resets();
   r.anatomy_returned = sim.fem().anatomy_returned();
@@ -623,8 +595,10 @@ int main(int argc, char** argv) {
                 fa.max_reaction_lost_ratio);
     std::printf("| lost-track ticks | %llu | - |\n",
                 static_cast<unsigned long long>(fa.lost_ticks));
-    std::printf("| max Green strain at 1x / at the end of the hold | %.3f / %.3f | - / %.3f |\n",
-                fa.strain_1x, fa.strain_3x, pe.strain_3x);
+    std::printf(
+        "| largest principal Green strain at 1x / at the end of the hold | %.3f / %.3f | - / %.3f "
+        "|\n",
+        fa.strain_1x, fa.strain_3x, pe.strain_3x);
     std::printf(
         "| largest published-gap error mm (lost-track ticks at the peak limit) | %.3f (%llu) | - "
         "|\n",

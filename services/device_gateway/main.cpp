@@ -3,15 +3,16 @@
 // the core in real time (sleep_until, opt-in spin and SCHED_FIFO) or in
 // lockstep (one tick per granted base step), publishing DevicePose every tick
 // and ServiceStatus a few times a second.
-#include <sched.h>
 #include <sys/mman.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "fahr/common/lockstep.h"
 #include "fahr/common/participant.h"
 #include "fahr/common/publisher.h"
+#include "fahr/common/realtime.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/common/subscriber.h"
 #include "fahr/device/recording.h"
@@ -112,12 +114,10 @@ void try_realtime(int priority) {
     std::fprintf(stderr, "fahr_device_gateway: mlockall failed (%s): continuing unlocked\n",
                  std::strerror(errno));
   }
-  sched_param param{};
-  param.sched_priority = priority;
-  if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
-    std::fprintf(stderr,
-                 "fahr_device_gateway: SCHED_FIFO %d refused (%s): continuing at normal priority\n",
-                 priority, std::strerror(errno));
+  const std::string refused = common::request_realtime_priority(priority);
+  if (!refused.empty()) {
+    std::fprintf(stderr, "fahr_device_gateway: SCHED_FIFO %d: %s; continuing at normal priority\n",
+                 priority, refused.c_str());
   } else {
     std::fprintf(stderr, "fahr_device_gateway: running SCHED_FIFO priority %d\n", priority);
   }

@@ -39,7 +39,7 @@ TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
   grid.candidate_margin_m = 0.25e-3;
   grid.contact_skin_m = 0.1e-3;
   std::size_t contacts = 0, with_surface = 0;
-  test::arm_allocation_counter();
+  fahr::test::AllocationCounter counter;
   for (int tick = 0; tick < 50; ++tick) {
     x[1] -= 1e-5;  // a node moves: a new FEM state every tick
     state.update(layout, x);
@@ -54,20 +54,22 @@ TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
     contacts += buffer.size();
     for (const SphereContact& c : buffer) with_surface += c.has_surface ? 1 : 0;
   }
-  const std::size_t allocations = test::disarm_allocation_counter();
-  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(counter.count(), 0);
   EXPECT_GT(contacts, 0u) << "the slab touches the tongue: the narrow phase ran";
   EXPECT_EQ(with_surface, contacts) << "every sphere of the default layout has a surface anchor";
   EXPECT_EQ(tree.rebuild_count(), 0u);
 }
 
 TEST(Allocation, CounterSeesAnAllocation) {
-  test::arm_allocation_counter();
-  // A direct call: a new-expression may be elided by the optimiser.
-  void* p = ::operator new(16);
-  const std::size_t allocations = test::disarm_allocation_counter();
-  ::operator delete(p);
-  EXPECT_EQ(allocations, 1u);
+  long allocations = 0;
+  {
+    fahr::test::AllocationCounter counter;
+    // A direct call: a new-expression may be elided by the optimiser.
+    void* p = ::operator new(16);
+    allocations = counter.count();
+    ::operator delete(p);
+  }
+  EXPECT_EQ(allocations, 1);
 }
 
 }  // namespace

@@ -18,7 +18,7 @@ TEST(Allocation, ContactResponseTickAllocatesNothing) {
   in.compliance = patch.compliance();
   in.device.renderable_force_n = 0.5;
   double y = 0.001;
-  test::count_allocations(true);
+  fahr::test::AllocationCounter counter;
   // Down past the limit (freeze), back up (release, catch-up): every branch.
   for (int k = 0; k < 3000; ++k) {
     y += k < 1500 ? -1e-5 : 1e-5;
@@ -26,18 +26,16 @@ TEST(Allocation, ContactResponseTickAllocatesNothing) {
     in.device.position_m = Eigen::Vector3d(0, y, 0);
     response.tick(in);
   }
-  test::count_allocations(false);
-  EXPECT_EQ(test::allocations(), 0u);
+  EXPECT_EQ(counter.count(), 0);
 }
 
 TEST(Allocation, PenaltyTickAllocatesNothing) {
   test::SyntheticPatch patch = test::make_patch(24, -0.001, 0.002, 0.002);
   PenaltyResponse penalty(PenaltySettings{});
   DeviceSample device;
-  test::count_allocations(true);
+  fahr::test::AllocationCounter counter;
   for (int k = 0; k < 100; ++k) penalty.tick(device, patch.rows, 1);
-  test::count_allocations(false);
-  EXPECT_EQ(test::allocations(), 0u);
+  EXPECT_EQ(counter.count(), 0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "allocation_counter.h"
 #include "scenes.h"
+#include "suitesparse_allocations.h"
 
 namespace fahr::fem {
 namespace {
@@ -42,7 +43,7 @@ std::vector<Mode> modes() {
 
 TEST(Allocation, StepAllocatesNothing) {
   test::hook_suitesparse_allocations();
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   // Every mode with the linear material and with compression stiffening.
   for (const double stiffening : {0.0, kTongueYeohC20OverC10})
     for (const Mode& mode : modes()) {
@@ -69,25 +70,24 @@ TEST(Allocation, StepAllocatesNothing) {
         set.state_step = body->step_index();
         body->step(&set, &links);
       }
-      test::reset_allocation_counts();
-      test::enable_allocation_counting(true);
+      fahr::test::AllocationCounter counter;
       int refactorisations = 0;
       for (int k = 0; k < 20; ++k) {
         set.state_step = body->step_index();
         refactorisations += body->step(&set, &links).refactorised ? 1 : 0;
       }
-      test::enable_allocation_counting(false);
-      EXPECT_EQ(test::new_count(), 0u) << mode.name << ", stiffening " << stiffening;
+      const long news = counter.count();
+      const long suitesparse_allocs = counter.other_count();
+      EXPECT_EQ(news, 0) << mode.name << ", stiffening " << stiffening;
       if (!mode.refactorises) {
         EXPECT_EQ(refactorisations, 0) << mode.name << ", stiffening " << stiffening;
-        EXPECT_EQ(test::suitesparse_alloc_count(), 0u)
-            << mode.name << ", stiffening " << stiffening;
+        EXPECT_EQ(suitesparse_allocs, 0) << mode.name << ", stiffening " << stiffening;
       } else {
         // Reported, not asserted: CHOLMOD's numeric refactorisation mallocs its
         // permuted copy of A and supernodal workspace.
         std::printf(
-            "[ info ] %s, stiffening %.2f: %d refactorisations, %zu CHOLMOD mallocs in 20 steps\n",
-            mode.name, stiffening, refactorisations, test::suitesparse_alloc_count());
+            "[ info ] %s, stiffening %.2f: %d refactorisations, %ld CHOLMOD mallocs in 20 steps\n",
+            mode.name, stiffening, refactorisations, suitesparse_allocs);
       }
     }
 }
@@ -98,7 +98,7 @@ TEST(Allocation, StepAllocatesNothing) {
 // kept, and allocates nothing once each chunk size has been seen.
 TEST(Allocation, ComplianceOfChangingSpheresAllocatesNothing) {
   test::hook_suitesparse_allocations();
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.solver.refactor_period = 0;
   settings.solver.refactor_rotation_rad = 0.0;
@@ -118,14 +118,14 @@ TEST(Allocation, ComplianceOfChangingSpheresAllocatesNothing) {
   // Warm-up: every chunk size (8, 4, 2, 1 spheres) once.
   ASSERT_TRUE(window(0, 15));
   ASSERT_TRUE(window(20, 16));
-  test::reset_allocation_counts();
-  test::enable_allocation_counting(true);
+  fahr::test::AllocationCounter counter;
   bool ok = true;
   for (std::uint32_t first = 1; first < 24; ++first) ok = window(first, 1 + first % 16) && ok;
-  test::enable_allocation_counting(false);
+  const long news = counter.count();
+  const long suitesparse_allocs = counter.other_count();
   EXPECT_TRUE(ok);
-  EXPECT_EQ(test::new_count(), 0u);
-  EXPECT_EQ(test::suitesparse_alloc_count(), 0u);
+  EXPECT_EQ(news, 0);
+  EXPECT_EQ(suitesparse_allocs, 0);
 }
 
 }  // namespace

@@ -6,7 +6,7 @@
 namespace fahr::fem {
 namespace {
 
-SphereLinks tip_spheres(const TetMesh& mesh, std::size_t count) {
+SphereLinks tip_spheres(const BodyMesh& mesh, std::size_t count) {
   SphereLinks links;
   for (std::size_t s = 0; s < count; ++s) {
     const std::array<double, 4> w = {0.1, 0.2, 0.3, 0.4};
@@ -26,7 +26,7 @@ BodySettings still_settings() {
 TEST(Compliance, MatchesTheResponseOfOneStep) {
   // At rest without gravity f = 0, so one step with force F on sphere t
   // (spread as J^T F) moves sphere s by exactly W_st F.
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   const BodySettings settings = still_settings();
   const SphereLinks links = tip_spheres(mesh, 3);
   const std::vector<std::uint32_t> spheres = {0, 1, 2};
@@ -67,7 +67,7 @@ TEST(Compliance, MatchesTheResponseOfOneStep) {
 TEST(Compliance, AlongNormalsIsTheBlocksTimesTheNormals) {
   // One column a sphere, W_st n_t, is the 3x3 blocks applied to n_t; the
   // 3x3 blocks' kept columns are not disturbed by it.
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   const BodySettings settings = still_settings();
   const SphereLinks links = tip_spheres(mesh, 3);
   const std::vector<std::uint32_t> spheres = {2, 0, 1};
@@ -106,7 +106,7 @@ TEST(Compliance, KeptColumnsGiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
   // A body that solved other spheres before (some of them kept) writes the
   // same block as a body solving these spheres for the first time; after a
   // refactorisation at a deformed state nothing kept is reused.
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.time_step = std::chrono::milliseconds(10);
   settings.sleep.enabled = false;
@@ -140,7 +140,7 @@ TEST(Compliance, KeptColumnsGiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
 }
 
 TEST(Sleep, RestingBodySleepsAndWakesOnTouch) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.time_step = std::chrono::milliseconds(10);
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));

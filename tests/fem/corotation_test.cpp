@@ -11,7 +11,7 @@ namespace fahr::fem {
 namespace {
 
 TEST(Corotation, RigidRotationGivesZeroElasticForce) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   auto body = test::make_body(settings, mesh, {});
   ASSERT_NE(body, nullptr);
@@ -58,7 +58,7 @@ TEST(Corotation, InvertedBodyRecovers) {
   // Every node of a free-floating bar mirrored through its mid-plane y: all
   // elements start inside out. Without gravity the bar must unfold to its
   // rest shape (up to a rigid motion; checked on edge lengths).
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.gravity_m_per_s2.setZero();
   settings.time_step = std::chrono::milliseconds(5);

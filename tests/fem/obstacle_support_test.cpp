@@ -40,7 +40,7 @@ BodySettings tongue_like() {
 // zero-radius sphere on the top node nearest the free end's middle, whose
 // W_yy is read.
 struct BarOnFloor {
-  TetMesh mesh = test::bar_mesh(2);
+  BodyMesh mesh = test::bar_mesh(2);
   std::vector<std::uint32_t> fixed = test::fixed_x0(mesh);
   std::vector<std::uint32_t> free_half_top;
   std::uint32_t probe = 0;

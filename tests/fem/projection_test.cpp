@@ -10,7 +10,7 @@ namespace fahr::fem {
 namespace {
 
 // A sphere tied to the four nodes of tet `e` with equal weights.
-SphereLinks links_for_tets(const TetMesh& mesh, std::initializer_list<std::size_t> tets,
+SphereLinks links_for_tets(const BodyMesh& mesh, std::initializer_list<std::size_t> tets,
                            double radius_m) {
   SphereLinks links;
   for (const std::size_t e : tets) {
@@ -75,7 +75,7 @@ TEST(Projection, TranslationSpreadMovesEveryFreeNodeAlike) {
 }
 
 TEST(Projection, FrozenConstraintHoldsExactly) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.projection.frozen_target = FrozenTarget::kHoldCentre;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
@@ -103,7 +103,7 @@ TEST(Projection, FrozenConstraintHoldsExactly) {
 // step found it, whatever hold centre the set carries, so the bar's tip,
 // frozen mid-fall, stays put under gravity.
 TEST(Projection, FrozenSphereStaysWhereTheStepStarted) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
   ASSERT_NE(body, nullptr);
@@ -129,7 +129,7 @@ TEST(Projection, FrozenSphereStaysWhereTheStepStarted) {
 // neither (the neonatal overshoot's holds did this, 2-7 mm apart, and moved
 // a node 153 mm in one step); held where the step started they do not move.
 TEST(Projection, ContradictoryHoldsDoNotDragTheNodes) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   const std::size_t tip_tet = mesh.tets.size() - 1;
   double moved[2] = {0.0, 0.0};
   for (const FrozenTarget target : {FrozenTarget::kStepStart, FrozenTarget::kHoldCentre}) {
@@ -166,7 +166,7 @@ TEST(Projection, ContradictoryHoldsDoNotDragTheNodes) {
 
 TEST(Projection, ActiveConstraintLeavesNoPenetration) {
   // The bar sags under gravity onto an obstacle plane y = -4 mm below it.
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
   ASSERT_NE(body, nullptr);
@@ -212,7 +212,7 @@ TEST(Projection, ActiveConstraintLeavesNoPenetration) {
 // set arrives at step k (false: dropped); a repeated set keeps its old
 // state_step, as a reliable keep-last reader would hand it over again.
 std::vector<double> run_schedule(bool (*schedule)(int), bool repeat_old) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.projection.frozen_target = FrozenTarget::kHoldCentre;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
@@ -249,7 +249,7 @@ TEST(Projection, DroppedSetOnlyAffectsItsOwnStep) {
 }
 
 TEST(Projection, StaleSetsAreIgnoredAndCounted) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.max_contact_age_steps = 3;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));

@@ -14,11 +14,11 @@ namespace fahr::fem::test {
 
 // A 30 x 10 x 10 mm bar, cells 3 x 1 x 1 scaled by `refine`, tongue-like
 // material, its x = 0 face fixed.
-inline TetMesh bar_mesh(int refine = 2) {
+inline BodyMesh bar_mesh(int refine = 2) {
   return make_box_mesh({3 * refine, refine, refine}, Eigen::Vector3d(0.03, 0.01, 0.01));
 }
 
-inline std::vector<std::uint32_t> nodes_where(const TetMesh& mesh, auto predicate) {
+inline std::vector<std::uint32_t> nodes_where(const BodyMesh& mesh, auto predicate) {
   std::vector<std::uint32_t> nodes;
   for (std::size_t i = 0; i < mesh.nodes_m.size(); ++i) {
     if (predicate(mesh.nodes_m[i])) nodes.push_back(static_cast<std::uint32_t>(i));
@@ -26,11 +26,11 @@ inline std::vector<std::uint32_t> nodes_where(const TetMesh& mesh, auto predicat
   return nodes;
 }
 
-inline std::vector<std::uint32_t> fixed_x0(const TetMesh& mesh) {
+inline std::vector<std::uint32_t> fixed_x0(const BodyMesh& mesh) {
   return nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.x() < 1e-9; });
 }
 
-inline std::unique_ptr<Body> make_body(const BodySettings& settings, const TetMesh& mesh,
+inline std::unique_ptr<Body> make_body(const BodySettings& settings, const BodyMesh& mesh,
                                        const std::vector<std::uint32_t>& fixed) {
   BodyOrError made = Body::create(settings, mesh.nodes_m, mesh.tets, fixed);
   if (!made.error.empty()) return nullptr;

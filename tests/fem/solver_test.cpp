@@ -13,7 +13,7 @@ namespace fahr::fem {
 namespace {
 
 std::vector<double> run(const SolverSettings& solver, int steps, double step_s = 0.01) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.solver = solver;
   settings.time_step = std::chrono::duration<double>(step_s);
@@ -82,7 +82,7 @@ TEST(Solvers, CgRefreshesItsFactorOnlyWhenTheSolveGetsExpensive) {
   // preconditioner. With the rotation trigger off, the iteration trigger
   // alone refreshes it, a few times rather than every step, and the
   // trajectory is still the exact one (CG converges on the current A).
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   SolverSettings exact;
   const auto reference = run(exact, 100);
   SolverSettings cg;
@@ -119,7 +119,7 @@ TEST(Solvers, CgRefreshesItsFactorOnlyWhenTheSolveGetsExpensive) {
 }
 
 TEST(Solvers, SetSolverSwitchesARunningBodyAndRejectsBadSettings) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.time_step = std::chrono::duration<double>(0.01);
   settings.sleep.enabled = false;

@@ -27,7 +27,7 @@ class LoadAbuse : public ::testing::TestWithParam<AbuseCase> {};
 
 TEST_P(LoadAbuse, StaysFiniteBoundedAndReturnsToRest) {
   const AbuseCase abuse = GetParam();
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.gravity_m_per_s2.setZero();  // rest is then the rest shape
   settings.time_step = std::chrono::duration<double>(abuse.step_s);
@@ -74,7 +74,7 @@ INSTANTIATE_TEST_SUITE_P(StepsAndLoads, LoadAbuse,
                                            AbuseCase{0.05, 100.0}));
 
 TEST(Stability, YankedNodeReleased) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   for (const double step_s : {0.001, 0.01, 0.05}) {
     BodySettings settings;
     settings.gravity_m_per_s2.setZero();
@@ -102,7 +102,7 @@ TEST(Stability, YankedNodeReleased) {
 
 TEST(Stability, GravitySagMatchesAcrossStepSizes) {
   // The static equilibrium does not depend on h (the force is exact).
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   std::vector<double> tips;
   for (const double step_s : {0.001, 0.05}) {
     BodySettings settings;

@@ -100,7 +100,7 @@ TEST(Stiffening, ScalesTheElementForceAndItsBlockOfA) {
 // material lets the node punch through the elements below it, the
 // stiffened one does not.
 int most_inverted_when_punched(double c20_over_c10) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
   settings.time_step = std::chrono::milliseconds(5);
   settings.gravity_m_per_s2.setZero();
@@ -177,7 +177,7 @@ std::vector<RecordedRun> recorded_runs() {
 }
 
 TEST(Stiffening, OffIsTheLinearMaterialBitForBit) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   const auto fixed = test::fixed_x0(mesh);
   std::uint32_t tip = 0;
   for (std::size_t i = 0; i < mesh.nodes_m.size(); ++i) {
@@ -203,7 +203,7 @@ TEST(Stiffening, OffIsTheLinearMaterialBitForBit) {
 // A stiffening element refreshes a lagged factorisation as a turning one
 // does; without stiffening the trigger never fires.
 TEST(Stiffening, AChangedScaleRefreshesALaggedFactor) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   const auto fixed = test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.y() < 1e-9; });
   const auto top =
       test::nodes_where(mesh, [](const Eigen::Vector3d& p) { return p.y() > 0.01 - 1e-9; });
@@ -228,7 +228,7 @@ TEST(Stiffening, AChangedScaleRefreshesALaggedFactor) {
 }
 
 TEST(Stiffening, BadRatioIsRejected) {
-  const TetMesh mesh = test::bar_mesh(1);
+  const BodyMesh mesh = test::bar_mesh(1);
   BodySettings settings;
   settings.material.yeoh_c20_over_c10 = -0.1;
   BodyOrError made = Body::create(settings, mesh.nodes_m, mesh.tets, test::fixed_x0(mesh));

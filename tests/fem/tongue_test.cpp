@@ -17,7 +17,7 @@ namespace {
 // Minimal TetGen reader for this test only (geometry's loaders come later):
 // .node "count dim attrs markers" then "index x y z ..."; .ele "count 4 attrs"
 // then "index n0 n1 n2 n3". '#' starts a comment.
-bool read_tetgen(const std::string& stem, TetMesh& mesh, std::string& error) {
+bool read_tetgen(const std::string& stem, BodyMesh& mesh, std::string& error) {
   std::ifstream node_file(stem + ".node");
   std::ifstream ele_file(stem + ".ele");
   if (!node_file || !ele_file) {
@@ -84,7 +84,7 @@ std::string tongue_stem() {
 }
 
 // The lowest 10 mm (+y up) are fixed.
-std::vector<std::uint32_t> tongue_base(const TetMesh& mesh) {
+std::vector<std::uint32_t> tongue_base(const BodyMesh& mesh) {
   double lowest = 1e9;
   for (const auto& p : mesh.nodes_m) lowest = std::min(lowest, p.y());
   return test::nodes_where(mesh, [&](const Eigen::Vector3d& p) { return p.y() < lowest + 0.010; });
@@ -95,7 +95,7 @@ TEST(Tongue, StepsStablyUnderGravity) {
   ASSERT_TRUE(std::filesystem::exists(stem + ".node"))
       << "ArtiSynth tongue not found at " << stem
       << ".node: ../shared/meshes/artisynth-tongue must be beside the checkout";
-  TetMesh mesh;
+  BodyMesh mesh;
   std::string error;
   ASSERT_TRUE(read_tetgen(stem, mesh, error)) << error;
   ASSERT_EQ(mesh.tets.size(), 11098u);
@@ -141,7 +141,7 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
   ASSERT_TRUE(std::filesystem::exists(stem + ".node"))
       << "ArtiSynth tongue not found at " << stem
       << ".node: ../shared/meshes/artisynth-tongue must be beside the checkout";
-  TetMesh mesh;
+  BodyMesh mesh;
   std::string error;
   ASSERT_TRUE(read_tetgen(stem, mesh, error)) << error;
   BodySettings settings;

@@ -31,7 +31,7 @@ BodySettings soft() {
 }
 
 // Highest node of the bar's free half (x > 15 mm), m.
-double highest_free_node(const Body& body, const TetMesh& mesh) {
+double highest_free_node(const Body& body, const BodyMesh& mesh) {
   double top = -1.0;
   for (std::uint32_t n = 0; n < body.node_count(); ++n) {
     if (mesh.nodes_m[n].x() > 0.015) top = std::max(top, body.position(n).y());
@@ -42,7 +42,7 @@ double highest_free_node(const Body& body, const TetMesh& mesh) {
 // The 30 x 10 x 10 mm bar, its x = 0 face fixed, under a slab lowered from
 // its top (10 mm) by 0.5 mm a step to 7 mm, no ContactSet at all.
 double lowest_reach_of_slab(bool tool_obstacle, int& supported) {
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   const auto fixed = test::fixed_x0(mesh);
   SphereLinks links;
   auto body = test::make_body(soft(), mesh, fixed);

@@ -107,7 +107,7 @@ CrushedBar crush_bar(double floor_ratio) {
   BodySettings settings;
   settings.sleep.enabled = false;
   settings.time_step = std::chrono::duration<double>(1.0 / 200.0);
-  const TetMesh mesh = test::bar_mesh(2);
+  const BodyMesh mesh = test::bar_mesh(2);
   const std::vector<std::uint32_t> fixed = test::fixed_x0(mesh);
   auto body = test::make_body(settings, mesh, fixed);
   EXPECT_NE(body, nullptr);

@@ -1,10 +1,14 @@
-// TetMesh and SurfaceMesh: rest data, boundary, quality statistics, topology.
+// TetMesh and SurfaceMesh: rest data, boundary, quality statistics, topology;
+// the tet deformation gradient.
 #include "fahr/geometry/tet_mesh.h"
 
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <cmath>
+#include <vector>
 
+#include "fahr/geometry/tet_deformation.h"
 #include "test_support.h"
 
 namespace fahr::geometry {
@@ -24,16 +28,37 @@ TEST(TetMesh, CubeRestDataAndBoundary) {
   for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
     const Tet& tet = mesh.tets()[t];
     const auto& x = mesh.rest_positions();
-    Eigen::Matrix3d dm;
-    dm << x[tet[1]] - x[tet[0]], x[tet[2]] - x[tet[0]], x[tet[3]] - x[tet[0]];
-    EXPECT_TRUE((mesh.rest_data()[t].dm_inverse * dm).isIdentity(kRoundoff));
+    const double six_volume = edge_matrix(x[tet[0]], x[tet[1]], x[tet[2]], x[tet[3]]).determinant();
     EXPECT_GT(mesh.rest_data()[t].volume_m3, 0.0);
+    EXPECT_NEAR(six_volume, 6.0 * mesh.rest_data()[t].volume_m3,
+                kRoundoff * mesh.rest_data()[t].volume_m3);
   }
   // Outward faces: the boundary encloses the cube's volume with a positive sign.
   const SurfaceMesh surface = mesh.boundary_surface();
   EXPECT_TRUE(surface.is_closed());
   EXPECT_TRUE(surface.is_manifold());
   EXPECT_NEAR(surface.enclosed_volume_m3(), volume, kRoundoff * volume);
+}
+
+// F = Ds Dm^-1 of an affine map x -> A x + b is A for every tet, whatever
+// its shape; from flat positions as the FEM keeps them.
+TEST(TetDeformation, GradientOfAnAffineMapIsItsMatrix) {
+  const TetMesh mesh = test::cube_tets(2, 0.01);
+  Eigen::Matrix3d a;
+  a << 1.1, 0.2, -0.05, 0.0, 0.8, 0.1, 0.03, -0.2, 1.3;
+  const Eigen::Vector3d b(0.01, -0.02, 0.005);
+  std::vector<double> flat;
+  for (const Eigen::Vector3d& x : mesh.rest_positions()) {
+    const Eigen::Vector3d y = a * x + b;
+    flat.insert(flat.end(), {y.x(), y.y(), y.z()});
+  }
+  const auto& x = mesh.rest_positions();
+  for (const Tet& tet : mesh.tets()) {
+    const Eigen::Matrix3d dm_inverse =
+        edge_matrix(x[tet[0]], x[tet[1]], x[tet[2]], x[tet[3]]).inverse();
+    const Eigen::Matrix3d f = deformation_gradient(flat.data(), tet, dm_inverse);
+    EXPECT_TRUE(f.isApprox(a, 1e-12)) << f;
+  }
 }
 
 TEST(TetMesh, KuhnTetQuality) {

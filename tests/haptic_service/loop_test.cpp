@@ -9,6 +9,7 @@
 
 #include "contact_set.h"
 #include "fahr/collision/surface_samples.h"
+#include "fahr/common/wire_eigen.h"
 #include "fahr/device/trajectory.h"
 #include "fahr/haptic_service/haptic_loop.h"
 #include "fahr/haptic_service/tissue_snapshot.h"
@@ -58,9 +59,7 @@ double anatomy_depth(const HapticSetup& setup, const Eigen::Vector3d& tip_m, dou
   return deepest;
 }
 
-Eigen::Vector3d to_eigen(const msg::Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
+using common::to_eigen;
 
 TEST(HapticLoop, BladeStopsAtTheAnatomy) {
   const HapticSetup& setup = neonatal_scene().setup;

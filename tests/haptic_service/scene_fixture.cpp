@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "fahr/common/wire_eigen.h"
+
 namespace fahr::haptic_service::test {
 
 const NeonatalScene& neonatal_scene() {
@@ -29,14 +31,10 @@ msg::DevicePose device_pose(std::uint64_t tick, const Eigen::Vector3d& position_
   pose.header().sim_time_ns(static_cast<std::int64_t>(tick) * 1000000);
   pose.device_id(1);
   pose.servo_tick(tick);
-  pose.world_from_stylus().position_m().x(position_m.x());
-  pose.world_from_stylus().position_m().y(position_m.y());
-  pose.world_from_stylus().position_m().z(position_m.z());
+  common::put(position_m, pose.world_from_stylus().position_m());
   const double half = 0.5 * pitch_deg * std::numbers::pi / 180.0;
-  pose.world_from_stylus().orientation().w(std::cos(half));
-  pose.world_from_stylus().orientation().x(0.0);
-  pose.world_from_stylus().orientation().y(0.0);
-  pose.world_from_stylus().orientation().z(std::sin(half));
+  common::put(Eigen::Quaterniond(std::cos(half), 0.0, 0.0, std::sin(half)),
+              pose.world_from_stylus().orientation());
   pose.renderable_force_n(renderable_force_n);
   pose.max_stiffness_npm(1480.0);
   return pose;

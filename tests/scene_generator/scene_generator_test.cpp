@@ -25,7 +25,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using fahr::scenegen::TetMesh;
+using fahr::scenegen::MeshedSolid;
 using fahr::scenegen::TriangleMesh;
 
 #ifndef FAHR_SCENE_GENERATOR
@@ -98,7 +98,7 @@ TEST_F(SceneGeneratorTest, CommittedFilesAreTheGeneratorOutput) {
 }
 
 TEST_F(SceneGeneratorTest, TetsHavePositiveVolumeAndBoundaryIsClosed) {
-  TetMesh tongue;
+  MeshedSolid tongue;
   std::string error;
   ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "tongue").string(), tongue, error)) << error;
   EXPECT_GE(tongue.tets.size(), 2000u);
@@ -171,7 +171,7 @@ TEST_F(SceneGeneratorTest, GeometryLibraryLoadsCleanSurfacesWithSignedFields) {
 }
 
 TEST_F(SceneGeneratorTest, TongueBoundaryIsCleanWithSignedField) {
-  TetMesh tongue;
+  MeshedSolid tongue;
   std::string error;
   ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "tongue").string(), tongue, error)) << error;
   // Only the nodes the boundary uses, so the surface has no stray vertices.
@@ -196,7 +196,7 @@ TEST_F(SceneGeneratorTest, TongueBoundaryIsCleanWithSignedField) {
 }
 
 TEST_F(SceneGeneratorTest, FixedNodesAreTongueNodes) {
-  TetMesh tongue;
+  MeshedSolid tongue;
   std::string error;
   ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "tongue").string(), tongue, error)) << error;
   std::ifstream file(*first_ / "tongue_fixed_nodes.txt");

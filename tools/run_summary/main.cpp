@@ -16,6 +16,7 @@
 
 #include "fahr/common/config_error.h"
 #include "fahr/common/subscriber.h"
+#include "fahr/common/wire_eigen.h"
 
 namespace {
 
@@ -48,7 +49,7 @@ struct Tally {
 };
 
 double norm(const msg::Vec3& v) {
-  return std::sqrt(v.x() * v.x() + v.y() * v.y() + v.z() * v.z());
+  return common::to_eigen(v).norm();
 }
 
 double median(std::vector<double> v) {

@@ -53,7 +53,7 @@ std::vector<View> views() {
   };
 }
 
-TriangleMesh tongue_surface(const fahr::scenegen::TetMesh& tet) {
+TriangleMesh tongue_surface(const fahr::scenegen::MeshedSolid& tet) {
   return {tet.nodes, tet.boundary};
 }
 
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
   if (out_dir.empty()) out_dir = mesh_dir;
 
   std::string error;
-  fahr::scenegen::TetMesh tongue;
+  fahr::scenegen::MeshedSolid tongue;
   if (!fahr::scenegen::read_tetgen(mesh_dir + "/tongue", tongue, error)) {
     std::fprintf(stderr, "fahr_scene_render: %s\n", error.c_str());
     return 1;

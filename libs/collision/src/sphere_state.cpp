@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "fahr/geometry/tet_deformation.h"
+
 namespace fahr::collision {
 namespace {
 
@@ -22,14 +24,6 @@ double six_volume(const geometry::Tet& t, const double* x) {
   const Eigen::Vector3d c = Eigen::Vector3d(x + 3 * t[2]) - a;
   const Eigen::Vector3d d = Eigen::Vector3d(x + 3 * t[3]) - a;
   return b.dot(c.cross(d));
-}
-
-// The edge matrix [x1 - x0, x2 - x0, x3 - x0] of a tet from flat positions.
-Eigen::Matrix3d edges(const geometry::Tet& t, const double* x) {
-  const Eigen::Vector3d a(x + 3 * t[0]);
-  Eigen::Matrix3d e;
-  for (int k = 0; k < 3; ++k) e.col(k) = Eigen::Vector3d(x + 3 * t[k + 1]) - a;
-  return e;
 }
 
 // The smallest singular value of F: the square root of the smallest
@@ -54,7 +48,7 @@ SphereState::SphereState(const sphere_layout::SphereLayout& layout,
   rest_inverse_.assign(tets.size(), Eigen::Matrix3d::Identity());
   smallest_stretch_.assign(tets.size(), 1.0);
   for (std::size_t t = 0; t < tets.size(); ++t) {
-    const Eigen::Matrix3d e = edges(tets[t], rest_positions_m.data());
+    const Eigen::Matrix3d e = geometry::edge_matrix(rest_positions_m.data(), tets[t]);
     if (!(std::abs(e.determinant()) > 0.0)) {
       throw std::invalid_argument("sphere state: tet " + std::to_string(t) + " is flat at rest");
     }
@@ -96,7 +90,8 @@ bool SphereState::update(const sphere_layout::SphereLayout& layout,
   const bool stretch_rule = !rest_inverse_.empty();
   if (stretch_rule) {
     for (std::size_t t = 0; t < tets.size(); ++t) {
-      smallest_stretch_[t] = smallest_singular_value(edges(tets[t], x) * rest_inverse_[t]);
+      smallest_stretch_[t] =
+          smallest_singular_value(geometry::deformation_gradient(x, tets[t], rest_inverse_[t]));
     }
   }
   for (std::size_t i = 0; i < layout.size(); ++i) {

@@ -99,7 +99,7 @@ void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Ma
   for (std::size_t e = 0; e < rest.size(); ++e) {
     // Rotated gradients r_a = R g_a give R K_ab R^T =
     // V (lambda r_a r_b^T + mu r_b r_a^T + mu (g_a . g_b) I).
-    const Eigen::Matrix<double, 3, 4>& g = rest.gradients[e];
+    const Eigen::Matrix<double, 3, 4> g = shape_gradients(rest.dm_inv[e]);
     const Eigen::Matrix<double, 3, 4> r = rotations[e] * g;
     double scale = stiffness_scale * rest.volume_m3[e];
     if (!element_scales.empty()) scale *= element_scales[e];

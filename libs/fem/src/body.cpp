@@ -7,6 +7,7 @@
 #include "fahr/fem/compression_stiffening.h"
 #include "fahr/fem/corotation.h"
 #include "fahr/fem/lumped_mass.h"
+#include "fahr/geometry/tet_deformation.h"
 
 namespace fahr::fem {
 
@@ -181,12 +182,7 @@ int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_en
   double* f = force_.data();
   for (std::size_t e = 0; e < rest_.size(); ++e) {
     const Tet& tet = rest_.tets[e];
-    const Eigen::Map<const Eigen::Vector3d> x0(x + 3 * std::size_t{tet[0]});
-    Eigen::Matrix3d ds;
-    ds.col(0) = Eigen::Map<const Eigen::Vector3d>(x + 3 * std::size_t{tet[1]}) - x0;
-    ds.col(1) = Eigen::Map<const Eigen::Vector3d>(x + 3 * std::size_t{tet[2]}) - x0;
-    ds.col(2) = Eigen::Map<const Eigen::Vector3d>(x + 3 * std::size_t{tet[3]}) - x0;
-    const Eigen::Matrix3d deformation = ds * rest_.dm_inv[e];
+    const Eigen::Matrix3d deformation = geometry::deformation_gradient(x, tet, rest_.dm_inv[e]);
     const Corotation corotation = rotation_from_deformation(deformation);
     inverted += corotation.inverted ? 1 : 0;
     const Eigen::Matrix3d& r = corotation.rotation;

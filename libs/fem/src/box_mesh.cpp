@@ -7,9 +7,9 @@
 
 namespace fahr::fem {
 
-TetMesh make_box_mesh(const std::array<int, 3>& cells, const Eigen::Vector3d& size_m,
-                      const Eigen::Vector3d& origin_m) {
-  TetMesh mesh;
+BodyMesh make_box_mesh(const std::array<int, 3>& cells, const Eigen::Vector3d& size_m,
+                       const Eigen::Vector3d& origin_m) {
+  BodyMesh mesh;
   const int nx = cells[0];
   const int ny = cells[1];
   const int nz = cells[2];

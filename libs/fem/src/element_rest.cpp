@@ -1,9 +1,11 @@
-// Rest data of linear tetrahedra: Dm^-1, shape function gradients, volume.
+// Rest data of linear tetrahedra: Dm^-1 and volume.
 #include "fahr/fem/element_rest.h"
 
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+
+#include "fahr/geometry/tet_deformation.h"
 
 namespace fahr::fem {
 namespace {
@@ -26,7 +28,6 @@ std::string build_element_rest(std::span<const Eigen::Vector3d> rest_positions_m
   rest = ElementRest{};
   rest.tets.assign(tets.begin(), tets.end());
   rest.dm_inv.resize(tets.size());
-  rest.gradients.resize(tets.size());
   rest.volume_m3.resize(tets.size());
   for (std::size_t e = 0; e < tets.size(); ++e) {
     std::array<Eigen::Vector3d, 4> x;
@@ -38,8 +39,7 @@ std::string build_element_rest(std::span<const Eigen::Vector3d> rest_positions_m
       x[a] = rest_positions_m[tets[e][a]];
       if (!x[a].allFinite()) return "node " + std::to_string(tets[e][a]) + " is not finite";
     }
-    Eigen::Matrix3d dm;
-    dm << x[1] - x[0], x[2] - x[0], x[3] - x[0];
+    const Eigen::Matrix3d dm = geometry::edge_matrix(x[0], x[1], x[2], x[3]);
     const double det = dm.determinant();
     const double edge = longest_edge(x);
     // Inverted (negative) or flat tets are rejected: the corotated force of
@@ -50,10 +50,6 @@ std::string build_element_rest(std::span<const Eigen::Vector3d> rest_positions_m
     }
     rest.volume_m3[e] = det / 6.0;
     rest.dm_inv[e] = dm.inverse();
-    // dN_a/dX for a = 1..3 are the rows of Dm^-1; N_0 = 1 - N_1 - N_2 - N_3.
-    Eigen::Matrix<double, 3, 4>& g = rest.gradients[e];
-    g.block<3, 3>(0, 1) = rest.dm_inv[e].transpose();
-    g.col(0) = -(g.col(1) + g.col(2) + g.col(3));
   }
   return {};
 }

@@ -1,7 +1,6 @@
 // TetMesh: validation, rest data, boundary faces and statistics, once at load.
 #include "fahr/geometry/tet_mesh.h"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -67,12 +66,7 @@ void TetMesh::compute_rest_data() {
       throw std::invalid_argument("tet " + std::to_string(t) + ": non-positive volume " +
                                   std::to_string(shape.volume_m3) + " m^3 (inverted or flat)");
     }
-    Eigen::Matrix3d dm;
-    dm.col(0) = x1 - x0;
-    dm.col(1) = x2 - x0;
-    dm.col(2) = x3 - x0;
     rest_data_[t].volume_m3 = shape.volume_m3;
-    rest_data_[t].dm_inverse = dm.inverse();  // det(Dm) = 6 V > 0, checked above
     for (Index n : tet) {
       used[n] = true;
     }

@@ -2,11 +2,13 @@
 #include "tet_links.h"
 
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <map>
 
 #include "fahr/geometry/closest_point.h"
+#include "fahr/geometry/tet_deformation.h"
 
 namespace fahr::sphere_layout::detail {
 namespace {
@@ -107,9 +109,15 @@ void TetLinker::candidates(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
       }
 }
 
-Eigen::Vector4d TetLinker::barycentric(std::uint32_t tet, const Eigen::Vector3d& p) const {
+Eigen::Matrix3d TetLinker::rest_edge_inverse(std::uint32_t tet) const {
   const auto& t = mesh_.tets()[tet];
-  const Eigen::Vector3d b = mesh_.rest_data()[tet].dm_inverse * (p - mesh_.rest_positions()[t[0]]);
+  const auto& x = mesh_.rest_positions();
+  return geometry::edge_matrix(x[t[0]], x[t[1]], x[t[2]], x[t[3]]).inverse();
+}
+
+Eigen::Vector4d TetLinker::barycentric(std::uint32_t tet, const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d b =
+      rest_edge_inverse(tet) * (p - mesh_.rest_positions()[mesh_.tets()[tet][0]]);
   return {1.0 - b.sum(), b.x(), b.y(), b.z()};
 }
 
@@ -173,7 +181,7 @@ SphereLink TetLinker::link(const Eigen::Vector3d& centre_m, double radius_m, dou
 
   // w = (1 - b) a' + b u reproduces c when a' holds c' = c + s (c - g), s = b / (1 - b).
   // a'(s) = a + s D (c - g) is linear in s: the largest s keeping a' >= 0.
-  const Eigen::Vector3d db3 = mesh_.rest_data()[hold_tet].dm_inverse * (c - g);
+  const Eigen::Vector3d db3 = rest_edge_inverse(hold_tet) * (c - g);
   const Eigen::Vector4d rate(-db3.sum(), db3.x(), db3.y(), db3.z());
   double s = weight_spread / (1.0 - weight_spread);
   for (int k = 0; k < 4; ++k) {

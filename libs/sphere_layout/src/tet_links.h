@@ -48,6 +48,8 @@ class TetLinker {
                            const Eigen::Vector3d& face_weights, double depth_factor);
 
  private:
+  // Dm^-1 of a tet at rest, computed when asked (set-up only; the mesh keeps none).
+  Eigen::Matrix3d rest_edge_inverse(std::uint32_t tet) const;
   Eigen::Vector4d barycentric(std::uint32_t tet, const Eigen::Vector3d& p) const;
   double distance_to_tet(std::uint32_t tet, const Eigen::Vector3d& p) const;
   // The positive weights (normalised to sum 1), their nodes and the centre they give at rest.

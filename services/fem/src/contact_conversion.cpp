@@ -3,12 +3,11 @@
 
 #include <algorithm>
 
+#include "fahr/common/wire_eigen.h"
+
 namespace fahr::fem_service {
-namespace {
-Eigen::Vector3d vec(const msg::Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-}  // namespace
+
+using common::to_eigen;
 
 void to_fem(const msg::ContactSet& wire, fem::ContactSet& out) {
   out.state_step = wire.fem_step();
@@ -23,18 +22,17 @@ void to_fem(const msg::ContactSet& wire, fem::ContactSet& out) {
     c.state = w.state() == msg::CONSTRAINT_ACTIVE   ? fem::ContactState::kActive
               : w.state() == msg::CONSTRAINT_FROZEN ? fem::ContactState::kFrozen
                                                     : fem::ContactState::kCandidate;
-    c.plane_point_m = vec(w.point_m());
-    c.normal = vec(w.normal());
-    c.hold_centre_m = vec(w.hold_centre_m());
+    c.plane_point_m = to_eigen(w.point_m());
+    c.normal = to_eigen(w.normal());
+    c.hold_centre_m = to_eigen(w.hold_centre_m());
     c.penetration_m = w.penetration_m();
     c.force_n = w.force_n();
   }
 }
 
 bool tool_pose(const msg::ContactSet& wire, Eigen::Isometry3d& world_from_tool) {
-  const auto& q = wire.world_from_tool().orientation();
-  const Eigen::Quaterniond orientation(q.w(), q.x(), q.y(), q.z());
-  const Eigen::Vector3d position = vec(wire.world_from_tool().position_m());
+  const Eigen::Quaterniond orientation = to_eigen(wire.world_from_tool().orientation());
+  const Eigen::Vector3d position = to_eigen(wire.world_from_tool().position_m());
   const double norm = orientation.norm();
   if (!(norm > 0.5 && norm < 2.0) || !position.allFinite())
     return false;  // NaN fails the range too

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "fahr/common/wire_eigen.h"
 #include "fahr/haptic_service/msg_conversion.h"
 
 namespace fahr::haptic_service {
@@ -112,9 +113,9 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
 contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   contact::DeviceSample d;
   d.pose_seq = pose.header().seq();
-  d.position_m = to_eigen(pose.world_from_stylus().position_m());
-  d.orientation = to_eigen(pose.world_from_stylus().orientation());
-  d.velocity_mps = to_eigen(pose.linear_velocity_mps());
+  d.position_m = common::to_eigen(pose.world_from_stylus().position_m());
+  d.orientation = common::to_unit_quaternion(pose.world_from_stylus().orientation());
+  d.velocity_mps = common::to_eigen(pose.linear_velocity_mps());
   d.renderable_force_n = std::max(0.0, pose.renderable_force_n());
   if (pose.max_stiffness_npm() > 0.0) d.max_stiffness_npm = pose.max_stiffness_npm();
   // The servo count gives the time since the last answered pose, whatever
@@ -336,9 +337,9 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   }
   // Where the FEM finds the tool: the proxy after this tick (the penalty
   // baseline's tool is the device).
-  put(setup_.penalty ? device.position_m : response_.proxy().position_m,
-      contacts.world_from_tool().position_m());
-  put(device.orientation, contacts.world_from_tool().orientation());
+  common::put(setup_.penalty ? device.position_m : response_.proxy().position_m,
+              contacts.world_from_tool().position_m());
+  common::put(device.orientation, contacts.world_from_tool().orientation());
   contacts.header().sim_step(pose.servo_tick());
   contacts.header().sim_time_ns(pose.header().sim_time_ns());
   ++tick_;

@@ -1,26 +1,13 @@
 // Wire conversions of the haptic service.
 #include "fahr/haptic_service/msg_conversion.h"
 
-#include <cmath>
+#include <algorithm>
+
+#include "fahr/common/wire_eigen.h"
 
 namespace fahr::haptic_service {
 
-Eigen::Quaterniond to_eigen(const msg::Quat& q) {
-  Eigen::Quaterniond out(q.w(), q.x(), q.y(), q.z());
-  const double norm = out.norm();
-  // A gateway that sent a zero or non-finite quaternion gets no rotation
-  // rather than a NaN pose in the collision query.
-  if (!(norm > 1e-9) || !std::isfinite(norm)) return Eigen::Quaterniond::Identity();
-  out.coeffs() /= norm;
-  return out;
-}
-
-void put(const Eigen::Quaterniond& q, msg::Quat& out) {
-  out.w(q.w());
-  out.x(q.x());
-  out.y(q.y());
-  out.z(q.z());
-}
+using common::put;
 
 void fill_command(const contact::ForceOutput& output, std::uint32_t device_id,
                   msg::ForceCommand& out) {
@@ -28,10 +15,7 @@ void fill_command(const contact::ForceOutput& output, std::uint32_t device_id,
   out.answered_pose_seq(output.answered_pose_seq);
   put(output.answered_position_m, out.answered_position_m());
   put(output.force_n, out.force_n());
-  auto& k = out.stiffness_npm().m();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) k[static_cast<std::size_t>(3 * r + c)] = output.stiffness_npm(r, c);
-  }
+  put(output.stiffness_npm, out.stiffness_npm());
   put(Eigen::Vector3d::Zero(), out.torque_nm());  // the rigid blade's torque is not computed yet
   put(output.proxy_position_m, out.world_from_proxy().position_m());
   put(output.proxy_orientation, out.world_from_proxy().orientation());

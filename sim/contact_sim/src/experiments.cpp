@@ -153,7 +153,7 @@ OvershootResult run_overshoot_experiment(Method method, double limit_n, double d
             phase = Phase::kHold;
             hold_until = k + 5000;
             result.deepest_device_y_m = device_y;
-            result.strain_at_3x = fem.max_strain();
+            result.strain_at_3x = fem.max_principal_green_strain();
           } else {
             device_y -= down * kDt;
           }
@@ -172,7 +172,7 @@ OvershootResult run_overshoot_experiment(Method method, double limit_n, double d
         result.max_reaction_n = std::max(result.max_reaction_n, rec.tissue_reaction_n);
         if (!seen_1x && commanded >= limit_n) {
           seen_1x = true;
-          result.strain_at_1x = fem.max_strain();
+          result.strain_at_1x = fem.max_principal_green_strain();
         }
         if (rec.lost_track) {
           ++result.lost_track_ticks;

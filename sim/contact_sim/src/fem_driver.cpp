@@ -2,9 +2,10 @@
 #include "fahr/contact/sim/fem_driver.h"
 
 #include <Eigen/Geometry>
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+
+#include "fahr/fem/strain.h"
 
 namespace fahr::contact::sim {
 
@@ -16,7 +17,7 @@ fem::SphereLinks make_node_spheres(std::span<const std::uint32_t> nodes, double 
 }
 
 std::unique_ptr<FemDriver> FemDriver::create(const FemDriverSettings& settings,
-                                             const fem::TetMesh& mesh,
+                                             const fem::BodyMesh& mesh,
                                              std::span<const std::uint32_t> fixed_nodes,
                                              fem::SphereLinks links,
                                              std::span<const std::uint32_t> compliance_spheres,
@@ -34,8 +35,6 @@ std::unique_ptr<FemDriver> FemDriver::create(const FemDriverSettings& settings,
     return nullptr;
   }
   driver->body_ = std::move(made.body);
-  error = fem::build_element_rest(mesh.nodes_m, mesh.tets, driver->rest_);
-  if (!error.empty()) return nullptr;
   driver->links_ = std::move(links);
   const std::size_t spheres = driver->links_.size();
   driver->radii_.resize(spheres);
@@ -103,39 +102,12 @@ double FemDriver::max_displacement_m() const {
   return largest;
 }
 
-namespace {
-
-Eigen::Matrix3d deformation_gradient(const fem::ElementRest& rest, std::size_t e, const double* x) {
-  const fem::Tet& tet = rest.tets[e];
-  const Eigen::Map<const Eigen::Vector3d> x0(x + 3 * std::size_t{tet[0]});
-  Eigen::Matrix3d ds;
-  for (Eigen::Index a = 0; a < 3; ++a) {
-    ds.col(a) = Eigen::Map<const Eigen::Vector3d>(
-                    x + 3 * std::size_t{tet[static_cast<std::size_t>(a + 1)]}) -
-                x0;
-  }
-  return ds * rest.dm_inv[e];
-}
-
-}  // namespace
-
-double FemDriver::max_strain() const {
-  double largest = 0.0;
-  const double* x = body_->positions_m().data();
-  for (std::size_t e = 0; e < rest_.size(); ++e) {
-    const Eigen::Matrix3d f = deformation_gradient(rest_, e, x);
-    const Eigen::Matrix3d green = 0.5 * (f.transpose() * f - Eigen::Matrix3d::Identity());
-    largest = std::max(largest, green.norm());
-  }
-  return largest;
+double FemDriver::max_principal_green_strain() const {
+  return fem::max_principal_green_strain(body_->element_rest(), body_->positions_m());
 }
 
 int FemDriver::inverted_now() const {
-  int inverted = 0;
-  const double* x = body_->positions_m().data();
-  for (std::size_t e = 0; e < rest_.size(); ++e)
-    inverted += deformation_gradient(rest_, e, x).determinant() <= 0.0;
-  return inverted;
+  return fem::inverted_element_count(body_->element_rest(), body_->positions_m());
 }
 
 }  // namespace fahr::contact::sim

@@ -165,7 +165,7 @@ double distance_to_surface(const TriangleMesh& mesh, const Vec3& p) {
   return std::sqrt(best);
 }
 
-TetQuality tet_quality(const TetMesh& mesh) {
+TetQuality tet_quality(const MeshedSolid& mesh) {
   TetQuality q;
   q.tet_count = static_cast<int>(mesh.tets.size());
   q.min_volume_mm3 = std::numeric_limits<double>::infinity();

@@ -51,7 +51,7 @@ bool read_obj(const std::string& path, TriangleMesh& mesh, std::string& error) {
   return true;
 }
 
-bool read_tetgen(const std::string& stem, TetMesh& mesh, std::string& error) {
+bool read_tetgen(const std::string& stem, MeshedSolid& mesh, std::string& error) {
   std::vector<std::string> node;
   std::vector<std::string> ele;
   std::vector<std::string> face;

@@ -51,7 +51,7 @@ TriangleMesh as_written(const TriangleMesh& mesh) {
   return rounded;
 }
 
-bool write_tetgen(const TetMesh& mesh, const std::string& stem, const std::string& header,
+bool write_tetgen(const MeshedSolid& mesh, const std::string& stem, const std::string& header,
                   std::string& error) {
   std::ostringstream node;
   write_header(node, header);

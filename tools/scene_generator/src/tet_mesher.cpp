@@ -120,7 +120,7 @@ void remove_nonmanifold_edges(std::vector<std::array<int, 4>>& tets) {
   }
 }
 
-bool tet_acceptable(const TetMesh& m, const std::array<int, 4>& t, double min_volume,
+bool tet_acceptable(const MeshedSolid& m, const std::array<int, 4>& t, double min_volume,
                     double min_dihedral) {
   const Vec3& a = m.nodes[t[0]];
   const Vec3& b = m.nodes[t[1]];
@@ -132,8 +132,8 @@ bool tet_acceptable(const TetMesh& m, const std::array<int, 4>& t, double min_vo
 
 }  // namespace
 
-TetMesh mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& settings,
-                            TetMesherReport& report) {
+MeshedSolid mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& settings,
+                                TetMesherReport& report) {
   const Grid grid = make_grid(shape, settings.cell_mm);
   report.grid_cells = grid.nx * grid.ny * grid.nz;
   auto tets = inside_tets(shape, grid);
@@ -144,7 +144,7 @@ TetMesh mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& s
   for (const auto& t : tets) {
     for (const int v : t) renumber[v] = 0;
   }
-  TetMesh mesh;
+  MeshedSolid mesh;
   for (auto& [grid_id, new_id] : renumber) {
     new_id = static_cast<int>(mesh.nodes.size());
     const int k = grid_id % (grid.nz + 1);

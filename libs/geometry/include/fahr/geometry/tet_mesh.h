@@ -1,7 +1,6 @@
 // The rest state of a tetrahedral body: rest positions, tets, outward
-// boundary faces, per-tet rest data for the FEM and quality statistics, all
-// computed once. Per-step state (deformed positions, velocities) lives with
-// whoever simulates the body, never here.
+// boundary faces, per-tet volumes and quality statistics, all computed once. Per-step state
+// (deformed positions, velocities) lives with whoever simulates the body, never here.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,12 +13,11 @@
 
 namespace fahr::geometry {
 
-// Rest data of one tet, computed once.
+// Rest data of one tet, computed once. No Dm^-1: the FEM keeps its own
+// (fem::ElementRest), and set-up code that needs one at rest takes
+// edge_matrix(...).inverse() (tet_deformation.h).
 struct TetRestData {
   double volume_m3 = 0.0;  // > 0
-  // Inverse of the rest shape matrix Dm = [x1 - x0, x2 - x0, x3 - x0] (1/m);
-  // the deformation gradient of a step is F = Ds * dm_inverse.
-  Eigen::Matrix3d dm_inverse = Eigen::Matrix3d::Zero();
 };
 
 // A boundary face, counter-clockwise seen from outside, and the tet it belongs to.

@@ -1,10 +1,9 @@
-// Wire (idl) <-> Eigen and library types of the haptic service. Writes into
-// preallocated samples: nothing allocates once sequences hold their
-// capacity (reserved at set-up).
+// Library types of the haptic service to the wire (idl); vectors and
+// quaternions go through fahr/common/wire_eigen.h. Writes into preallocated
+// samples: nothing allocates once sequences hold their capacity (reserved at
+// set-up).
 #pragma once
 
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 #include <cstdint>
 #include <span>
 
@@ -15,21 +14,6 @@
 #include "force_command.h"
 
 namespace fahr::haptic_service {
-
-inline Eigen::Vector3d to_eigen(const msg::Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-inline void put(const Eigen::Vector3d& v, msg::Vec3& out) {
-  out.x(v.x());
-  out.y(v.y());
-  out.z(v.z());
-}
-
-// Normalised; identity if the wire quaternion is degenerate.
-Eigen::Quaterniond to_eigen(const msg::Quat& q);
-
-void put(const Eigen::Quaterniond& q, msg::Quat& out);
 
 void fill_command(const contact::ForceOutput& output, std::uint32_t device_id,
                   msg::ForceCommand& out);

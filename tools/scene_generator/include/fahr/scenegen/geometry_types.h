@@ -1,6 +1,7 @@
 // Plain mesh containers shared by the scene generator, its renderer and its
-// test. Deliberately minimal: the real mesh types live in libs/geometry;
-// these only carry what the generator writes.
+// test. Deliberately minimal and apart from libs/ (the generator depends on
+// none of them; the loaded, validated mesh is geometry::TetMesh): these only
+// carry what the generator writes.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,10 +20,11 @@ struct TriangleMesh {
   std::vector<std::array<int, 3>> triangles;
 };
 
-// Tetrahedral mesh. Coordinates in millimetres; every tet (a, b, c, d) has
+// A solid meshed into tetrahedra, as the generator writes it (TetGen files).
+// Coordinates in millimetres; every tet (a, b, c, d) has
 // (b - a) . ((c - a) x (d - a)) > 0; `boundary` holds the outward-oriented
 // boundary triangles.
-struct TetMesh {
+struct MeshedSolid {
   std::vector<Vec3> nodes;
   std::vector<std::array<int, 4>> tets;
   std::vector<std::array<int, 3>> boundary;

@@ -10,7 +10,7 @@
 
 namespace fahr::scenegen {
 
-// Signed volume of a tet, positive for the orientation stated in TetMesh (mm^3).
+// Signed volume of a tet, positive for the orientation stated in MeshedSolid (mm^3).
 double tet_signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
 // Smallest of the six interior dihedral angles of a tet, in degrees.
@@ -57,7 +57,7 @@ struct TetQuality {
   double max_dihedral_deg = 0.0;
   int below_10_deg = 0;  // tets whose smallest dihedral is under 10 degrees
 };
-TetQuality tet_quality(const TetMesh& mesh);
+TetQuality tet_quality(const MeshedSolid& mesh);
 
 // Axis-aligned bounds of a point set.
 std::array<Vec3, 2> bounds(const std::vector<Vec3>& points);

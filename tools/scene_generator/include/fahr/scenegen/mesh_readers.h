@@ -10,6 +10,6 @@
 namespace fahr::scenegen {
 
 bool read_obj(const std::string& path, TriangleMesh& mesh, std::string& error);
-bool read_tetgen(const std::string& stem, TetMesh& mesh, std::string& error);
+bool read_tetgen(const std::string& stem, MeshedSolid& mesh, std::string& error);
 
 }  // namespace fahr::scenegen

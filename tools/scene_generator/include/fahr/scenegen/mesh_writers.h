@@ -12,7 +12,7 @@ namespace fahr::scenegen {
 
 // Writes <stem>.node, <stem>.ele and <stem>.face (0-based, mm). Returns false
 // and fills `error` (naming the file) when a file cannot be written.
-bool write_tetgen(const TetMesh& mesh, const std::string& stem, const std::string& header,
+bool write_tetgen(const MeshedSolid& mesh, const std::string& stem, const std::string& header,
                   std::string& error);
 
 bool write_obj(const TriangleMesh& mesh, const std::string& path, const std::string& header,

@@ -30,7 +30,7 @@ struct TetMesherReport {
   int nonmanifold_boundary_edges = 0;
 };
 
-TetMesh mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& settings,
-                            TetMesherReport& report);
+MeshedSolid mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& settings,
+                                TetMesherReport& report);
 
 }  // namespace fahr::scenegen

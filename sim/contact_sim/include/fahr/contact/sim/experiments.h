@@ -39,7 +39,8 @@ struct OvershootResult {
       0.0;  // largest K_c |x_d - p| (force-aware) or |k_p sum d n| (penalty), N
   double max_reaction_lost_n = 0.0;  // largest tissue reaction while lost track, N
   double max_reaction_n = 0.0;       // largest tissue reaction overall, N
-  double strain_at_1x = 0.0;         // max Green strain when the command first reached the limit
+  double strain_at_1x =
+      0.0;  // largest principal Green strain when the command first reached the limit
   double strain_at_3x = 0.0;         // ... when it reached 3x (or the deepest point)
   double max_gap_error_m = 0.0;      // | |gap| - (F_cmd - L)/K_c - L/K_c | while lost track, m
   double max_reengage_step_n = 0.0;  // largest |dF| per tick within 50 ms of re-engagement, N

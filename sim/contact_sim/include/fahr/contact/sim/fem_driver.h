@@ -45,7 +45,7 @@ class FemDriver {
   // compliance_spheres: the candidate spheres whose W is published (<= the
   // body's max_compliance_spheres). Returns null and sets `error` on failure.
   static std::unique_ptr<FemDriver> create(const FemDriverSettings& settings,
-                                           const fem::TetMesh& mesh,
+                                           const fem::BodyMesh& mesh,
                                            std::span<const std::uint32_t> fixed_nodes,
                                            fem::SphereLinks links,
                                            std::span<const std::uint32_t> compliance_spheres,
@@ -75,8 +75,8 @@ class FemDriver {
 
   // Largest node displacement from rest, m.
   double max_displacement_m() const;
-  // Largest Green strain norm |(F^T F - I)/2|_F over the tets.
-  double max_strain() const;
+  // Largest principal Green strain over the tets (fem/strain.h).
+  double max_principal_green_strain() const;
   // Count of tets with det F <= 0 now.
   int inverted_now() const;
 
@@ -88,7 +88,6 @@ class FemDriver {
   std::unique_ptr<fem::Body> body_;
   fem::SphereLinks links_;
   std::unique_ptr<fem::ContactStep> contact_step_;
-  fem::ElementRest rest_;
   std::vector<Eigen::Vector3d> free_centres_, centres_;
   std::vector<double> radii_;
   std::vector<std::int32_t> compliance_index_;

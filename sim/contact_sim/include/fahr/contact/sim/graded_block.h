@@ -22,7 +22,7 @@ struct GradedBlockSpec {
 };
 
 struct BlockScene {
-  fem::TetMesh mesh;
+  fem::BodyMesh mesh;
   std::vector<std::uint32_t> fixed_nodes;  // the bottom face
   std::vector<std::uint32_t> top_nodes;    // the top face (y = 0)
 };
