@@ -94,7 +94,6 @@ class ContactStep {
   // Allocates: call at set-up.
   void set_obstacles(std::span<const ObstacleField* const> fields,
                      const ObstacleProjectionSettings& settings = {});
-  bool has_obstacles() const { return obstacles_ != nullptr; }
 
   // Experimental: the tool as an obstacle the whole body is kept out of,
   // beside the ContactSet's spheres (which carry the force). The ContactSet

@@ -120,14 +120,11 @@ class ObstacleProjection {
   int nodes_returned() const { return nodes_returned_; }
   int nodes_beyond() const { return nodes_beyond_; }
 
-  // Nodes moved since begin_step().
-  int nodes_moved() const { return nodes_moved_; }
   // Whether `node` was moved since begin_step(), and the outward unit normal
   // of the obstacle that moved it last (where it put the node).
   bool moved(std::size_t node) const { return moved_[node] != 0; }
   const Eigen::Vector3d& move_normal(std::size_t node) const { return move_normal_[node]; }
   std::size_t node_count() const { return moved_.size(); }
-  std::size_t field_count() const { return fields_.size(); }
   const ObstacleProjectionSettings& settings() const { return settings_; }
 
  private:

@@ -49,8 +49,6 @@ class ServiceStep {
   // spent beyond a bone, left alone by it (fem obstacle_projection.h).
   std::uint64_t anatomy_returned() const { return anatomy_returned_; }
   std::uint64_t anatomy_beyond_steps() const { return anatomy_beyond_steps_; }
-  // Deepest a node went into the anatomy before the step moved it out, m.
-  double anatomy_depth_max_m() const { return anatomy_depth_max_m_; }
 
   // The service's own ServiceStatus metrics.
   void metrics(std::vector<std::pair<std::string, double>>& out) const;

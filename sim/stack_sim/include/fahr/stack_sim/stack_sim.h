@@ -90,7 +90,6 @@ class StackSim {
   const msg::DevicePose& pose() const { return pose_; }
   const msg::ForceCommand& command() const { return command_; }
   const msg::ContactSet& contacts() const { return contacts_; }
-  const msg::DeformationState& fem_state() const { return fem_->state(); }
   bool fem_stepped() const { return fem_stepped_; }  // in the last step
 
   const fem::Body& body() const { return *fem_setup_.body; }
