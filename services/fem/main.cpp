@@ -104,11 +104,6 @@ int run(int argc, char** argv) {
   CLI::App app{"fahr FEM deformation service"};
   runtime::ServiceOptions options;
   runtime::add_service_options(app, options);
-  bool tool_obstacle = false;
-  app.add_flag("--tool-obstacle", tool_obstacle,
-               "experimental: keep the whole body out of the tool at the ContactSet's tool pose, "
-               "not only the "
-               "set's spheres (services/fem contact_step.h set_tool_obstacle)");
   CLI11_PARSE(app, argc, argv);
   runtime::pin_to_cpus(options.cpus);
 
@@ -130,7 +125,6 @@ int run(int argc, char** argv) {
 
   common::install_stop_handlers();
   FemBodySetup setup = set_up_body(*scene, scene->bodies[plan.fem_bodies.front()]);
-  if (tool_obstacle) setup.tool = load_tool_field(*scene);
   ServiceStep fem_step(setup);
   common::Participant participant(
       runtime::transport_for(*scene, options.dds, options.domain, options.profile, "fem"));

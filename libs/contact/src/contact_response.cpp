@@ -397,7 +397,7 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
     report_.tissue_held_by_load =
         held == HeldProxy::kHoldLoad &&
         (state_ == TrackingState::kLostTrack || report_.tissue_force_scaled_held);
-  } else if (settings_.mode != ResponseMode::kNaive && held != HeldProxy::kUnclamped &&
+  } else if (settings_.mode != ResponseMode::kNaive &&
              solved_reaction > kWedgeBand * device.renderable_force_n) {
     tissue_force_scale_ = device.renderable_force_n / solved_reaction;
     report_.tissue_force_clamped = true;

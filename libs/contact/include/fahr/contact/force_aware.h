@@ -16,14 +16,11 @@ enum class TrackingState : std::uint8_t {
 };
 
 enum class HeldProxy : std::uint8_t {
-  // Backs off along the reaction until the reaction is the limit
-  // (ContactResponse::yield_to_limit): the tissue's reaction is the limit,
-  // the proxy drifts from where it froze.
-  kBackOff,
-  // Stays where it froze (the paper: the proxy stops); the tissue forces
-  // sent to the FEM are scaled so that their resultant is the limit, and
-  // the spheres stay frozen (the FEM holds them where each step finds
-  // them). The published gap is then the hand's pull past the limit.
+  // Stays where it froze (the paper's positional hold: the proxy stops,
+  // c' = c); the tissue forces sent to the FEM are scaled so that their
+  // resultant is the limit, and the spheres stay frozen (the FEM holds them
+  // where each step finds them). The published gap is then the hand's pull
+  // past the limit. A scene choice (contact.held_proxy: stay).
   kStay,
   // The default. Stays where it froze (the published gap is then exactly
   // the hand's pull past the proxy), and the tissue is held by a load, not
@@ -35,12 +32,13 @@ enum class HeldProxy : std::uint8_t {
   // grew under them). It releases, and holds again while catching up, on
   // the hand's pull along the push it froze with, never backs off, and
   // keeps the load scaled and force only while catching up past the limit
-  // (tools/overshoot_bench/README.md, "A proxy held by its load").
+  // (bench/overshoot/README.md, "A proxy held by its load").
   kHoldLoad,
-  // A diagnostic, not a response: stays, and the tissue gets whatever the
-  // pinned solve asks, unclamped, so a bench can see whether the frozen
-  // hold is steady by itself.
-  kUnclamped,
+  // Retired, kept for the overshoot bench's comparison only (bench-only:
+  // stack_sim::Experiments::back_off_held_proxy): backs off along the
+  // reaction until the reaction is the limit (ContactResponse::
+  // yield_to_limit); the proxy drifts from where it froze.
+  kBackOff,
 };
 
 struct ForceAwareSettings {

@@ -82,15 +82,6 @@ struct ObstacleProjectionSettings {
   // until it is home, m (> 0). A node sliding over a bone's ridge has a
   // chord only the ridge's sagitta deep (3 mm over a 5 mm radius: 0.23 mm).
   double beyond_depth_m = 1e-3;
-  // false: a node whose path enters the margin stops where it enters (as if
-  // the bone held it fast). true: the rest of its path slides along the
-  // surface (frictionless). Stopped, a node whose path clips a bone's corner
-  // by micrometres can stay put for seconds; sliding, the tongue recovers
-  // from an overshoot with fewer tets left inverted, but at 100 kPa its
-  // strain grew under the held blade (tools/overshoot_bench/README.md,
-  // "Frozen spheres held where the step found them"). Off until that is
-  // settled.
-  bool slide_after_entry = false;
 };
 
 class ObstacleProjection {

@@ -60,11 +60,6 @@ class ServiceStep {
   fem::ContactStep contact_step_;
   fem::ContactSet contacts_;
   bool have_contacts_ = false;
-  // The newest ContactSet's tool pose (setup.tool): where the step puts the
-  // tool obstacle, and where it was at the last step.
-  bool have_tool_pose_ = false;
-  Eigen::Isometry3d world_from_tool_ = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d world_from_tool_at_last_step_ = Eigen::Isometry3d::Identity();
   std::uint64_t applied_contact_seq_ = 0;
   msg::DeformationState state_;
   fem::StepReport last_report_;
