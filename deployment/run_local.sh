@@ -8,12 +8,10 @@
 #                           [--duration-s S] [--scene FILE] [--script intubation|overshoot]
 #                           [--dds-gateway V] [--dds-fem V] [--dds-haptic V]
 #                           [--mode realtime|lockstep] [--haptic-collision aist|triangle]
-#                           [--fem-tool-obstacle] [--cpus-fem LIST] [--cpus-haptic LIST]
+#                           [--cpus-fem LIST] [--cpus-haptic LIST]
 #
 # --haptic-collision triangle: the haptic service finds the blade's contacts
 # with the tongue by the triangle-level baseline instead of the AIST.
-# --fem-tool-obstacle: the FEM service keeps the whole tongue out of the
-# tool at the ContactSet's tool pose (experimental; services/fem/README.md).
 # --cpus-fem / --cpus-haptic: run that service on these CPUs only (its
 # --cpus, libs/runtime cpu_pinning.h), e.g. --cpus-fem 1 --cpus-haptic 0
 # keeps the FEM's steps off the core the haptic tick runs on.
@@ -60,7 +58,6 @@ while [ $# -gt 0 ]; do
     --dds-haptic) dds_haptic="$2"; shift 2 ;;
     --mode) mode="$2"; shift 2 ;;
     --haptic-collision) haptic_collision="$2"; shift 2 ;;
-    --fem-tool-obstacle) fem_extra+=(--tool-obstacle); shift ;;
     --cpus-fem) fem_extra+=(--cpus "$2"); shift 2 ;;
     --cpus-haptic) haptic_extra+=(--cpus "$2"); shift 2 ;;
     -h|--help) sed -n '2,30p' "$0"; exit 0 ;;

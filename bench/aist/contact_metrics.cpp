@@ -205,10 +205,6 @@ double ContactMetrics::recall_deeper() const {
              : 1.0;
 }
 
-double ContactMetrics::depth_error_p99_m() const {
-  return percentile(aist_depth_error_m_, 99);
-}
-
 void ContactMetrics::print() const {
   auto ratio = [](std::size_t a, std::size_t b) {
     return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 100.0;

@@ -26,7 +26,6 @@ class ContactMetrics {
   double recall_deeper() const;
   double recall_near()
       const;  // counting candidate spheres too  // over verified contacts deeper than kDeeperM
-  double depth_error_p99_m() const;
 
   // Baseline contacts shallower than this are also counted apart: the sphere
   // union may lie up to the coverage (about 0.4 mm) inside the surface, so a

@@ -323,7 +323,7 @@ int main(int argc, char** argv) {
         return 2;
       }
       stack_sim::StackOptions options;
-      if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
+      if (support_ratio >= 0.0) options.experiments.fem_support_ratio = support_ratio;
       run.sim = std::make_unique<stack_sim::StackSim>(scene, options);
       run.shadow.setup = std::make_unique<fem_service::FemBodySetup>(
           fem_service::set_up_body(*scene, *run.sim->fem().setup().scene_body));

@@ -6,24 +6,16 @@
 // force-aware response and the penalty baseline on the same script.
 //
 //   fahr_overshoot_bench [--scene FILE] [--factor 3] [--response both|force-aware|penalty]
-//                        [--fem-anatomy on|off] [--fem-support RATIO] [--youngs-pa E] [--tool-stops
-//                        on|off]
-//                        [--stiffening C20/C10]
-//                        [--sphere-spread service|mass|translation] [--frozen-target
-//                        service|step-start|hold-centre]
-//                        [--fem-anatomy-slide]
-//                        [--trace FILE] [--check]
+//                        [--youngs-pa E] [--tool-stops scene|on|off] [--stiffening C20/C10]
+//                        [--volume-floor R] [--w-normals N] [--held-proxy load|stay|limit]
+//                        [--fem-anatomy on|off] [--fem-support RATIO] [--fem-anatomy-rounds N]
+//                        [--candidate-margin-mm M] [--trace FILE] [--tick-trace FILE] [--check]
 //
-// --fem-anatomy off: the FEM leaves the anatomy to the haptic side's
-// obstacle contacts (as before the FEM kept its own nodes out of bone).
-// --sphere-spread: how the FEM shares a tool contact's correction among the
-// sphere's nodes (libs/fem projection.h), instead of the service's choice.
-// --frozen-target: where the FEM holds a frozen sphere (projection.h
-// FrozenTarget): its centre at the step's start (the service's) or the
-// haptic side's hold centre (before).
-// --fem-anatomy-slide: the FEM's anatomy pass slides a node along the bone
-// after its path enters the margin instead of stopping it there
-// (libs/fem obstacle_projection.h slide_after_entry).
+// --youngs-pa, --tool-stops, --stiffening, --volume-floor, --w-normals and
+// --held-proxy load|stay change the scene's keys. --held-proxy limit,
+// --fem-anatomy off, --fem-support, --fem-anatomy-rounds and
+// --candidate-margin-mm rerun a comparison against a choice the services do
+// not offer (stack_sim::Experiments; docs/design/retired-modes.md).
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
 // (libs/fem compression_stiffening.h; 0: off), instead of the scene's.
 // --trace: one CSV line per FEM step of each run (FILE with the response's
@@ -244,14 +236,9 @@ struct RunChoices {
   double youngs_pa = 0.0;       // 0: the scene's
   double stiffening = -1.0;     // < 0: the scene's
   std::string tool_stops = "scene";
-  std::string spread = "service";
-  std::string frozen_target = "service";
-  bool fem_anatomy_slide = false;
   int fem_anatomy_rounds = 0;  // 0: the FEM's
-  std::string held_proxy = "load";
-  bool fem_tool_obstacle = false;
+  std::string held_proxy = "scene";
   double candidate_margin_mm = -1.0;
-  std::string row_compliance = "scene";
   int w_normals = 0;
   double volume_floor = -1.0;  // < 0: the scene's
   std::string trace_path;
@@ -273,13 +260,14 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   const double youngs_pa = choices.youngs_pa;
   const double stiffening = choices.stiffening;
   const std::string& tool_stops = choices.tool_stops;
-  const std::string& spread = choices.spread;
   const std::string& trace_path = choices.trace_path;
   const std::string& tick_trace_path = choices.tick_trace_path;
   auto variant = std::make_shared<scene::Scene>(*scene);
   variant->contact.response =
       penalty ? scene::ContactResponse::kPenalty : scene::ContactResponse::kForceAware;
   if (tool_stops != "scene") variant->contact.tool_stops_at_anatomy = tool_stops == "on";
+  if (choices.held_proxy == "load") variant->contact.held_proxy = scene::HeldProxy::kLoad;
+  if (choices.held_proxy == "stay") variant->contact.held_proxy = scene::HeldProxy::kStay;
   if (youngs_pa > 0.0) {
     for (auto& body : variant->bodies) {
       if (body.deformable) body.deformable->material.youngs_modulus_pa = youngs_pa;
@@ -299,24 +287,13 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   stack_sim::StackOptions options;
   options.script = device::Script::kOvershoot;
   options.overshoot_factor = factor;
-  options.fem_anatomy = choices.fem_anatomy;
-  if (choices.support_ratio >= 0.0) options.fem_support_ratio = choices.support_ratio;
-  if (choices.held_proxy == "limit") options.held_proxy = contact::HeldProxy::kBackOff;
-  if (choices.held_proxy == "stay") options.held_proxy = contact::HeldProxy::kStay;
-  if (choices.held_proxy == "fixed") options.held_proxy = contact::HeldProxy::kUnclamped;
-  if (choices.held_proxy == "load") options.held_proxy = contact::HeldProxy::kHoldLoad;
-  options.fem_tool_obstacle = choices.fem_tool_obstacle;
+  stack_sim::Experiments& experiments = options.experiments;
+  experiments.haptic_side_anatomy = !choices.fem_anatomy;
+  if (choices.support_ratio >= 0.0) experiments.fem_support_ratio = choices.support_ratio;
+  experiments.back_off_held_proxy = choices.held_proxy == "limit";
   if (choices.candidate_margin_mm >= 0.0)
-    options.candidate_margin_m = 1e-3 * choices.candidate_margin_mm;
-  if (choices.row_compliance != "scene")
-    options.row_compliance = haptic_service::row_compliance_named(choices.row_compliance);
-  if (spread == "mass") options.sphere_spread = fem::SphereSpread::kMassWeighted;
-  if (spread == "translation") options.sphere_spread = fem::SphereSpread::kTranslation;
-  if (choices.frozen_target == "step-start") options.frozen_target = fem::FrozenTarget::kStepStart;
-  if (choices.frozen_target == "hold-centre")
-    options.frozen_target = fem::FrozenTarget::kHoldCentre;
-  options.fem_anatomy_slide = choices.fem_anatomy_slide;
-  options.fem_anatomy_rounds = choices.fem_anatomy_rounds;
+    experiments.candidate_margin_m = 1e-3 * choices.candidate_margin_mm;
+  experiments.fem_anatomy_rounds = choices.fem_anatomy_rounds;
   stack_sim::StackSim sim(variant, options);
   Result r;
   r.name = penalty ? "penalty" : "force-aware";
@@ -501,22 +478,11 @@ int main(int argc, char** argv) {
   std::string response = "both";
   std::string fem_anatomy = "on";
   app.add_option("--scene", scene_path, "scene file");
-  app.add_option("--sphere-spread", choices.spread,
-                 "how the FEM spreads a sphere's correction (default: the service's)")
-      ->check(CLI::IsMember({"service", "mass", "translation"}));
-  app.add_option("--frozen-target", choices.frozen_target,
-                 "where the FEM holds a frozen sphere: its centre at the step's start or the "
-                 "haptic side's hold centre "
-                 "(default: the service's)")
-      ->check(CLI::IsMember({"service", "step-start", "hold-centre"}));
   app.add_option("--volume-floor", choices.volume_floor,
                  "no tet ends a FEM step below this share of its rest volume "
                  "(solver.volume_floor_ratio); 0: off "
                  "(default: the scene's)")
       ->check(CLI::Range(0.0, 0.9));
-  app.add_flag(
-      "--fem-anatomy-slide", choices.fem_anatomy_slide,
-      "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
   app.add_option(
          "--fem-anatomy-rounds", choices.fem_anatomy_rounds,
          "the FEM's tool/anatomy alternation rounds per step (libs/fem obstacle_projection.h "
@@ -524,7 +490,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1000));
   app.add_option("--response", response, "which response to run")
       ->check(CLI::IsMember({"both", "force-aware", "penalty"}));
-  app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")
+  app.add_option("--fem-anatomy", fem_anatomy,
+                 "the FEM keeps its nodes out of the anatomy itself; off: the haptic side finds "
+                 "the tongue's obstacle contacts (a comparison)")
       ->check(CLI::IsMember({"on", "off"}));
   app.add_option(
          "--fem-support", choices.support_ratio,
@@ -547,28 +515,15 @@ int main(int argc, char** argv) {
                  "overshoot: the hand's pull as a multiple of the device's peak force")
       ->check(CLI::Range(1.0, 10.0));
   app.add_option("--held-proxy", choices.held_proxy,
-                 "while the device has lost track: limit (back off to keep the tissue within the "
-                 "limit), stay "
-                 "(stay where it froze, tissue forces scaled to the limit), load (stay, the tissue "
-                 "held by that load alone, "
-                 "force only) or fixed (a diagnostic: stay, tissue "
-                 "forces unclamped)")
-      ->check(CLI::IsMember({"limit", "stay", "load", "fixed"}));
+                 "while the device has lost track: load (stay, the tissue held by the limited "
+                 "load, force only) or stay (stay, the spheres frozen: the paper's c' = c), the "
+                 "scene's contact.held_proxy; limit (a comparison: back off to keep the tissue "
+                 "at the limit); default the scene's")
+      ->check(CLI::IsMember({"scene", "load", "stay", "limit"}));
   app.add_option("--candidate-margin-mm", choices.candidate_margin_mm,
                  "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; "
                  "default the service's 1")
       ->check(CLI::Range(0.0, 5.0));
-  app.add_flag("--fem-tool-obstacle", choices.fem_tool_obstacle,
-               "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose, "
-               "not only the "
-               "ContactSet's spheres (libs/fem contact_step.h set_tool_obstacle)");
-  app.add_option("--row-compliance", choices.row_compliance,
-                 "experimental: which rows get W when the blade touches more spheres than the FEM "
-                 "sends W for: "
-                 "scene (its solver.compliance_columns decides), deepest, keep or free "
-                 "(services/haptic haptic_setup.h "
-                 "RowCompliance)")
-      ->check(CLI::IsMember({"scene", "deepest", "keep", "free"}));
   app.add_option("--w-normals", choices.w_normals,
                  "W along the normals for this many spheres (the scene's "
                  "solver.compliance_columns: normals and "

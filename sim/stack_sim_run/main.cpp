@@ -5,10 +5,7 @@
 // Equal hashes show that the in-process run is the distributed one.
 //
 //   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
-//                      [--fem-anatomy on|off] [--fem-support RATIO] [--stiffening C20/C10]
-//                      [--fem-tool-obstacle] [--fem-anatomy-slide] [--w-normals N]
-//                      [--row-compliance scene|deepest|keep|free]
-//                      [--seconds 4]
+//                      [--stiffening C20/C10] [--volume-floor R] [--w-normals N] [--seconds 4]
 //
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
 // (libs/fem compression_stiffening.h; 0: off), instead of the scene's.
@@ -36,15 +33,6 @@ int main(int argc, char** argv) {
   app.add_option("--script", script, "the simulated hand's script")
       ->check(CLI::IsMember({"intubation", "overshoot"}));
   std::string collision = "aist";
-  std::string fem_anatomy = "on";
-  double support_ratio = -1.0;
-  app.add_option(
-         "--fem-support", support_ratio,
-         "the FEM's anatomy support springs, stiffness over the node's diagonal of A; 0: off "
-         "(default: the service's)")
-      ->check(CLI::Range(0.0, 1e6));
-  app.add_option("--fem-anatomy", fem_anatomy, "the FEM keeps its nodes out of the anatomy itself")
-      ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--collision", collision, "the haptic service's collision method")
       ->check(CLI::IsMember({"aist", "triangle"}));
   double stiffening = -1.0;
@@ -57,35 +45,11 @@ int main(int argc, char** argv) {
                  "(solver.volume_floor_ratio); 0: off "
                  "(default: the scene's)")
       ->check(CLI::Range(0.0, 0.9));
-  bool fem_anatomy_slide = false;
-  app.add_flag(
-      "--fem-anatomy-slide", fem_anatomy_slide,
-      "the FEM's anatomy pass slides a node along the bone after its path enters the margin");
-  int fem_anatomy_rounds = 0;
-  app.add_option(
-         "--fem-anatomy-rounds", fem_anatomy_rounds,
-         "the FEM's tool/anatomy alternation rounds per step (libs/fem obstacle_projection.h "
-         "max_rounds); default the FEM's")
-      ->check(CLI::Range(1, 1000));
-  bool fem_tool_obstacle = false;
-  app.add_flag("--fem-tool-obstacle", fem_tool_obstacle,
-               "experimental: the FEM keeps the whole tongue out of the tool at the proxy's pose");
-  std::string row_compliance = "scene";
-  app.add_option("--row-compliance", row_compliance,
-                 "which rows the haptic tick keeps: scene (its solver.compliance_columns decides), "
-                 "deepest, keep or "
-                 "free (services/haptic haptic_setup.h RowCompliance)")
-      ->check(CLI::IsMember({"scene", "deepest", "keep", "free"}));
   int w_normals = 0;
   app.add_option("--w-normals", w_normals,
                  "W along the normals for this many spheres (solver.compliance_columns: normals, "
                  "max_candidate_contacts); 0: the scene's")
       ->check(CLI::Range(0, 64));
-  double candidate_margin_mm = -1.0;
-  app.add_option("--candidate-margin-mm", candidate_margin_mm,
-                 "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; "
-                 "default the service's 1")
-      ->check(CLI::Range(0.0, 5.0));
   app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -93,14 +57,6 @@ int main(int argc, char** argv) {
     stack_sim::StackOptions options;
     options.script =
         script == "overshoot" ? device::Script::kOvershoot : device::Script::kIntubation;
-    options.fem_anatomy = fem_anatomy == "on";
-    if (support_ratio >= 0.0) options.fem_support_ratio = support_ratio;
-    options.fem_tool_obstacle = fem_tool_obstacle;
-    options.fem_anatomy_slide = fem_anatomy_slide;
-    options.fem_anatomy_rounds = fem_anatomy_rounds;
-    if (candidate_margin_mm >= 0.0) options.candidate_margin_m = 1e-3 * candidate_margin_mm;
-    if (row_compliance != "scene")
-      options.row_compliance = haptic_service::row_compliance_named(row_compliance);
     options.collision = collision == "triangle" ? haptic_service::CollisionMethod::kTriangle
                                                 : haptic_service::CollisionMethod::kAist;
     auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));

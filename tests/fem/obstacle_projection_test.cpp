@@ -310,25 +310,20 @@ TEST(ObstacleProjection, ANodeBeyondAThickBoneIsLeftAloneUntilHome) {
   EXPECT_NEAR(x[4], 3e-3 + kMargin, 1e-9);
 }
 
-TEST(ObstacleProjection, SlidingAfterEntryKeepsTheMotionAlongTheSurface) {
+TEST(ObstacleProjection, APathStopsWhereItEntersTheMargin) {
   // A path from 1 mm above the floor to 1 mm below it, 3 mm along x: it
-  // enters the margin at x = 1.2 mm. Stopped there by default; sliding, it
-  // goes on along the floor to x = 3 mm at the margin.
+  // enters the margin at x = 1.2 mm and stops there.
   const Floor floor(0.0);
   const ObstacleField* fields[] = {&floor};
   const std::vector<double> start = {0.0, 1e-3, 0.0};
   const std::vector<double> inverse_mass = {1.0};
-  for (const bool slide : {false, true}) {
-    ObstacleProjectionSettings settings;
-    settings.slide_after_entry = slide;
-    ObstacleProjection projection(fields, 1, settings);
-    std::vector<double> x = {3e-3, -1e-3, 0.0};
-    projection.begin_step();
-    ProjectionReport report;
-    projection.project(x, inverse_mass, report, start);
-    EXPECT_NEAR(x[0], slide ? 3e-3 : 1.2e-3, 1e-8) << slide;
-    EXPECT_NEAR(x[1], kMargin, 1e-8) << slide;
-  }
+  ObstacleProjection projection(fields, 1);
+  std::vector<double> x = {3e-3, -1e-3, 0.0};
+  projection.begin_step();
+  ProjectionReport report;
+  projection.project(x, inverse_mass, report, start);
+  EXPECT_NEAR(x[0], 1.2e-3, 1e-8);
+  EXPECT_NEAR(x[1], kMargin, 1e-8);
 }
 
 TEST(ObstacleProjection, FarNodesAreNotSampledEveryStep) {

@@ -133,7 +133,7 @@ TEST(Tongue, StepsStablyUnderGravity) {
 }
 
 TEST(Tongue, PressedByALaryngoscopeAndReleased) {
-  // Eight frozen contacts on the top of the tongue are pushed 10 mm down in
+  // Eight tool contacts on the top of the tongue are pushed 10 mm down in
   // 0.5 s (a blade pressing), held, then the contact set stops (the trainee
   // lifts the blade). The lagged direct solve must stay finite and
   // uninverted, refactorise on rotation, and let the tongue spring back.
@@ -148,8 +148,6 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
   settings.time_step = std::chrono::milliseconds(10);
   settings.solver.refactor_period = 0;  // refactorise on 0.1 rad of rotation
   settings.sleep.enabled = false;
-  // The press is driven through the frozen holds' centres.
-  settings.projection.frozen_target = FrozenTarget::kHoldCentre;
   auto made = Body::create(settings, mesh.nodes_m, mesh.tets, tongue_base(mesh));
   ASSERT_EQ(made.error, "");
   Body& body = *made.body;
@@ -184,7 +182,8 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
     ASSERT_EQ(links.add_sphere(near, w, 0.002), "");
     Contact contact;
     contact.sphere_id = static_cast<std::uint32_t>(s);
-    contact.state = ContactState::kFrozen;
+    contact.state = ContactState::kActive;
+    contact.normal = -Eigen::Vector3d::UnitY();  // the tool presses from above
     set.contacts.push_back(contact);
   }
   std::vector<Eigen::Vector3d> start;
@@ -193,8 +192,9 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
   int inverted_while_pressed = 0;
   for (int k = 0; k < 100; ++k) {
     const double depth = 0.010 * std::min(1.0, (k + 1) / 50.0);
+    // (c - q) . n >= r: each centre at least `depth` below where it started.
     for (std::uint32_t s = 0; s < 8; ++s)
-      set.contacts[s].hold_centre_m = start[s] - Eigen::Vector3d(0, depth, 0);
+      set.contacts[s].plane_point_m = start[s] - Eigen::Vector3d(0, depth - links.radius_m(s), 0);
     set.state_step = body.step_index();
     const StepReport report = body.step(&set, &links);
     refactorisations += report.refactorised ? 1 : 0;
@@ -202,8 +202,8 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
     inverted_while_pressed = std::max(inverted_while_pressed, report.inverted_elements);
   }
   for (std::uint32_t s = 0; s < 8; ++s) {
-    EXPECT_NEAR((links.centre(s, body.positions_m().data()) - set.contacts[s].hold_centre_m).norm(),
-                0.0, 1e-6);
+    const double pressed_to = start[s].y() - 0.010;
+    EXPECT_NEAR(links.centre(s, body.positions_m().data()).y(), pressed_to, 1e-6);
   }
   const double pressed = test::max_displacement(body);
   StepReport last;

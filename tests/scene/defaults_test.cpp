@@ -76,6 +76,7 @@ TEST(SceneDefaults, MinimalSceneGetsEveryDefault) {
   EXPECT_EQ(scene->contact.deformable_obstacle_margin_m, kDefaultDeformableObstacleMarginM);
   EXPECT_TRUE(scene->contact.include_pairs.empty());
   EXPECT_TRUE(scene->contact.tool_stops_at_anatomy);
+  EXPECT_EQ(scene->contact.held_proxy, HeldProxy::kLoad);
   EXPECT_TRUE(scene->qos.empty());
 }
 
@@ -140,7 +141,7 @@ TEST(SceneDefaults, ExplicitSettingsAreRead) {
             "  compliance: lagged\n  compliance_columns: normals\n  max_contact_age_ms: 2.5\n"
             "  volume_floor_ratio: 0.6\n"
             "contact:\n  response: penalty\n  coupling_stiffness_npm: 250\n  "
-            "tool_stops_at_anatomy: false\n"
+            "tool_stops_at_anatomy: false\n  held_proxy: stay\n"
             "dds:\n  vendor: fastdds\n  domain_id: 42\n"
             "qos:\n  DevicePose: {deadline_ms: 2, reliability: best_effort}\n"
             "  ContactSet:\n    history_depth: 4\n");
@@ -159,6 +160,7 @@ TEST(SceneDefaults, ExplicitSettingsAreRead) {
   EXPECT_EQ(scene->contact.response, ContactResponse::kPenalty);
   EXPECT_EQ(scene->contact.coupling_stiffness_npm, 250.0);
   EXPECT_FALSE(scene->contact.tool_stops_at_anatomy);
+  EXPECT_EQ(scene->contact.held_proxy, HeldProxy::kStay);
   EXPECT_EQ(scene->dds.vendor, DdsVendor::kFastDds);
   EXPECT_EQ(scene->dds.domain_id, 42);
   ASSERT_EQ(scene->qos.size(), 2u);

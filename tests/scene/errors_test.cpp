@@ -106,6 +106,8 @@ TEST(SceneErrors, UnknownEnumerationValuesListTheValidOnes) {
                    "openhaptics"});
   expect_contains(error_of(std::string(kMinimalScene) + "solver:\n  compliance_columns: rows\n"),
                   {"solver.compliance_columns: 'rows' is not one of: blocks, normals"});
+  expect_contains(error_of(std::string(kMinimalScene) + "contact:\n  held_proxy: back_off\n"),
+                  {"contact.held_proxy: 'back_off' is not one of: load, stay"});
   expect_contains(error_of(std::string(kMinimalScene) + "solver:\n  volume_floor_ratio: 1.2\n"),
                   {"solver.volume_floor_ratio: value 1.2 is out of range; valid: [0, 0.9]"});
 }

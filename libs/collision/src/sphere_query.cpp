@@ -191,336 +191,408 @@ bool narrow_phase(const Grid& field, const Eigen::Vector3d* hint, double margin,
   return depth > -margin;
 }
 
-}  // namespace
+// One query of a tree against a body: the constants its bounds need, the
+// leaf in hand, the deepest contacts kept so far and the figures.
+// query_spheres() makes one and walks the tree with it, all of it
+// (walk_all) or deepest first (walk_deepest).
+class Query {
+ public:
+  Query(const SphereTree& tree, const RigidBody& body, const QuerySettings& settings,
+        PrePenetrationMemory& memory, std::uint64_t query, ContactBuffer& out) noexcept;
 
-QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const RigidBody& body,
-                         const QuerySettings& settings, PrePenetrationMemory& memory,
-                         ContactBuffer& out) noexcept {
-  QueryStats stats;
-  const auto& nodes = tree.nodes();
-  if (nodes.empty() || tree.order().empty() || body.sdf == nullptr) return stats;
-  const geometry::SignedDistanceField& sdf = *body.sdf;
+  // Every contact: a depth-first walk of the nodes whose bound passes.
+  QueryStats walk_all() noexcept;
+  // The deepest settings.deepest_only contacts: a best-first walk that
+  // stops once no node left can hold a deeper one.
+  QueryStats walk_deepest() noexcept;
+
+ private:
+  bool on_grid(const Eigen::Vector3d& p) const noexcept {
+    return (p.array() >= grid_low_.array()).all() && (p.array() <= grid_high_.array()).all();
+  }
+  Eigen::Vector3d node_middle(const SphereTreeNode& node) const noexcept {
+    return frame_.to_body(0.5 * (node.box_min_m + node.box_max_m));
+  }
+  double bound_at(const SphereTreeNode& node, const Eigen::Vector3d& middle) const noexcept;
+  double node_bound(const SphereTreeNode& node) const noexcept {
+    return bound_at(node, node_middle(node));
+  }
+  void note_depth(double depth) noexcept;
+  std::size_t load_leaf(const SphereTreeNode& node) noexcept;
+  void bound_leaf(const SphereTreeNode& node, std::size_t count) noexcept;
+  void remember_leaf(const SphereTreeNode& node, double bound) noexcept;
+  void test_leaf(const SphereTreeNode& node) noexcept;
+  void test_sphere(std::uint32_t sphere, std::uint32_t slot, const Eigen::Vector3d& p) noexcept;
+  void push_deferred(std::uint32_t sphere, std::uint32_t slot, double r, double grid) noexcept;
+
+  const SphereTree& tree_;
+  const std::vector<SphereTreeNode>& nodes_;
+  const std::vector<Eigen::Vector4d>& slots_;
+  const std::vector<std::uint32_t>& order_;
+  const RigidBody& body_;
+  const QuerySettings& settings_;
+  PrePenetrationMemory& memory_;
+  ContactBuffer& out_;
+  const std::uint64_t query_;
+  const geometry::SignedDistanceField& sdf_;
   // The broad phase and the leaf test read the copy in both narrow phases;
-  // the exact one still searches the triangles (and near the surface asks the
-  // field itself), so its contacts do not change.
-  const FieldGrid* copy = body.grid != nullptr && !body.grid->empty() ? body.grid : nullptr;
-  const double grid_error =
-      kGridErrorCells * sdf.cell_size_m() + (copy != nullptr ? copy->storage_error_m() : 0.0);
-  const Grid field{sdf, copy, grid_error};
-  const Eigen::Isometry3d body_from_world = body.world_from_body.inverse();
-  const Frame frame{body_from_world.linear(), body_from_world.translation()};
-  const Eigen::Matrix3d world_rotation = body.world_from_body.linear();
-  const std::uint64_t query = memory.next_query();
-  const auto& slots = tree.slot_spheres();
-  const auto& order = tree.order();
+  // the exact one still searches the triangles (and near the surface asks
+  // the field itself), so its contacts do not change.
+  const FieldGrid* copy_;
+  const Grid field_;
+  const Frame frame_;
+  const Eigen::Matrix3d world_rotation_;
   // With a FieldGrid and the grid narrow phase one read gives the value
   // and, only for the spheres that reach the narrow phase, the gradient.
-  const bool one_read = copy != nullptr && !settings.exact_narrow_phase;
-  const bool defer = one_read && settings.defer_outside_contacts;
-  if (slots.size() != state.centres_m().size()) return stats;  // a tree of another layout
-
+  const bool one_read_;
+  const bool defer_;
   // The grid's interpolant is L-Lipschitz, L = sqrt(3) (1 + 2 e / h) + 1:
   // each axis's slope is a blend of edge differences of exact distances,
   // each within a cell plus twice the storage error e; beyond the grid the
-  // clamp adds slope 1. The sphere floors below
-  // (PrePenetrationMemory::remember) use it.
-  // Between two points both on the grid (a box, so the segment is too) the
-  // clamp's slope does not enter: L = sqrt(3) (1 + 2 e / h).
-  const double storage_error = copy != nullptr ? copy->storage_error_m() : 0.0;
-  const double lipschitz_on_grid = std::sqrt(3.0) * (1.0 + 2.0 * storage_error / sdf.cell_size_m());
-  const double lipschitz = lipschitz_on_grid + 1.0;
+  // clamp adds slope 1. The sphere floors (PrePenetrationMemory::remember)
+  // use it. Between two points both on the grid (a box, so the segment is
+  // too) the clamp's slope does not enter: L = sqrt(3) (1 + 2 e / h).
+  double lipschitz_on_grid_ = 0.0;
+  double lipschitz_ = 0.0;
   // What a decision taken from the grid (or a floor of it) must leave for
   // the grid's error. The exact narrow phase decides on the true distance,
   // within grid_error of the grid. The grid narrow phase's contacts are the
   // grid's own values (a contact is r - grid > -margin): a floor of the grid
   // decides them with nothing to spare.
-  const double decision_error = settings.exact_narrow_phase ? grid_error : 0.0;
-
-  // Lower bound of the grid value at any point of a node's spheres (grown by
-  // the skin and the candidate margin), m. On the grid: the grid at the box's
-  // middle less the node's reach (a distance is 1-Lipschitz), less the grid's
-  // error twice (the grid is within it of the distance at the middle and at
-  // the sphere). Off the grid the field extends its border value by the
-  // distance to the border, which can exceed the distance; there the bound is
-  // the distance to the surface's box, which the grid surrounds by at least
-  // the exact band plus two cells (SignedDistanceField), less one error.
-  const Eigen::Vector3d grid_low = sdf.grid_origin_m();
-  const Eigen::Vector3d grid_high =
-      grid_low +
-      sdf.cell_size_m() * (sdf.grid_dimensions() - Eigen::Vector3i::Ones()).cast<double>();
-  const Eigen::Vector3d inset = Eigen::Vector3d::Constant(sdf.band_m() + 2.0 * sdf.cell_size_m());
-  const Eigen::Vector3d surface_low = grid_low + inset;
-  const Eigen::Vector3d surface_high = grid_high - inset;
-  auto on_grid = [&](const Eigen::Vector3d& p) noexcept {
-    return (p.array() >= grid_low.array()).all() && (p.array() <= grid_high.array()).all();
-  };
-  auto node_middle = [&](const SphereTreeNode& node) noexcept {
-    return frame.to_body(0.5 * (node.box_min_m + node.box_max_m));
-  };
-  auto bound_at = [&](const SphereTreeNode& node, const Eigen::Vector3d& middle) noexcept {
-    const double reach = node.reach_m + settings.contact_skin_m + settings.candidate_margin_m;
-    if (on_grid(middle)) return field.distance(middle) - 2.0 * grid_error - reach;
-    const double to_surface_box =
-        (middle - middle.cwiseMax(surface_low).cwiseMin(surface_high)).norm();
-    return to_surface_box - grid_error - reach;  // a NaN pose gives NaN: the caller prunes it
-  };
-  auto node_bound = [&](const SphereTreeNode& node) noexcept {
-    return bound_at(node, node_middle(node));
-  };
+  double decision_error_ = 0.0;
+  // The grid's box, and the surface's box inside it (bound_at).
+  Eigen::Vector3d grid_low_, grid_high_, surface_low_, surface_high_;
   // The deepest k contacts found so far, as a min-heap of depths (deepest_only).
-  const std::size_t keep = std::min(settings.deepest_only, kMaxDeepest);
-  std::array<double, kMaxDeepest> kept_depths;
-  std::size_t kept = 0;
+  const std::size_t keep_;
+  std::array<double, kMaxDeepest> kept_depths_;
+  std::size_t kept_ = 0;
+  // The spheres of the leaf in hand, in the body frame, and the new floor of
+  // a sphere whose read is skipped (else NaN).
+  std::array<Eigen::Vector3d, SphereTree::kLeafSize> leaf_body_;
+  std::array<double, SphereTree::kLeafSize> leaf_floor_;
+  QueryStats stats_;
+};
+
+// The grid's error: kGridErrorCells of a cell, plus the copy's storage error.
+double grid_error_m(const geometry::SignedDistanceField& sdf, const FieldGrid* copy) noexcept {
+  return kGridErrorCells * sdf.cell_size_m() + (copy != nullptr ? copy->storage_error_m() : 0.0);
+}
+
+const FieldGrid* usable_copy(const RigidBody& body) noexcept {
+  return body.grid != nullptr && !body.grid->empty() ? body.grid : nullptr;
+}
+
+Frame frame_of(const RigidBody& body) noexcept {
+  const Eigen::Isometry3d body_from_world = body.world_from_body.inverse();
+  return Frame{body_from_world.linear(), body_from_world.translation()};
+}
+
+Query::Query(const SphereTree& tree, const RigidBody& body, const QuerySettings& settings,
+             PrePenetrationMemory& memory, std::uint64_t query, ContactBuffer& out) noexcept
+    : tree_(tree),
+      nodes_(tree.nodes()),
+      slots_(tree.slot_spheres()),
+      order_(tree.order()),
+      body_(body),
+      settings_(settings),
+      memory_(memory),
+      out_(out),
+      query_(query),
+      sdf_(*body.sdf),
+      copy_(usable_copy(body)),
+      field_{sdf_, copy_, grid_error_m(sdf_, copy_)},
+      frame_(frame_of(body)),
+      world_rotation_(body.world_from_body.linear()),
+      one_read_(copy_ != nullptr && !settings.exact_narrow_phase),
+      defer_(one_read_ && settings.defer_outside_contacts),
+      keep_(std::min(settings.deepest_only, kMaxDeepest)) {
+  const double storage_error = copy_ != nullptr ? copy_->storage_error_m() : 0.0;
+  lipschitz_on_grid_ = std::sqrt(3.0) * (1.0 + 2.0 * storage_error / sdf_.cell_size_m());
+  lipschitz_ = lipschitz_on_grid_ + 1.0;
+  decision_error_ = settings.exact_narrow_phase ? field_.error_m : 0.0;
+  grid_low_ = sdf_.grid_origin_m();
+  grid_high_ = grid_low_ + sdf_.cell_size_m() *
+                               (sdf_.grid_dimensions() - Eigen::Vector3i::Ones()).cast<double>();
+  const Eigen::Vector3d inset = Eigen::Vector3d::Constant(sdf_.band_m() + 2.0 * sdf_.cell_size_m());
+  surface_low_ = grid_low_ + inset;
+  surface_high_ = grid_high_ - inset;
+}
+
+// Lower bound of the grid value at any point of a node's spheres (grown by
+// the skin and the candidate margin), m. On the grid: the grid at the box's
+// middle less the node's reach (a distance is 1-Lipschitz), less the grid's
+// error twice (the grid is within it of the distance at the middle and at
+// the sphere). Off the grid the field extends its border value by the
+// distance to the border, which can exceed the distance; there the bound is
+// the distance to the surface's box, which the grid surrounds by at least
+// the exact band plus two cells (SignedDistanceField), less one error.
+double Query::bound_at(const SphereTreeNode& node, const Eigen::Vector3d& middle) const noexcept {
+  const double reach = node.reach_m + settings_.contact_skin_m + settings_.candidate_margin_m;
+  if (on_grid(middle)) return field_.distance(middle) - 2.0 * field_.error_m - reach;
+  const double to_surface_box =
+      (middle - middle.cwiseMax(surface_low_).cwiseMin(surface_high_)).norm();
+  return to_surface_box - field_.error_m - reach;  // a NaN pose gives NaN: the caller prunes it
+}
+
+void Query::note_depth(double depth) noexcept {
+  if (keep_ == 0) return;
   const auto deeper_first = [](double a, double b) { return a > b; };  // min-heap
-  auto note_depth = [&](double depth) noexcept {
-    if (keep == 0) return;
-    if (kept < keep) {
-      kept_depths[kept++] = depth;
-      std::push_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept),
-                     deeper_first);
-    } else if (depth > kept_depths[0]) {
-      std::pop_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept),
-                    deeper_first);
-      kept_depths[kept - 1] = depth;
-      std::push_heap(kept_depths.begin(), kept_depths.begin() + static_cast<std::ptrdiff_t>(kept),
-                     deeper_first);
-    }
-  };
-  // Every sphere of a leaf in the body frame first, each one's grid cell
-  // asked for at once: with the grid cold (the haptic tick after a FEM step
-  // in one process, or after other processes), the 16 reads overlap instead
-  // of waiting on memory one after another (aist_bench replay --evict-kb
-  // 65536: -25 % median; warm, with the lines in cache, it costs ~10 %).
-  std::array<Eigen::Vector3d, SphereTree::kLeafSize> leaf_body;
-  auto load_leaf = [&](const SphereTreeNode& node) noexcept {
-    const auto count =
-        static_cast<std::size_t>(std::min<std::int32_t>(node.count, SphereTree::kLeafSize));
-    for (std::size_t k = 0; k < count; ++k) {
-      leaf_body[k] = frame.to_body(slots[static_cast<std::size_t>(node.first) + k].head<3>());
-    }
-    return count;
-  };
-  // The grid read at a sphere decides first whether grid - decision_error >
-  // r + candidate margin (then it is only remembered). Its memory's floor of
-  // the grid at the centre it last remembered decides that without the
-  // read when floor - L |p - centre| is still beyond it. No square root unless
-  // the read is skipped: the new floor needs it.
-  std::array<double, SphereTree::kLeafSize>
-      leaf_floor;  // new floor of a sphere whose read is skipped, else NaN
-  auto bound_leaf = [&](const SphereTreeNode& node, std::size_t count) noexcept {
-    for (std::size_t k = 0; k < count; ++k) {
-      const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
-      const double r = slots[slot][3] + settings.contact_skin_m;
-      const double spare =
-          memory.grid_floor_m(slot) - decision_error - r - settings.candidate_margin_m;
-      const Eigen::Vector3d& last = memory.last_centre_body_m(slot);
-      const double moved_squared = (leaf_body[k] - last).squaredNorm();
-      const double slope = on_grid(leaf_body[k]) && on_grid(last) ? lipschitz_on_grid : lipschitz;
-      if (spare > 0.0 && spare * spare > slope * slope * moved_squared) {
-        leaf_floor[k] = memory.grid_floor_m(slot) - slope * std::sqrt(moved_squared);
-      } else {
-        leaf_floor[k] = std::numeric_limits<double>::quiet_NaN();
-        if (copy != nullptr) copy->prefetch(leaf_body[k]);
-      }
-    }
-  };
-  // A leaf whose bound proves every centre outside, with its margin to
-  // spare: each sphere would pass the leaf test's first check (grid -
-  // decision_error > r + candidate margin) and only be remembered, so it is
-  // remembered without its grid read (and its cells are not prefetched:
-  // lines nobody reads only evict others). The same memory and contacts as testing it.
-  // The floor it leaves: the grid at a sphere is at least the bound + r +
-  // candidate margin (|c - middle| + r <= reach, the bound's derivation).
-  auto remember_leaf = [&](const SphereTreeNode& node, double bound) noexcept {
-    const std::size_t count = load_leaf(node);
-    for (std::size_t k = 0; k < count; ++k) {
-      const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
-      const double r = slots[slot][3] + settings.contact_skin_m;
-      memory.remember(slot, leaf_body[k], query, bound + r + settings.candidate_margin_m);
-    }
-    stats.spheres_remembered += static_cast<std::uint32_t>(count);
-  };
-  auto test_leaf = [&](const SphereTreeNode& node) noexcept {
-    // The floors are read before any grid cell can be asked for: their lines
-    // are asked for at once, so a cold leaf waits on memory once, not once
-    // per line. (The stack walk asked for them already, when the leaf
-    // passed its bound; asking before the bound was read was slower: most
-    // leaves whose bound is read are pruned.)
-    memory.prefetch_leaf(static_cast<std::uint32_t>(node.first),
-                         static_cast<std::uint32_t>(node.count));
-    const std::size_t count = load_leaf(node);
-    bound_leaf(node, count);
-    for (std::size_t k = 0; k < count; ++k) {
-      const std::uint32_t sphere = order[static_cast<std::size_t>(node.first) + k];
-      // The memory is kept by slot (leaf order): read in sequence, not at random.
-      const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
-      const Eigen::Vector3d& p = leaf_body[k];
-      const double r = slots[slot][3] + settings.contact_skin_m;
-      if (!std::isnan(leaf_floor[k])) {
-        // The read would find grid - error > r + margin: remembered, as then.
-        memory.remember(slot, p, query, leaf_floor[k]);
-        ++stats.spheres_bounded;
-        continue;
-      }
-      ++stats.spheres_tested;
-      FieldGrid::Read cell;
-      if (one_read) cell = copy->read(p);
-      const double grid = one_read ? cell.value : field.distance(p);
-      if (grid - decision_error > r + settings.candidate_margin_m) {
-        memory.remember(slot, p, query, grid);  // outside: grid - error > r > 0
-        continue;
-      }
-      // The grid narrow phase's distance is this read: with the centre
-      // outside and the depth r - grid not within the candidate margin, the
-      // narrow phase would only remember the centre and report nothing. Its
-      // normal (a square root and three divisions) is not worked out for that.
-      if (!settings.exact_narrow_phase && grid > 0.0 &&
-          !(r - grid > -settings.candidate_margin_m)) {
-        memory.remember(slot, p, query, grid);
-        continue;
-      }
-      ++stats.exact_queries;
-      if (defer && grid > 0.0) {
-        // Outside and within the candidate margin (the test above): the
-        // narrow phase's depth is r - grid; the rest waits for
-        // complete_deferred(), which only the kept contacts reach.
-        memory.remember(slot, p, query, grid);
-        ++stats.contacts;
-        SphereContact contact;
-        contact.sphere_id = sphere;
-        contact.body_id = body.id;
-        contact.depth_m = r - grid;
-        contact.candidate = contact.depth_m <= 0.0;
-        contact.deferred = true;
-        contact.slot = slot;
-        if (!out.push(contact)) stats.overflowed = true;
-        note_depth(contact.depth_m);
-        continue;
-      }
-      Eigen::Vector3d last_nearest;
-      // Only the exact search uses the hint: the grid narrow phase does not read it.
-      const Eigen::Vector3d* hint =
-          settings.exact_narrow_phase && memory.recall_nearest(slot, last_nearest) ? &last_nearest
-                                                                                   : nullptr;
-      const geometry::SdfSample s = one_read ? from_gradient(p, grid, copy->gradient(cell))
-                                             : sample(field, p, grid, settings, hint);
-      if (s.distance_m > 0.0) memory.remember(slot, p, query, grid);
-      if (!(s.distance_m > 0.0)) ++stats.spheres_inside;
-      if (s.exact) memory.remember_nearest(slot, s.closest_point_m);
-      Eigen::Vector3d q, n;
-      double depth = 0.0;
-      bool no_history = false;
-      if (!narrow_phase(field, hint, settings.candidate_margin_m, p, r, s, settings, memory, slot,
-                        query, q, n, depth, no_history)) {
-        continue;
-      }
-      ++stats.contacts;
-      SphereContact contact;
-      contact.sphere_id = sphere;
-      contact.body_id = body.id;
-      contact.point_m = body.world_from_body * q;
-      contact.normal = world_rotation * n;
-      contact.depth_m = depth;
-      contact.normal_without_history = no_history;
-      contact.candidate = depth <= 0.0;
-      contact.slot = slot;
-      probe_surface(tree, slot, settings.surface_probe, contact);
-      if (!out.push(contact)) stats.overflowed = true;
-      note_depth(depth);
-    }
-  };
-
-  if (keep == 0) {
-    // A node's bound is worked out when its parent passes, both children's
-    // at once: their grid cells are asked for together, and a child that
-    // passes has its own children's boxes (or, a leaf, its spheres and
-    // memory) asked for when it is pushed, long before it is popped. On a
-    // cold cache the walk otherwise waits on a box, then on its grid cell,
-    // node after node. The nodes that pass are popped in the same order
-    // (right child first) as when each bound was read at its pop.
-    struct Pending {
-      std::int32_t node;
-      double bound_m;
-    };
-    std::array<Pending, SphereTree::kMaxDepth + 1> stack{};
-    int top = 0;
-    auto passes = [&](double bound) noexcept {
-      return bound <= settings.approach_margin_m;
-    };  // NaN: pruned
-    auto push = [&](std::int32_t index, double bound) noexcept {
-      const SphereTreeNode& node = nodes[static_cast<std::size_t>(index)];
-      if (node.count == 0) {
-        // Both children share two lines.
-        __builtin_prefetch(&nodes[static_cast<std::size_t>(node.first)]);
-        __builtin_prefetch(&nodes[static_cast<std::size_t>(node.first) + 1]);
-      } else {
-        const auto first = static_cast<std::size_t>(node.first);
-        const std::size_t end =
-            std::min(slots.size(), first + static_cast<std::size_t>(node.count));
-        for (std::size_t slot = first; slot < end; slot += 2) __builtin_prefetch(&slots[slot]);
-        memory.prefetch_leaf(static_cast<std::uint32_t>(node.first),
-                             static_cast<std::uint32_t>(node.count));
-      }
-      stack[top++] = {index, bound};
-    };
-    ++stats.nodes_visited;
-    const double root_bound = node_bound(nodes[0]);
-    if (!passes(root_bound)) {
-      stats.body_skipped = true;
-      return stats;
-    }
-    push(0, root_bound);
-    while (top > 0) {
-      const Pending next = stack[--top];
-      const SphereTreeNode& node = nodes[static_cast<std::size_t>(next.node)];
-      if (node.count == 0) {
-        const SphereTreeNode& left = nodes[static_cast<std::size_t>(node.first)];
-        const SphereTreeNode& right = nodes[static_cast<std::size_t>(node.first) + 1];
-        const Eigen::Vector3d left_middle = node_middle(left);
-        const Eigen::Vector3d right_middle = node_middle(right);
-        if (copy != nullptr) {
-          copy->prefetch(left_middle);
-          copy->prefetch(right_middle);
-        }
-        const double left_bound = bound_at(left, left_middle);
-        const double right_bound = bound_at(right, right_middle);
-        stats.nodes_visited += 2;
-        if (passes(left_bound)) push(node.first, left_bound);
-        if (passes(right_bound)) push(node.first + 1, right_bound);
-        continue;
-      }
-      // bound - decision_error > 0: every centre is outside by more than its
-      // radius, the skin and the candidate margin plus the sphere test's own
-      // error (none in the grid narrow phase).
-      if (next.bound_m - decision_error > kDecisionSlackM) {
-        remember_leaf(node, next.bound_m);
-      } else {
-        test_leaf(node);
-      }
-    }
-    return stats;
+  const auto first = kept_depths_.begin();
+  if (kept_ < keep_) {
+    kept_depths_[kept_++] = depth;
+    std::push_heap(first, first + static_cast<std::ptrdiff_t>(kept_), deeper_first);
+  } else if (depth > kept_depths_[0]) {
+    std::pop_heap(first, first + static_cast<std::ptrdiff_t>(kept_), deeper_first);
+    kept_depths_[kept_ - 1] = depth;
+    std::push_heap(first, first + static_cast<std::ptrdiff_t>(kept_), deeper_first);
   }
+}
 
-  // Deepest first: the frontier is a heap on the bound (the smallest, i.e.
-  // the deepest a sphere in it can be, on top). A sphere of a node with bound
-  // b reads at most -b - margin deep: its depth r + skin - grid(c) is at most
-  // reach + skin - grid(middle) + 2 grid error, as |c - middle| + r <= reach.
-  std::vector<PrePenetrationMemory::Frontier>& frontier = memory.frontier();
+// Every sphere of a leaf in the body frame first, each one's grid cell
+// asked for at once (bound_leaf): with the grid cold (the haptic tick after
+// a FEM step in one process, or after other processes), the 16 reads
+// overlap instead of waiting on memory one after another (aist_bench replay
+// --evict-kb 65536: -25 % median; warm, with the lines in cache, it costs
+// ~10 %).
+std::size_t Query::load_leaf(const SphereTreeNode& node) noexcept {
+  const auto count =
+      static_cast<std::size_t>(std::min<std::int32_t>(node.count, SphereTree::kLeafSize));
+  for (std::size_t k = 0; k < count; ++k) {
+    leaf_body_[k] = frame_.to_body(slots_[static_cast<std::size_t>(node.first) + k].head<3>());
+  }
+  return count;
+}
+
+// The grid read at a sphere decides first whether grid - decision_error >
+// r + candidate margin (then it is only remembered). Its memory's floor of
+// the grid at the centre it last remembered decides that without the read
+// when floor - L |p - centre| is still beyond it. No square root unless the
+// read is skipped: the new floor needs it.
+void Query::bound_leaf(const SphereTreeNode& node, std::size_t count) noexcept {
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
+    const double r = slots_[slot][3] + settings_.contact_skin_m;
+    const double spare =
+        memory_.grid_floor_m(slot) - decision_error_ - r - settings_.candidate_margin_m;
+    const Eigen::Vector3d& last = memory_.last_centre_body_m(slot);
+    const double moved_squared = (leaf_body_[k] - last).squaredNorm();
+    const double slope = on_grid(leaf_body_[k]) && on_grid(last) ? lipschitz_on_grid_ : lipschitz_;
+    if (spare > 0.0 && spare * spare > slope * slope * moved_squared) {
+      leaf_floor_[k] = memory_.grid_floor_m(slot) - slope * std::sqrt(moved_squared);
+    } else {
+      leaf_floor_[k] = std::numeric_limits<double>::quiet_NaN();
+      if (copy_ != nullptr) copy_->prefetch(leaf_body_[k]);
+    }
+  }
+}
+
+// A leaf whose bound proves every centre outside, with its margin to spare:
+// each sphere would pass the leaf test's first check (grid - decision_error
+// > r + candidate margin) and only be remembered, so it is remembered
+// without its grid read (and its cells are not prefetched: lines nobody
+// reads only evict others). The same memory and contacts as testing it.
+// The floor it leaves: the grid at a sphere is at least the bound + r +
+// candidate margin (|c - middle| + r <= reach, the bound's derivation).
+void Query::remember_leaf(const SphereTreeNode& node, double bound) noexcept {
+  const std::size_t count = load_leaf(node);
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
+    const double r = slots_[slot][3] + settings_.contact_skin_m;
+    memory_.remember(slot, leaf_body_[k], query_, bound + r + settings_.candidate_margin_m);
+  }
+  stats_.spheres_remembered += static_cast<std::uint32_t>(count);
+}
+
+void Query::test_leaf(const SphereTreeNode& node) noexcept {
+  // The floors are read before any grid cell can be asked for: their lines
+  // are asked for at once, so a cold leaf waits on memory once, not once
+  // per line. (The stack walk asked for them already, when the leaf passed
+  // its bound; asking before the bound was read was slower: most leaves
+  // whose bound is read are pruned.)
+  memory_.prefetch_leaf(static_cast<std::uint32_t>(node.first),
+                        static_cast<std::uint32_t>(node.count));
+  const std::size_t count = load_leaf(node);
+  bound_leaf(node, count);
+  for (std::size_t k = 0; k < count; ++k) {
+    // The memory is kept by slot (leaf order): read in sequence, not at random.
+    const auto slot = static_cast<std::uint32_t>(node.first) + static_cast<std::uint32_t>(k);
+    if (!std::isnan(leaf_floor_[k])) {
+      // The read would find grid - error > r + margin: remembered, as then.
+      memory_.remember(slot, leaf_body_[k], query_, leaf_floor_[k]);
+      ++stats_.spheres_bounded;
+      continue;
+    }
+    test_sphere(order_[static_cast<std::size_t>(node.first) + k], slot, leaf_body_[k]);
+  }
+}
+
+// A sphere outside and within the candidate margin, with deferral on: the
+// narrow phase's depth is r - grid; the rest waits for complete_deferred(),
+// which only the kept contacts reach.
+void Query::push_deferred(std::uint32_t sphere, std::uint32_t slot, double r,
+                          double grid) noexcept {
+  ++stats_.contacts;
+  SphereContact contact;
+  contact.sphere_id = sphere;
+  contact.body_id = body_.id;
+  contact.depth_m = r - grid;
+  contact.candidate = contact.depth_m <= 0.0;
+  contact.deferred = true;
+  contact.slot = slot;
+  if (!out_.push(contact)) stats_.overflowed = true;
+  note_depth(contact.depth_m);
+}
+
+// One sphere whose floor did not decide it: the grid read, then (near the
+// surface) the narrow phase and its contact.
+void Query::test_sphere(std::uint32_t sphere, std::uint32_t slot,
+                        const Eigen::Vector3d& p) noexcept {
+  const double r = slots_[slot][3] + settings_.contact_skin_m;
+  ++stats_.spheres_tested;
+  FieldGrid::Read cell;
+  if (one_read_) cell = copy_->read(p);
+  const double grid = one_read_ ? cell.value : field_.distance(p);
+  if (grid - decision_error_ > r + settings_.candidate_margin_m) {
+    memory_.remember(slot, p, query_, grid);  // outside: grid - error > r > 0
+    return;
+  }
+  // The grid narrow phase's distance is this read: with the centre outside
+  // and the depth r - grid not within the candidate margin, the narrow phase
+  // would only remember the centre and report nothing. Its normal (a square
+  // root and three divisions) is not worked out for that.
+  if (!settings_.exact_narrow_phase && grid > 0.0 && !(r - grid > -settings_.candidate_margin_m)) {
+    memory_.remember(slot, p, query_, grid);
+    return;
+  }
+  ++stats_.exact_queries;
+  if (defer_ && grid > 0.0) {
+    memory_.remember(slot, p, query_, grid);
+    push_deferred(sphere, slot, r, grid);
+    return;
+  }
+  Eigen::Vector3d last_nearest;
+  // Only the exact search uses the hint: the grid narrow phase does not read it.
+  const Eigen::Vector3d* hint =
+      settings_.exact_narrow_phase && memory_.recall_nearest(slot, last_nearest) ? &last_nearest
+                                                                                 : nullptr;
+  const geometry::SdfSample s = one_read_ ? from_gradient(p, grid, copy_->gradient(cell))
+                                          : sample(field_, p, grid, settings_, hint);
+  if (s.distance_m > 0.0) memory_.remember(slot, p, query_, grid);
+  if (!(s.distance_m > 0.0)) ++stats_.spheres_inside;
+  if (s.exact) memory_.remember_nearest(slot, s.closest_point_m);
+  Eigen::Vector3d q, n;
+  double depth = 0.0;
+  bool no_history = false;
+  if (!narrow_phase(field_, hint, settings_.candidate_margin_m, p, r, s, settings_, memory_, slot,
+                    query_, q, n, depth, no_history)) {
+    return;
+  }
+  ++stats_.contacts;
+  SphereContact contact;
+  contact.sphere_id = sphere;
+  contact.body_id = body_.id;
+  contact.point_m = body_.world_from_body * q;
+  contact.normal = world_rotation_ * n;
+  contact.depth_m = depth;
+  contact.normal_without_history = no_history;
+  contact.candidate = depth <= 0.0;
+  contact.slot = slot;
+  probe_surface(tree_, slot, settings_.surface_probe, contact);
+  if (!out_.push(contact)) stats_.overflowed = true;
+  note_depth(depth);
+}
+
+// A node's bound is worked out when its parent passes, both children's at
+// once: their grid cells are asked for together, and a child that passes
+// has its own children's boxes (or, a leaf, its spheres and memory) asked
+// for when it is pushed, long before it is popped. On a cold cache the walk
+// otherwise waits on a box, then on its grid cell, node after node. The
+// nodes that pass are popped in the same order (right child first) as when
+// each bound was read at its pop.
+QueryStats Query::walk_all() noexcept {
+  struct Pending {
+    std::int32_t node;
+    double bound_m;
+  };
+  std::array<Pending, SphereTree::kMaxDepth + 1> stack{};
+  int top = 0;
+  auto passes = [&](double bound) noexcept {
+    return bound <= settings_.approach_margin_m;
+  };  // NaN: pruned
+  auto push = [&](std::int32_t index, double bound) noexcept {
+    const SphereTreeNode& node = nodes_[static_cast<std::size_t>(index)];
+    if (node.count == 0) {
+      // Both children share two lines.
+      __builtin_prefetch(&nodes_[static_cast<std::size_t>(node.first)]);
+      __builtin_prefetch(&nodes_[static_cast<std::size_t>(node.first) + 1]);
+    } else {
+      const auto first = static_cast<std::size_t>(node.first);
+      const std::size_t end = std::min(slots_.size(), first + static_cast<std::size_t>(node.count));
+      for (std::size_t slot = first; slot < end; slot += 2) __builtin_prefetch(&slots_[slot]);
+      memory_.prefetch_leaf(static_cast<std::uint32_t>(node.first),
+                            static_cast<std::uint32_t>(node.count));
+    }
+    stack[top++] = {index, bound};
+  };
+  ++stats_.nodes_visited;
+  const double root_bound = node_bound(nodes_[0]);
+  if (!passes(root_bound)) {
+    stats_.body_skipped = true;
+    return stats_;
+  }
+  push(0, root_bound);
+  while (top > 0) {
+    const Pending next = stack[--top];
+    const SphereTreeNode& node = nodes_[static_cast<std::size_t>(next.node)];
+    if (node.count == 0) {
+      const SphereTreeNode& left = nodes_[static_cast<std::size_t>(node.first)];
+      const SphereTreeNode& right = nodes_[static_cast<std::size_t>(node.first) + 1];
+      const Eigen::Vector3d left_middle = node_middle(left);
+      const Eigen::Vector3d right_middle = node_middle(right);
+      if (copy_ != nullptr) {
+        copy_->prefetch(left_middle);
+        copy_->prefetch(right_middle);
+      }
+      const double left_bound = bound_at(left, left_middle);
+      const double right_bound = bound_at(right, right_middle);
+      stats_.nodes_visited += 2;
+      if (passes(left_bound)) push(node.first, left_bound);
+      if (passes(right_bound)) push(node.first + 1, right_bound);
+      continue;
+    }
+    // bound - decision_error > 0: every centre is outside by more than its
+    // radius, the skin and the candidate margin plus the sphere test's own
+    // error (none in the grid narrow phase).
+    if (next.bound_m - decision_error_ > kDecisionSlackM) {
+      remember_leaf(node, next.bound_m);
+    } else {
+      test_leaf(node);
+    }
+  }
+  return stats_;
+}
+
+// Deepest first: the frontier is a heap on the bound (the smallest, i.e.
+// the deepest a sphere in it can be, on top). A sphere of a node with bound
+// b reads at most -b - margin deep: its depth r + skin - grid(c) is at most
+// reach + skin - grid(middle) + 2 grid error, as |c - middle| + r <= reach.
+QueryStats Query::walk_deepest() noexcept {
+  std::vector<PrePenetrationMemory::Frontier>& frontier = memory_.frontier();
   frontier.clear();
-  if (frontier.capacity() <
-      nodes.size()) {  // a memory of another tree (or a copy): never allocate here
-    stats.overflowed = true;
-    return stats;
+  // A memory of another tree (or a copy): never allocate here.
+  if (frontier.capacity() < nodes_.size()) {
+    stats_.overflowed = true;
+    return stats_;
   }
   const auto nearer_first = [](const PrePenetrationMemory::Frontier& a,
                                const PrePenetrationMemory::Frontier& b) {
     return a.bound_m > b.bound_m;
   };
   auto offer_node = [&](std::int32_t index) noexcept {
-    const double bound = node_bound(nodes[static_cast<std::size_t>(index)]);
-    ++stats.nodes_visited;
-    if (!(bound <= settings.approach_margin_m)) {
-      if (index == 0) stats.body_skipped = true;
+    const double bound = node_bound(nodes_[static_cast<std::size_t>(index)]);
+    ++stats_.nodes_visited;
+    if (!(bound <= settings_.approach_margin_m)) {
+      if (index == 0) stats_.body_skipped = true;
       return;
     }
     frontier.push_back({bound, index});
@@ -531,10 +603,10 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     std::pop_heap(frontier.begin(), frontier.end(), nearer_first);
     const PrePenetrationMemory::Frontier next = frontier.back();
     frontier.pop_back();
-    const SphereTreeNode& node = nodes[static_cast<std::size_t>(next.node)];
-    if (kept == keep) {
-      const double deepest_possible = -next.bound_m - settings.candidate_margin_m;
-      if (kept_depths[0] >= deepest_possible) break;  // nothing left can beat the k kept
+    const SphereTreeNode& node = nodes_[static_cast<std::size_t>(next.node)];
+    if (kept_ == keep_) {
+      const double deepest_possible = -next.bound_m - settings_.candidate_margin_m;
+      if (kept_depths_[0] >= deepest_possible) break;  // nothing left can beat the k kept
     }
     if (node.count == 0) {
       offer_node(node.first);
@@ -543,7 +615,20 @@ QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const
     }
     test_leaf(node);
   }
-  return stats;
+  return stats_;
+}
+
+}  // namespace
+
+QueryStats query_spheres(const SphereTree& tree, const SphereState& state, const RigidBody& body,
+                         const QuerySettings& settings, PrePenetrationMemory& memory,
+                         ContactBuffer& out) noexcept {
+  if (tree.nodes().empty() || tree.order().empty() || body.sdf == nullptr) return {};
+  const std::uint64_t query = memory.next_query();
+  // A tree of another layout.
+  if (tree.slot_spheres().size() != state.centres_m().size()) return {};
+  Query walk(tree, body, settings, memory, query, out);
+  return settings.deepest_only == 0 ? walk.walk_all() : walk.walk_deepest();
 }
 
 void complete_deferred(const SphereTree& tree, const RigidBody& body, const QuerySettings& settings,

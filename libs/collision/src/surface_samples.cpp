@@ -121,7 +121,6 @@ void SurfaceSamples::build(std::int32_t node, std::int32_t begin, std::int32_t e
   if (end - begin <= leaf_size || depth >= kMaxDepth - 1) {
     nodes_[node].first = begin;
     nodes_[node].count = end - begin;
-    ++leaf_count_;
     return;
   }
   int axis = 0;

@@ -219,8 +219,5 @@ std::uint64_t TriangleBaseline::refit_count() const {
 std::uint64_t TriangleBaseline::rebuild_count() const {
   return impl_->builds - 1;
 }
-std::size_t TriangleBaseline::last_pair_count() const {
-  return static_cast<std::size_t>(impl_->pairs.size());
-}
 
 }  // namespace fahr::collision

@@ -42,20 +42,4 @@ QosProfile QosProfile::for_role(TopicRole role) {
   return qos;
 }
 
-std::string_view topic_role_name(TopicRole role) {
-  switch (role) {
-    case TopicRole::kServoStream:
-      return "servo_stream";
-    case TopicRole::kStateStream:
-      return "state_stream";
-    case TopicRole::kLatched:
-      return "latched";
-    case TopicRole::kReport:
-      return "report";
-    case TopicRole::kLockstep:
-      return "lockstep";
-  }
-  return "unknown";
-}
-
 }  // namespace fahr::common

@@ -5,32 +5,6 @@
 
 namespace fahr::common {
 
-std::string_view event_kind_name(EventKind kind) {
-  switch (kind) {
-    case EventKind::kRequestedDeadlineMissed:
-      return "requested_deadline_missed";
-    case EventKind::kOfferedDeadlineMissed:
-      return "offered_deadline_missed";
-    case EventKind::kSampleLost:
-      return "sample_lost";
-    case EventKind::kSampleRejected:
-      return "sample_rejected";
-    case EventKind::kSubscriptionMatched:
-      return "subscription_matched";
-    case EventKind::kPublicationMatched:
-      return "publication_matched";
-    case EventKind::kRequestedIncompatibleQos:
-      return "requested_incompatible_qos";
-    case EventKind::kOfferedIncompatibleQos:
-      return "offered_incompatible_qos";
-    case EventKind::kLivelinessChanged:
-      return "liveliness_changed";
-    case EventKind::kLivelinessLost:
-      return "liveliness_lost";
-  }
-  return "unknown";
-}
-
 std::string_view TransportEvent::topic_name() const {
   return {topic.data(), strnlen(topic.data(), topic.size())};
 }

@@ -3,6 +3,7 @@
 #include "fahr/contact/contact_response.h"
 
 #include <cmath>
+#include <optional>
 
 #include "fahr/contact/force_limit.h"
 
@@ -171,12 +172,14 @@ Eigen::Vector3d ContactResponse::catch_up_step(const Eigen::Vector3d& toward, do
   return step;
 }
 
+// Where the proxy goes this tick, as an offset from where it is, and the
+// tracking state after it. Each phase leaves the solve at the proxy's new
+// place (tick() reads its forces): held while lost track, or released; the
+// coupled solve's step; the catch-up's bound; the freeze.
 Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input,
                                             const EffectiveCoupling& coupling) {
   const DeviceSample& device = input.device;
-  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   const double limit = device.renderable_force_n;
-  const bool hold_load = settings_.force_aware.held_proxy == HeldProxy::kHoldLoad;
   // kHoldLoad decides on the hand's pull into the tissue along the push the
   // tool froze with: a hand pressing on keeps the tool held, one that eases
   // off or draws back out (the spring then stretches the other way) releases
@@ -185,85 +188,105 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input,
   // the rows or with a tissue still relaxing under the released tool.
   const double pull =
       coupling.stiffness_npm * (device.position_m - proxy_.position_m).dot(held_push_direction_);
-  if (state_ == TrackingState::kLostTrack && hold_load) {
-    if (!should_release(settings_.force_aware, pull, limit)) {
-      solver_.solve_pinned(zero, settings_.pgs);
-      return zero;
-    }
-    state_ = TrackingState::kCatchingUp;
-  } else if (state_ == TrackingState::kLostTrack) {
-    const double spring = coupling.stiffness_npm * (device.position_m - proxy_.position_m).norm();
-    bool release = should_release(settings_.force_aware, spring, limit);
-    if (!release) {
-      // The spring alone cannot tell a hand still pushing in from one that
-      // has drawn back out of the tissue (or the mouth): both stretch it.
-      // Release when tracking again would load the tissue within the band.
-      solver_.solve_coupled(coupling.effective_stiffness_npm, coupling.target_m - proxy_.position_m,
-                            settings_.pgs);
-      release =
-          should_release(settings_.force_aware, solver_.resultant(RowKind::kTissue).norm(), limit);
-    }
-    if (!release) {
-      solver_.solve_pinned(zero, settings_.pgs);
-      if (settings_.force_aware.held_proxy != HeldProxy::kBackOff) return zero;
-      const Eigen::Vector3d back = yield_to_limit(zero, limit);
-      if (back != zero) capture_holds(input.compliance);
-      return back;
-    }
+  if (state_ == TrackingState::kLostTrack) {
+    if (const std::optional<Eigen::Vector3d> held = held_step(input, coupling, pull)) return *held;
     state_ = TrackingState::kCatchingUp;
   }
   const Eigen::Vector3d target_offset = coupling.target_m - proxy_.position_m;
   Eigen::Vector3d step =
       solver_.solve_coupled(coupling.effective_stiffness_npm, target_offset, settings_.pgs);
-  if (!plausible_step(step, target_offset)) {
-    // Hold the tool this tick (the pinned solve is well posed: no coupling
-    // term) rather than jump; the next tick's warm start solves from here.
-    report_.implausible_step = true;
-    solver_.solve_pinned(zero, settings_.pgs);
-    return hold_load ? zero : yield_to_limit(zero, limit);
-  }
-  if (state_ == TrackingState::kCatchingUp) {
-    // Reactivated: the equilibrium may be a few mm away (the tissue relaxed
-    // while the hand eased off); go there at a bounded speed so the force
-    // changes smoothly, holding the tool where the bound leaves it.
-    const double max_step = settings_.force_aware.catch_up_speed_mps * device.dt_s;
-    if (step.norm() > max_step) {
-      step = catch_up_step(step, max_step, device.dt_s);
-      solver_.solve_pinned(step, settings_.pgs);
-      // kHoldLoad never backs off: a back-off is not bounded by the
-      // catch-up speed, and tick() scales what the tissue receives instead.
-      if (!hold_load) step = yield_to_limit(step, limit);
-      report_.catch_up_limited = true;
-    } else {
-      state_ = TrackingState::kTracking;
-    }
-  }
-  const double reaction = solver_.resultant(RowKind::kTissue).norm();
-  // While catching up the tissue may still push at the frozen level (up to
-  // the limit and a little over); freeze again only if it grows, i.e. the
-  // hand pushes back in, so the two states cannot chatter (kHoldLoad: only
-  // if the hand's pull passes the limit again).
-  const bool catching_up = state_ == TrackingState::kCatchingUp;
-  const bool growing = !catching_up || reaction > previous_reaction_n_;
-  const bool freeze = hold_load && catching_up
-                          ? should_freeze(settings_.force_aware, pull, limit)
-                          : should_freeze(settings_.force_aware, reaction, limit) && growing;
-  if (freeze) {
-    // The proxy stops where it was (the last tick's pose, whose reaction was
-    // within the limit) and the loaded spheres are held there.
-    state_ = TrackingState::kLostTrack;
-    solver_.solve_pinned(zero, settings_.pgs);
-    const Eigen::Vector3d push = solver_.resultant(RowKind::kTissue);
-    held_push_direction_ =
-        push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
-    const HeldProxy held = settings_.force_aware.held_proxy;
-    const Eigen::Vector3d back = held == HeldProxy::kStay || held == HeldProxy::kHoldLoad
-                                     ? zero
-                                     : yield_to_limit(zero, limit);
-    if (!hold_load) capture_holds(input.compliance);  // kHoldLoad holds no sphere
-    return back;
-  }
+  if (!plausible_step(step, target_offset)) return hold_after_implausible_step(limit);
+  if (state_ == TrackingState::kCatchingUp) step = bound_catch_up(step, device);
+  if (freezes(pull, limit)) return freeze(input.compliance, limit);
   return step;
+}
+
+// While the device has lost track: the held proxy's step this tick, or
+// nothing once the hold is released (the proxy then catches up).
+std::optional<Eigen::Vector3d> ContactResponse::held_step(const TickInput& input,
+                                                          const EffectiveCoupling& coupling,
+                                                          double pull) {
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  const double limit = input.device.renderable_force_n;
+  const bool release = holds_load() ? should_release(settings_.force_aware, pull, limit)
+                                    : releases_position_hold(input.device, coupling);
+  if (release) return std::nullopt;
+  solver_.solve_pinned(zero, settings_.pgs);
+  if (settings_.force_aware.held_proxy != HeldProxy::kBackOff) return zero;
+  const Eigen::Vector3d back = yield_to_limit(zero, limit);
+  if (back != zero) capture_holds(input.compliance);
+  return back;
+}
+
+// kStay and kBackOff release when the coupling spring falls within the
+// band, or when tracking again would load the tissue within it.
+bool ContactResponse::releases_position_hold(const DeviceSample& device,
+                                             const EffectiveCoupling& coupling) {
+  const double limit = device.renderable_force_n;
+  const double spring = coupling.stiffness_npm * (device.position_m - proxy_.position_m).norm();
+  if (should_release(settings_.force_aware, spring, limit)) return true;
+  // The spring alone cannot tell a hand still pushing in from one that has
+  // drawn back out of the tissue (or the mouth): both stretch it.
+  solver_.solve_coupled(coupling.effective_stiffness_npm, coupling.target_m - proxy_.position_m,
+                        settings_.pgs);
+  return should_release(settings_.force_aware, solver_.resultant(RowKind::kTissue).norm(), limit);
+}
+
+// The coupled solve's step was refused: hold the tool this tick (the pinned
+// solve is well posed: no coupling term) rather than jump; the next tick's
+// warm start solves from here.
+Eigen::Vector3d ContactResponse::hold_after_implausible_step(double limit) {
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  report_.implausible_step = true;
+  solver_.solve_pinned(zero, settings_.pgs);
+  return holds_load() ? zero : yield_to_limit(zero, limit);
+}
+
+// Reactivated: the equilibrium may be a few mm away (the tissue relaxed
+// while the hand eased off); go there at a bounded speed so the force
+// changes smoothly, holding the tool where the bound leaves it. Tracking
+// again once the equilibrium is within one bounded step.
+Eigen::Vector3d ContactResponse::bound_catch_up(const Eigen::Vector3d& step,
+                                                const DeviceSample& device) {
+  const double max_step = settings_.force_aware.catch_up_speed_mps * device.dt_s;
+  if (!(step.norm() > max_step)) {
+    state_ = TrackingState::kTracking;
+    return step;
+  }
+  Eigen::Vector3d bounded = catch_up_step(step, max_step, device.dt_s);
+  solver_.solve_pinned(bounded, settings_.pgs);
+  // kHoldLoad never backs off: a back-off is not bounded by the catch-up
+  // speed, and tick() scales what the tissue receives instead.
+  if (!holds_load()) bounded = yield_to_limit(bounded, device.renderable_force_n);
+  report_.catch_up_limited = true;
+  return bounded;
+}
+
+// While catching up the tissue may still push at the frozen level (up to
+// the limit and a little over); freeze again only if it grows, i.e. the
+// hand pushes back in, so the two states cannot chatter (kHoldLoad: only if
+// the hand's pull passes the limit again).
+bool ContactResponse::freezes(double pull, double limit) const {
+  const double reaction = solver_.resultant(RowKind::kTissue).norm();
+  const bool catching_up = state_ == TrackingState::kCatchingUp;
+  if (holds_load() && catching_up) return should_freeze(settings_.force_aware, pull, limit);
+  const bool growing = !catching_up || reaction > previous_reaction_n_;
+  return should_freeze(settings_.force_aware, reaction, limit) && growing;
+}
+
+// The proxy stops where it was (the last tick's pose, whose reaction was
+// within the limit); kStay and kBackOff hold the loaded spheres there.
+Eigen::Vector3d ContactResponse::freeze(const TissueCompliance& compliance, double limit) {
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  state_ = TrackingState::kLostTrack;
+  solver_.solve_pinned(zero, settings_.pgs);
+  const Eigen::Vector3d push = solver_.resultant(RowKind::kTissue);
+  held_push_direction_ =
+      push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d back =
+      settings_.force_aware.held_proxy == HeldProxy::kBackOff ? yield_to_limit(zero, limit) : zero;
+  if (!holds_load()) capture_holds(compliance);  // kHoldLoad holds no sphere
+  return back;
 }
 
 void ContactResponse::push_contact(const fem::Contact& contact) {
@@ -328,63 +351,53 @@ void ContactResponse::write_contacts(const TickInput& input, const Eigen::Vector
   for (const fem::Contact& c : input.tissue_obstacle_contacts) push_contact(c);
 }
 
-const ForceOutput& ContactResponse::tick(const TickInput& input) {
-  const DeviceSample& device = input.device;
-  report_ = TickReport{};
-  solver_.reset_work();
-  const Eigen::Vector3d p0 = proxy_.position_m;
-  const EffectiveCoupling coupling =
-      effective_coupling(settings_.coupling, device.max_stiffness_npm, device.dt_s,
-                         device.position_m, device.velocity_mps, p0);
-  report_.load = solver_.load(input.rows, input.compliance, settings_.fallback_compliance_mpn);
-  if (settings_.mode == ResponseMode::kNaive) solver_.make_rigid();
-  Eigen::Vector3d step = move_proxy(input, coupling);
-  if (solver_.has_obstacle_rows() &&
-      (state_ != TrackingState::kTracking || report_.implausible_step)) {
-    // A held, backing-off or catching-up proxy was placed by the pinned
-    // solve, which gives bone no force: keep it out of the bone, and
-    // re-solve the tissue where it ends up.
-    const Eigen::Vector3d kept_out = solver_.project_on_obstacles(step, settings_.pgs);
-    if (kept_out.allFinite() && (kept_out - step).squaredNorm() > 0.0) {
-      step = kept_out;
-      solver_.solve_pinned(step, settings_.pgs);
-    }
-  }
-  solver_.store_warm_start();
-  report_.pgs = solver_.last_report();
-  report_.state = state_;
+// A held, backing-off or catching-up proxy was placed by the pinned solve,
+// which gives bone no force: keep it out of the bone, and re-solve the
+// tissue where it ends up.
+Eigen::Vector3d ContactResponse::keep_out_of_bone(const Eigen::Vector3d& step) {
+  if (!solver_.has_obstacle_rows() ||
+      (state_ == TrackingState::kTracking && !report_.implausible_step))
+    return step;
+  const Eigen::Vector3d kept_out = solver_.project_on_obstacles(step, settings_.pgs);
+  if (!kept_out.allFinite() || !((kept_out - step).squaredNorm() > 0.0)) return step;
+  solver_.solve_pinned(kept_out, settings_.pgs);
+  return kept_out;
+}
 
-  proxy_.position_m = p0 + step;
-  proxy_.orientation = device.orientation;
-  proxy_.velocity_mps = step / device.dt_s;
-
+// The ForceCommand's fields from the proxy the tick left.
+void ContactResponse::fill_output(const DeviceSample& device, const EffectiveCoupling& coupling) {
   ForceOutput& out = output_;
   out.answered_pose_seq = device.pose_seq;
   out.answered_position_m = device.position_m;
   out.force_n = coupling.stiffness_npm * (proxy_.position_m - device.position_m) +
                 coupling.damping_nspm * (proxy_.velocity_mps - device.velocity_mps);
-  const bool pinned = state_ == TrackingState::kLostTrack || report_.catch_up_limited;
   // A pinned proxy does not follow the device: the stylus feels the bare
   // coupling spring. Otherwise the active set's stiffness, <= K_c.
-  out.stiffness_npm = pinned ? Eigen::Matrix3d(coupling.stiffness_npm * Eigen::Matrix3d::Identity())
-                             : solver_.local_stiffness(coupling.stiffness_npm);
+  out.stiffness_npm = pinned()
+                          ? Eigen::Matrix3d(coupling.stiffness_npm * Eigen::Matrix3d::Identity())
+                          : solver_.local_stiffness(coupling.stiffness_npm);
   report_.force_limited = limit_force(device.renderable_force_n, out.force_n, out.stiffness_npm);
   out.proxy_position_m = proxy_.position_m;
   out.proxy_orientation = proxy_.orientation;
   out.lost_track = state_ == TrackingState::kLostTrack;
   out.device_minus_proxy_m = device.position_m - proxy_.position_m;
-  // What the tissue receives is never more than the device can render: a
-  // solve that asks for clearly more (the tool wedged between bone and
-  // tongue, where the bone's rows push it into the tissue) has its tissue
-  // forces scaled down to the limit and sent as force only. Within the band
-  // the force-aware decision already keeps the reaction at the limit (to
-  // its yield tolerance and the one-tick lag), and the constraints stay.
+}
+
+// What the tissue receives is never more than the device can render: a
+// solve that asks for clearly more (the tool wedged between bone and
+// tongue, where the bone's rows push it into the tissue) has its tissue
+// forces scaled down to the limit and sent as force only. Within the band
+// the force-aware decision already keeps the reaction at the limit (to its
+// yield tolerance and the one-tick lag), and the constraints stay. Sets
+// tissue_force_scale_; returns the solve's own tissue reaction, N.
+double ContactResponse::scale_tissue_forces(const DeviceSample& device) {
   const HeldProxy held = settings_.force_aware.held_proxy;
   const double solved_reaction = solver_.resultant(RowKind::kTissue).norm();
   tissue_force_scale_ = 1.0;
+  if (settings_.mode == ResponseMode::kNaive) return solved_reaction;
   const bool holds_proxy = (held == HeldProxy::kStay && state_ == TrackingState::kLostTrack) ||
-                           (held == HeldProxy::kHoldLoad && pinned);
-  if (settings_.mode != ResponseMode::kNaive && holds_proxy) {
+                           (held == HeldProxy::kHoldLoad && pinned());
+  if (holds_proxy) {
     // Held where it froze: the tissue forces are scaled to the limit; the
     // spheres stay frozen (kStay) or carry that load alone (kHoldLoad,
     // force only: write_contacts).
@@ -397,17 +410,39 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
     report_.tissue_held_by_load =
         held == HeldProxy::kHoldLoad &&
         (state_ == TrackingState::kLostTrack || report_.tissue_force_scaled_held);
-  } else if (settings_.mode != ResponseMode::kNaive && held != HeldProxy::kUnclamped &&
-             solved_reaction > kWedgeBand * device.renderable_force_n) {
+  } else if (solved_reaction > kWedgeBand * device.renderable_force_n) {
     tissue_force_scale_ = device.renderable_force_n / solved_reaction;
     report_.tissue_force_clamped = true;
   }
-  out.tissue_reaction_n = tissue_force_scale_ * solved_reaction;
+  return solved_reaction;
+}
+
+const ForceOutput& ContactResponse::tick(const TickInput& input) {
+  const DeviceSample& device = input.device;
+  report_ = TickReport{};
+  solver_.reset_work();
+  const Eigen::Vector3d p0 = proxy_.position_m;
+  const EffectiveCoupling coupling =
+      effective_coupling(settings_.coupling, device.max_stiffness_npm, device.dt_s,
+                         device.position_m, device.velocity_mps, p0);
+  report_.load = solver_.load(input.rows, input.compliance, settings_.fallback_compliance_mpn);
+  if (settings_.mode == ResponseMode::kNaive) solver_.make_rigid();
+  const Eigen::Vector3d step = keep_out_of_bone(move_proxy(input, coupling));
+  solver_.store_warm_start();
+  report_.pgs = solver_.last_report();
+  report_.state = state_;
+
+  proxy_.position_m = p0 + step;
+  proxy_.orientation = device.orientation;
+  proxy_.velocity_mps = step / device.dt_s;
+  fill_output(device, coupling);
+  const double solved_reaction = scale_tissue_forces(device);
+  output_.tissue_reaction_n = tissue_force_scale_ * solved_reaction;
   report_.obstacle_reaction_n = solver_.resultant(RowKind::kObstacle).norm();
-  out.active_contacts = 0;
+  output_.active_contacts = 0;
   for (std::size_t i = 0; i < solver_.size(); ++i)
-    out.active_contacts += solver_.lambda(i) > 0.0 ? 1u : 0u;
-  out.fem_step = input.compliance.fem_step;
+    output_.active_contacts += solver_.lambda(i) > 0.0 ? 1u : 0u;
+  output_.fem_step = input.compliance.fem_step;
   report_.pgs_work = solver_.work();
   previous_reaction_n_ = solved_reaction;
 
@@ -416,7 +451,7 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   const Eigen::Vector3d plane_shift =
       settings_.mode == ResponseMode::kNaive ? Eigen::Vector3d(device.position_m - p0) : step;
   write_contacts(input, plane_shift);
-  return out;
+  return output_;
 }
 
 }  // namespace fahr::contact

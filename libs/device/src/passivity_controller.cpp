@@ -7,7 +7,6 @@ namespace fahr::device {
 
 Vec3 PassivityController::apply(const Vec3& force_n, const Vec3& velocity_mps,
                                 std::chrono::duration<double> dt) {
-  last_beta_ = 0.0;
   if (!config_.enabled) return force_n;
   const double h = dt.count();
   // Energy left if this force were rendered as is.
@@ -17,7 +16,6 @@ Vec3 PassivityController::apply(const Vec3& force_n, const Vec3& velocity_mps,
     return force_n;
   // beta |v|^2 h = -predicted brings the account back to zero.
   const double beta = std::min(-predicted_j / (speed_squared * h), config_.max_damping_nspm);
-  last_beta_ = beta;
   ++active_ticks_;
   dissipated_j_ += beta * speed_squared * h;
   return force_n - beta * velocity_mps;

@@ -438,10 +438,6 @@ void Body::set_node_position(std::uint32_t node, const Eigen::Vector3d& position
   sleep_.wake();
 }
 
-void Body::set_velocities_zero() {
-  v_.setZero();
-}
-
 void Body::wake() {
   sleep_.wake();
 }

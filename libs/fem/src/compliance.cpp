@@ -53,7 +53,6 @@ void ComplianceBlock::reserve(std::size_t dofs, std::size_t max_spheres) {
   rhs_.assign(dofs * chunk, 0.0);
   solution_.assign(dofs * chunk, 0.0);
   uses_ = 0;
-  last_solved_ = 0;
 }
 
 std::size_t ComplianceBlock::slot_for(std::uint32_t sphere, std::uint64_t factorisation,
@@ -109,7 +108,6 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
                               WarpedFactor& warp, double time_step_s, std::span<float> out) {
   const std::size_t k = spheres.size();
   const std::size_t rows = 3 * k;
-  last_solved_ = 0;
   if (k == 0) return true;
   if (k > max_spheres_ || out.size() < rows * rows || !factor.factorized()) return false;
   for (const std::uint32_t s : spheres) {
@@ -127,7 +125,6 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
     request_slots_[s] = slot_for(spheres[s], factorisation, cached);
     if (!cached) to_solve_.push_back(request_slots_[s]);
   }
-  last_solved_ = to_solve_.size();
   for (std::size_t done = 0; done < to_solve_.size();) {
     const std::size_t left = to_solve_.size() - done;
     std::size_t chunk = kChunkSpheres.back();
@@ -160,7 +157,6 @@ bool ComplianceBlock::compute_along(std::span<const std::uint32_t> spheres,
                                     std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
                                     WarpedFactor& warp, double time_step_s, std::span<float> out) {
   const std::size_t k = spheres.size();
-  last_solved_ = 0;
   if (k == 0) return true;
   if (k > max_spheres_ || normals.size() < k || out.size() < 3 * k * k || !factor.factorized())
     return false;
@@ -200,7 +196,6 @@ bool ComplianceBlock::compute_along(std::span<const std::uint32_t> spheres,
     }
     done += chunk;
   }
-  last_solved_ = k;
   return true;
 }
 

@@ -23,8 +23,6 @@ ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStep
       links_(links),
       settings_(settings),
       projection_settings_(body.settings().projection) {
-  projection_settings_.spread = settings_.spread;
-  projection_settings_.frozen_target = settings_.frozen_target;
   const std::size_t dofs = 3 * body.node_count();
   const std::size_t k = settings_.max_compliance_spheres;
   carry_n_.assign(dofs, 0.0);
@@ -79,22 +77,6 @@ void ContactStep::set_obstacles(std::span<const ObstacleField* const> fields,
                   ? std::make_unique<ObstacleSupport>(body_.node_count())
                   : nullptr;
   body_.set_supports({}, 0.0);
-}
-
-void ContactStep::set_tool_obstacle(const ObstacleField* field) {
-  tool_field_ = field;
-  if (field == nullptr) {
-    tool_pass_.reset();
-    return;
-  }
-  // No margin: the spheres' projection already clears r from the tool; the
-  // nodes need only be out of it.
-  ObstacleProjectionSettings settings;
-  settings.margin_m = 0.0;
-  settings.support_stiffness_ratio = 0.0;
-  tool_pass_ = std::make_unique<ObstacleProjection>(
-      std::span<const ObstacleField* const>(&tool_field_, 1), body_.node_count(), settings);
-  tool_start_.assign(3 * body_.node_count(), 0.0);
 }
 
 bool ContactStep::reset() {
@@ -259,7 +241,7 @@ bool ContactStep::diverged() const {
 }
 
 // Gauss-Seidel between the tool and the bone: the ContactSet's projection,
-// the tool obstacle's pass (if set), then the anatomy's pass; again while
+// then the anatomy's pass; again while
 // the anatomy's moves broke a tool constraint, up to the round limit. The
 // anatomy always has the last word.
 void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
@@ -269,22 +251,8 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
   ProjectionReport anatomy;
   int sweeps = 0;
   if (obstacles_) obstacles_->begin_step();
-  int tool_nodes = 0;
   int volume_below = 0;
   int volume_unresolved = 0;
-  if (tool_pass_) {
-    // The tool moved since the last step: no clearance from then holds, and
-    // each node's path is taken relative to the tool.
-    tool_pass_->begin_step();
-    tool_pass_->forget_clearances();
-    for (std::size_t n = 0; n < body_.node_count(); ++n) {
-      const Eigen::Vector3d start(start_positions_[3 * n], start_positions_[3 * n + 1],
-                                  start_positions_[3 * n + 2]);
-      const Eigen::Vector3d carried = tool_motion_ * start;
-      for (std::size_t d = 0; d < 3; ++d)
-        tool_start_[3 * n + d] = carried[static_cast<Eigen::Index>(d)];
-    }
-  }
   for (int round = 0; round < rounds; ++round) {
     // After a round: whether the anatomy's last pass left nothing to redo.
     bool settled = round > 0;
@@ -296,11 +264,6 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
       // squeezed a tet below it, checked after the floor's pass).
       settled = settled && projection_.sweeps <= 1 && projection_.converged;
       if (settled && !volume_floor_) break;
-    }
-    if (tool_pass_) {
-      ProjectionReport tool_report;
-      tool_pass_->project(projected_, inverse_mass, tool_report, tool_start_);
-      tool_nodes += tool_report.obstacle_nodes;
     }
     if (volume_floor_) {
       const VolumeFloorReport floor = volume_floor_->project(projected_, inverse_mass);
@@ -318,7 +281,6 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
       break;
   }
   projection_.sweeps = sweeps;
-  projection_.tool_nodes = tool_nodes;
   projection_.volume_floor_below = volume_below;
   projection_.volume_floor_unresolved = volume_unresolved;
   projection_.obstacle_rounds = anatomy.obstacle_rounds;
@@ -359,8 +321,7 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   update_compliance(report.refactorised);
   update_free_centres();
   projection_ = {};
-  if (obstacles_ || tool_pass_ || volume_floor_ ||
-      (contacts != nullptr && !contacts->contacts.empty())) {
+  if (obstacles_ || volume_floor_ || (contacts != nullptr && !contacts->contacts.empty())) {
     project(contacts);
   }
   if (supports_ && supports_->update(*obstacles_, start_positions_, free_positions_)) {

@@ -133,19 +133,6 @@ double ObstacleProjection::enter_along_path(const ObstacleField& field,
       const Eigen::Vector3d end = x;
       x = entry;
       s = field.sample(x);
-      const double normal_length = s.normal.norm();
-      if (settings_.slide_after_entry && normal_length > kMinNormalLength && s.normal.allFinite()) {
-        // The rest of the path slides along the surface (frictionless)
-        // rather than stopping at the entry: stopped there, a node whose
-        // path clips a bone's corner by a few micrometres never moves again.
-        const Eigen::Vector3d n = s.normal / normal_length;
-        const Eigen::Vector3d rest_of_path = end - entry;
-        const Eigen::Vector3d slide = rest_of_path - std::min(0.0, rest_of_path.dot(n)) * n;
-        if (slide.allFinite()) {
-          x = entry + slide;
-          s = field.sample(x);
-        }
-      }
       return (end - x).norm();
     }
     t = t_next;

@@ -10,25 +10,6 @@ namespace {
 // normalised reliably (c == q at the haptic side) and is skipped.
 constexpr double kMinNormalLength = 1e-9;
 
-bool translate_sphere_nodes(std::size_t sphere, const SphereLinks& links,
-                            std::span<const double> inverse_mass_per_node,
-                            const Eigen::Vector3d& dc_m, std::span<double> positions_m) {
-  const auto nodes = links.nodes(sphere);
-  const auto weights = links.weights(sphere);
-  double free_weight = 0.0;  // the share of the centre the free nodes carry
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    if (inverse_mass_per_node[nodes[k]] > 0.0) free_weight += weights[k];
-  }
-  if (!(free_weight > 0.0)) return false;
-  const Eigen::Vector3d move = dc_m / free_weight;
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    if (inverse_mass_per_node[nodes[k]] > 0.0) {
-      Eigen::Map<Eigen::Vector3d>(positions_m.data() + 3 * std::size_t{nodes[k]}) += move;
-    }
-  }
-  return true;
-}
-
 }  // namespace
 
 bool contact_is_frozen(const Contact& contact) {
@@ -46,10 +27,7 @@ bool contact_is_projected(const Contact& contact, const ProjectionSettings& sett
 
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
                         std::span<const double> inverse_mass_per_node, const Eigen::Vector3d& dc_m,
-                        std::span<double> positions_m, SphereSpread spread) {
-  if (spread == SphereSpread::kTranslation) {
-    return translate_sphere_nodes(sphere, links, inverse_mass_per_node, dc_m, positions_m);
-  }
+                        std::span<double> positions_m) {
   const auto nodes = links.nodes(sphere);
   const auto weights = links.weights(sphere);
   double denominator = 0.0;  // sum_j w_j^2 / m_j, 1/kg
@@ -70,8 +48,6 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
                                   const ProjectionSettings& settings, std::span<double> positions_m,
                                   std::span<const double> step_start_m) {
   ProjectionReport report;
-  const bool hold_at_start =
-      settings.frozen_target == FrozenTarget::kStepStart && !step_start_m.empty();
   for (const Contact& contact : contacts.contacts) {
     if (contact_is_projected(contact, settings)) ++report.constraints;
   }
@@ -91,10 +67,7 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
       const Eigen::Vector3d centre = links.centre(contact.sphere_id, positions_m.data());
       Eigen::Vector3d dc = Eigen::Vector3d::Zero();
       if (contact_is_frozen(contact)) {
-        const Eigen::Vector3d target = hold_at_start
-                                           ? links.centre(contact.sphere_id, step_start_m.data())
-                                           : contact.hold_centre_m;
-        dc = target - centre;
+        dc = links.centre(contact.sphere_id, step_start_m.data()) - centre;
       } else {
         const double length = contact.normal.norm();
         if (!(length > kMinNormalLength)) {
@@ -107,8 +80,7 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
         if (gap >= 0.0) continue;  // inequality satisfied: no correction
         dc = -gap * n;
       }
-      if (!move_sphere_centre(contact.sphere_id, links, inverse_mass_per_node, dc, positions_m,
-                              settings.spread)) {
+      if (!move_sphere_centre(contact.sphere_id, links, inverse_mass_per_node, dc, positions_m)) {
         ++report.unmovable;
         continue;
       }

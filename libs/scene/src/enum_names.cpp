@@ -38,6 +38,9 @@ std::string_view to_string(ComplianceMode mode) {
 std::string_view to_string(ContactResponse response) {
   return name_of(detail::kContactResponseNames, response);
 }
+std::string_view to_string(HeldProxy held) {
+  return name_of(detail::kHeldProxyNames, held);
+}
 std::string_view to_string(Reliability reliability) {
   return name_of(detail::kReliabilityNames, reliability);
 }

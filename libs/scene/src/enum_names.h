@@ -51,6 +51,8 @@ inline constexpr std::pair<std::string_view, ComplianceColumns> kComplianceColum
     {"blocks", ComplianceColumns::kBlocks}, {"normals", ComplianceColumns::kNormals}};
 inline constexpr std::pair<std::string_view, ContactResponse> kContactResponseNames[] = {
     {"force_aware", ContactResponse::kForceAware}, {"penalty", ContactResponse::kPenalty}};
+inline constexpr std::pair<std::string_view, HeldProxy> kHeldProxyNames[] = {
+    {"load", HeldProxy::kLoad}, {"stay", HeldProxy::kStay}};
 inline constexpr std::pair<std::string_view, Reliability> kReliabilityNames[] = {
     {"reliable", Reliability::kReliable}, {"best_effort", Reliability::kBestEffort}};
 inline constexpr std::pair<std::string_view, PairKind> kPairKindNames[] = {

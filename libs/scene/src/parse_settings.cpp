@@ -274,12 +274,13 @@ ContactSettings parse_contact(const ParseContext& ctx, const MapReader& top,
   const MapReader map(
       ctx.log, top.value("contact"), "contact",
       {"response", "coupling_stiffness_npm", "coupling_damping_nspm", "force_aware_hysteresis",
-       "penalty_stiffness_npm", "deformable_obstacle_margin_m", "include_pairs", "exclude_pairs",
-       "tool_stops_at_anatomy"});
+       "held_proxy", "penalty_stiffness_npm", "deformable_obstacle_margin_m", "include_pairs",
+       "exclude_pairs", "tool_stops_at_anatomy"});
   map.read_enum("response", kContactResponseNames, c.response);
   map.read("coupling_stiffness_npm", open_closed(0.0, 1.0e5), c.coupling_stiffness_npm);
   map.read("coupling_damping_nspm", closed(0.0, 1.0e3), c.coupling_damping_nspm);
   map.read("force_aware_hysteresis", closed(0.0, 0.9), c.force_aware_hysteresis);
+  map.read_enum("held_proxy", kHeldProxyNames, c.held_proxy);
   map.read("penalty_stiffness_npm", open_closed(0.0, 1.0e6), c.penalty_stiffness_npm);
   map.read("deformable_obstacle_margin_m", closed(0.0, 1.0), c.deformable_obstacle_margin_m);
   parse_pair_list(ctx, map, "include_pairs", bodies, c.include_pairs);

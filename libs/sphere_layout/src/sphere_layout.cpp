@@ -71,7 +71,6 @@ SphereLayout::SphereLayout(std::vector<SphereRecord> spheres, std::vector<std::u
       throw std::invalid_argument("sphere layout: sphere " + std::to_string(i) +
                                   " has weights not summing to 1 or a radius <= 0");
     }
-    max_rest_radius_m_ = std::max(max_rest_radius_m_, s.rest_radius_m);
   }
 }
 

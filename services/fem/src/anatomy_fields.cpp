@@ -18,11 +18,6 @@ AnatomyField::AnatomyField(std::unique_ptr<runtime::RigidField> field)
       world_from_body_rotation_(field_->world_from_body().linear()),
       far_error_m_(kCellDiagonal * field_->sdf->cell_size_m()) {}
 
-void AnatomyField::set_world_from_body(const Eigen::Isometry3d& world_from_body) {
-  body_from_world_ = world_from_body.inverse();
-  world_from_body_rotation_ = world_from_body.linear();
-}
-
 fem::ObstacleSample AnatomyField::sample(const Eigen::Vector3d& p_m) const noexcept {
   fem::ObstacleSample out;
   if (!p_m.allFinite()) {
@@ -34,12 +29,6 @@ fem::ObstacleSample AnatomyField::sample(const Eigen::Vector3d& p_m) const noexc
   out.distance_m = far_outside ? s.distance_m - far_error_m_ : s.distance_m;
   out.normal = world_from_body_rotation_ * s.normal;
   return out;
-}
-
-std::unique_ptr<AnatomyField> load_tool_field(const scene::Scene& scene) {
-  const auto tool = scene.tool_index();
-  if (!tool) return nullptr;
-  return std::make_unique<AnatomyField>(runtime::load_rigid_field(scene.bodies[*tool]));
 }
 
 std::vector<std::unique_ptr<AnatomyField>> load_anatomy_fields(const scene::Scene& scene,

@@ -30,16 +30,6 @@ void to_fem(const msg::ContactSet& wire, fem::ContactSet& out) {
   }
 }
 
-bool tool_pose(const msg::ContactSet& wire, Eigen::Isometry3d& world_from_tool) {
-  const Eigen::Quaterniond orientation = to_eigen(wire.world_from_tool().orientation());
-  const Eigen::Vector3d position = to_eigen(wire.world_from_tool().position_m());
-  const double norm = orientation.norm();
-  if (!(norm > 0.5 && norm < 2.0) || !position.allFinite())
-    return false;  // NaN fails the range too
-  world_from_tool = Eigen::Translation3d(position) * orientation.normalized();
-  return true;
-}
-
 void fill_state(const fem::Body& body, std::uint32_t body_id, msg::DeformationState& out) {
   out.body_id(body_id);
   out.step(body.step_index());

@@ -25,8 +25,6 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
           *setup.body, setup.links,
           fem::ContactStepSettings{.apply_contact_forces = true,
                                    .max_compliance_spheres = setup.settings.max_compliance_spheres,
-                                   .spread = setup.sphere_spread,
-                                   .frozen_target = setup.frozen_target,
                                    .compliance_along_normals = setup.compliance_along_normals,
                                    .divergence_limit_m = divergence_limit_m(setup.mesh),
                                    .volume_floor = setup.volume_floor}) {
@@ -36,10 +34,6 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
     for (const auto& field : setup.anatomy) anatomy.push_back(field.get());
   }
   contact_step_.set_obstacles(anatomy, setup.anatomy_settings);
-  if (setup.tool) {
-    contact_step_.set_tool_obstacle(setup.tool.get());
-    world_from_tool_at_last_step_ = setup.tool->field().world_from_body();
-  }
   contacts_.contacts.reserve(msg::MAX_CONTACTS);
   state_.positions_m().reserve(3 * setup.mesh.node_count());
   state_.velocities_mps().reserve(3 * setup.mesh.node_count());
@@ -52,7 +46,6 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
 void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
   to_fem(wire, contacts_);
   have_contacts_ = true;
-  have_tool_pose_ = tool_pose(wire, world_from_tool_);
   applied_contact_seq_ = seq;
 }
 
@@ -62,14 +55,6 @@ void ServiceStep::step() {
       have_contacts_ &&
       setup_.body->step_index() <= contacts_.state_step + setup_.settings.max_contact_age_steps;
   if (have_contacts_ && !usable) ++stale_sets_;
-  if (setup_.tool) {
-    // The tool where the newest set left it; it stays put without one.
-    const Eigen::Isometry3d now =
-        usable && have_tool_pose_ ? world_from_tool_ : world_from_tool_at_last_step_;
-    setup_.tool->set_world_from_body(now);
-    contact_step_.set_tool_motion(now * world_from_tool_at_last_step_.inverse());
-    world_from_tool_at_last_step_ = now;
-  }
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
   inverted_max_ = std::max<std::uint64_t>(
       inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));

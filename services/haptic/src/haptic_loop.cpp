@@ -128,9 +128,9 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
 }
 
 // The rows' order of choice (haptic_setup.h RowCompliance): the k deepest,
-// the deepest with a W sphere's depth taken on its free centre, or the W
-// spheres first. Keys are worked out once per contact, then partially
-// sorted, as select_deepest does for the depth alone.
+// or the deepest with a W sphere's depth taken on its free centre. Keys are
+// worked out once per contact, then partially sorted, as select_deepest does
+// for the depth alone.
 std::size_t HapticLoop::select_rows(const TissueSnapshot& tissue) {
   if (setup_.row_compliance == RowCompliance::kDeepest) {
     return collision::select_deepest(tool_contacts_, tissue_row_budget_, order_);
@@ -138,13 +138,12 @@ std::size_t HapticLoop::select_rows(const TissueSnapshot& tissue) {
   const std::size_t n = std::min(tool_contacts_.size(), order_.size());
   std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
   if (n <= tissue_row_budget_) return n;
-  const bool free_depth = setup_.row_compliance == RowCompliance::kFreeDepth;
   for (std::size_t i = 0; i < n; ++i) {
     const std::int32_t w = tissue.compliance_index[tool_contacts_[i].sphere_id];
     double key = tool_contacts_[i].depth_m;
-    // kFreeDepth: |c - c_free| stands for (c - c_free) . n, the FEM's shift
-    // being along the pushing normals. kKeep: a metre ahead of any depth.
-    if (w >= 0) key += free_depth ? double{tissue.free_shift_m[static_cast<std::size_t>(w)]} : 1.0;
+    // |c - c_free| stands for (c - c_free) . n, the FEM's shift being along
+    // the pushing normals.
+    if (w >= 0) key += double{tissue.free_shift_m[static_cast<std::size_t>(w)]};
     row_key_[i] = key;
   }
   std::partial_sort(order_.begin(),

@@ -19,6 +19,9 @@ contact::ResponseSettings response_settings(const scene::Scene& scene) {
   s.coupling.stiffness_npm = scene.contact.coupling_stiffness_npm;
   s.coupling.damping_nspm = scene.contact.coupling_damping_nspm;
   s.force_aware.hysteresis = scene.contact.force_aware_hysteresis;
+  s.force_aware.held_proxy = scene.contact.held_proxy == scene::HeldProxy::kStay
+                                 ? contact::HeldProxy::kStay
+                                 : contact::HeldProxy::kHoldLoad;
   // The DeformationState carries W for at most 64 spheres: more rows would
   // all run on the fallback compliance.
   // Tissue rows are bounded by W (64 spheres); the anatomy adds its own.

@@ -25,7 +25,8 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
     : scene_(std::move(scene)),
       base_period_ns_(scene_->run.base_period.count()),
       fem_period_(static_cast<std::uint64_t>(scene_->rates.fem_period() / scene_->run.base_period)),
-      haptic_setup_(haptic_service::set_up(*scene_, options.collision, options.fem_anatomy)),
+      haptic_setup_(haptic_service::set_up(*scene_, options.collision,
+                                           !options.experiments.haptic_side_anatomy)),
       fem_setup_(fem_service::set_up_body(*scene_, deformable_body(*scene_))) {
   if (scene_->rates.haptic_period() != scene_->run.base_period) {
     throw std::runtime_error("stack_sim: the haptic rate must be the base rate of scene '" +
@@ -44,21 +45,19 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
       std::make_unique<device::SimulatedBackend>(std::move(script), hand, gateway_config_.model,
                                                  gateway_config_.mapping, gateway_config_.period);
   gateway_ = std::make_unique<device::ServoCore>(gateway_config_, *hand_);
-  haptic_setup_.response.force_aware.held_proxy = options.held_proxy;
-  if (options.row_compliance) haptic_setup_.row_compliance = *options.row_compliance;
-  if (options.candidate_margin_m) haptic_setup_.candidate_margin_m = *options.candidate_margin_m;
+  const Experiments& experiments = options.experiments;
+  if (experiments.back_off_held_proxy)
+    haptic_setup_.response.force_aware.held_proxy = contact::HeldProxy::kBackOff;
+  if (experiments.candidate_margin_m)
+    haptic_setup_.candidate_margin_m = *experiments.candidate_margin_m;
   haptic_ = std::make_unique<haptic_service::HapticLoop>(haptic_setup_);
   digest_ = std::make_unique<haptic_service::TissueDigest>(haptic_setup_);
   tissue_ = digest_->make_snapshot();
-  fem_setup_.enforce_anatomy = options.fem_anatomy;
-  if (options.fem_support_ratio)
-    fem_setup_.anatomy_settings.support_stiffness_ratio = *options.fem_support_ratio;
-  fem_setup_.anatomy_settings.slide_after_entry = options.fem_anatomy_slide;
-  if (options.fem_anatomy_rounds > 0)
-    fem_setup_.anatomy_settings.max_rounds = options.fem_anatomy_rounds;
-  if (options.sphere_spread) fem_setup_.sphere_spread = *options.sphere_spread;
-  if (options.frozen_target) fem_setup_.frozen_target = *options.frozen_target;
-  if (options.fem_tool_obstacle) fem_setup_.tool = fem_service::load_tool_field(*scene_);
+  fem_setup_.enforce_anatomy = !experiments.haptic_side_anatomy;
+  if (experiments.fem_support_ratio)
+    fem_setup_.anatomy_settings.support_stiffness_ratio = *experiments.fem_support_ratio;
+  if (experiments.fem_anatomy_rounds > 0)
+    fem_setup_.anatomy_settings.max_rounds = experiments.fem_anatomy_rounds;
   fem_ = std::make_unique<fem_service::ServiceStep>(fem_setup_);
   contacts_.contacts().reserve(msg::MAX_CONTACTS);
   next_contacts_.contacts().reserve(msg::MAX_CONTACTS);

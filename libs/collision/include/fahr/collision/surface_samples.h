@@ -61,7 +61,6 @@ class SurfaceSamples {
   // Tool frame, m, in leaf order.
   const std::vector<Eigen::Vector3d>& points_m() const { return points_m_; }
   const std::vector<SurfaceSampleNode>& nodes() const { return nodes_; }
-  std::size_t leaf_count() const { return leaf_count_; }
   int depth() const { return depth_; }
 
  private:
@@ -69,7 +68,6 @@ class SurfaceSamples {
 
   std::vector<Eigen::Vector3d> points_m_;
   std::vector<SurfaceSampleNode> nodes_;
-  std::size_t leaf_count_ = 0;
   int depth_ = 0;
 };
 

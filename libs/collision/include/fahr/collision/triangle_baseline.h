@@ -53,7 +53,6 @@ class TriangleBaseline {
 
   std::uint64_t refit_count() const;
   std::uint64_t rebuild_count() const;  // builds after construction: stays 0
-  std::size_t last_pair_count() const;  // box-overlapping triangle pairs of the last collide
 
   // A vertex found behind a face deeper than this is not that face's contact
   // (it is another face's: a blade plate is 1.2 mm thick), m.

@@ -36,6 +36,4 @@ struct QosProfile {
   static QosProfile for_role(TopicRole role);
 };
 
-std::string_view topic_role_name(TopicRole role);
-
 }  // namespace fahr::common

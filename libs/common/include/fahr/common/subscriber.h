@@ -42,7 +42,6 @@ class Subscriber final : private detail::SampleSink {
   // Consumer side (one thread): true if a newer sample arrived since the
   // last fetch; newest()/newest_info() then refer to it. Wait-free.
   bool fetch_newest() { return latest_.fetch(); }
-  bool has_sample() const { return latest_.has_value(); }
   const T& newest() const { return latest_.value(); }
   const SampleInfo& newest_info() const { return latest_.info(); }
 

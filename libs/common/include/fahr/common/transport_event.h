@@ -27,8 +27,6 @@ enum class EventKind {
 };
 inline constexpr int kEventKindCount = 10;
 
-std::string_view event_kind_name(EventKind kind);
-
 struct TransportEvent {
   std::int64_t time_ns = 0;  // wall clock when fahr saw it
   EventKind kind = EventKind::kSampleLost;

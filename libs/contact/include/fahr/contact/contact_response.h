@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -119,7 +120,22 @@ class ContactResponse {
     Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
   };
 
+  // move_proxy() and its phases (contact_response.cpp).
   Eigen::Vector3d move_proxy(const TickInput& input, const EffectiveCoupling& coupling);
+  std::optional<Eigen::Vector3d> held_step(const TickInput& input,
+                                           const EffectiveCoupling& coupling, double pull);
+  bool releases_position_hold(const DeviceSample& device, const EffectiveCoupling& coupling);
+  Eigen::Vector3d hold_after_implausible_step(double limit);
+  Eigen::Vector3d bound_catch_up(const Eigen::Vector3d& step, const DeviceSample& device);
+  bool freezes(double pull, double limit) const;
+  Eigen::Vector3d freeze(const TissueCompliance& compliance, double limit);
+  bool holds_load() const { return settings_.force_aware.held_proxy == HeldProxy::kHoldLoad; }
+  // tick()'s phases after the proxy moved.
+  Eigen::Vector3d keep_out_of_bone(const Eigen::Vector3d& step);
+  void fill_output(const DeviceSample& device, const EffectiveCoupling& coupling);
+  double scale_tissue_forces(const DeviceSample& device);
+  // The proxy does not follow the device this tick (held, or its catch-up bounded).
+  bool pinned() const { return state_ == TrackingState::kLostTrack || report_.catch_up_limited; }
   Eigen::Vector3d catch_up_step(const Eigen::Vector3d& toward, double max_step, double dt_s) const;
   Eigen::Vector3d yield_to_limit(const Eigen::Vector3d& offset_m, double limit_n);
   bool plausible_step(const Eigen::Vector3d& step_m, const Eigen::Vector3d& target_offset_m) const;

@@ -71,7 +71,6 @@ class ContactSolver {
   const ContactRow& row(std::size_t i) const { return rows_[i]; }
   double lambda(std::size_t i) const { return lambda_[i]; }
   double penetration(std::size_t i) const { return depth_[i]; }  // d_i at p0, m
-  double delassus(std::size_t i, std::size_t j) const { return a_[i * capacity_ + j]; }
   // sum_i n_i lambda_i over rows of `kind`, N (the force the tool exerts on them).
   Eigen::Vector3d resultant(RowKind kind) const;
   // W_row(i),row(j) n_j summed with lambda_j over tissue rows: the predicted

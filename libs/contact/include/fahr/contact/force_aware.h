@@ -16,14 +16,11 @@ enum class TrackingState : std::uint8_t {
 };
 
 enum class HeldProxy : std::uint8_t {
-  // Backs off along the reaction until the reaction is the limit
-  // (ContactResponse::yield_to_limit): the tissue's reaction is the limit,
-  // the proxy drifts from where it froze.
-  kBackOff,
-  // Stays where it froze (the paper: the proxy stops); the tissue forces
-  // sent to the FEM are scaled so that their resultant is the limit, and
-  // the spheres stay frozen (the FEM holds them where each step finds
-  // them). The published gap is then the hand's pull past the limit.
+  // Stays where it froze (the paper's positional hold: the proxy stops,
+  // c' = c); the tissue forces sent to the FEM are scaled so that their
+  // resultant is the limit, and the spheres stay frozen (the FEM holds them
+  // where each step finds them). The published gap is then the hand's pull
+  // past the limit. A scene choice (contact.held_proxy: stay).
   kStay,
   // The default. Stays where it froze (the published gap is then exactly
   // the hand's pull past the proxy), and the tissue is held by a load, not
@@ -37,10 +34,11 @@ enum class HeldProxy : std::uint8_t {
   // keeps the load scaled and force only while catching up past the limit
   // (docs/design/force-aware-decision.md, the held proxy).
   kHoldLoad,
-  // A diagnostic, not a response: stays, and the tissue gets whatever the
-  // pinned solve asks, unclamped, so a bench can see whether the frozen
-  // hold is steady by itself.
-  kUnclamped,
+  // Retired, kept for the overshoot bench's comparison only (bench-only:
+  // stack_sim::Experiments::back_off_held_proxy): backs off along the
+  // reaction until the reaction is the limit (ContactResponse::
+  // yield_to_limit); the proxy drifts from where it froze.
+  kBackOff,
 };
 
 struct ForceAwareSettings {

@@ -36,7 +36,6 @@ class ForceRenderer {
   bool has_command() const { return has_command_; }
   std::uint64_t answered_pose_seq() const { return answered_pose_seq_; }
   const Vec3& torque_nm() const { return torque_nm_; }
-  const Mat3& conditioned_stiffness_npm() const { return stiffness_npm_; }
 
   // Force on the stylus at `position_m` (world frame), N, not yet saturated.
   Vec3 render(const Vec3& position_m) const;

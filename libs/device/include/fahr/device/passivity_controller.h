@@ -55,19 +55,15 @@ class PassivityController {
   void account(const Vec3& rendered_force_n, const Vec3& velocity_mps,
                std::chrono::duration<double> dt);
 
-  // Energy the port has absorbed, J (>= 0 when passive, up to the cap).
-  double observed_energy_j() const { return energy_j_; }
   // Energy the controller's damper has removed since start, J, >= 0.
   double dissipated_energy_j() const { return dissipated_j_; }
   // Ticks in which the controller added damping.
   std::uint64_t active_ticks() const { return active_ticks_; }
-  double last_damping_nspm() const { return last_beta_; }
 
  private:
   PassivityConfig config_;
   double energy_j_ = 0.0;
   double dissipated_j_ = 0.0;
-  double last_beta_ = 0.0;
   std::uint64_t active_ticks_ = 0;
 };
 

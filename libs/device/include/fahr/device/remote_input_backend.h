@@ -22,16 +22,14 @@ class RemoteInputBackend final : public Backend {
   // Returns false (and counts) if the sample has a non-finite field.
   bool push(const DeviceReading& reading);
   DeviceReading read(std::chrono::nanoseconds now) override;
-  void apply(const Vec3& force_n) override { last_force_n_ = force_n; }
+  void apply(const Vec3& /*force_n*/) override {}  // a remote input renders no force
 
   std::uint64_t rejected_non_finite() const { return rejected_non_finite_; }
   std::uint64_t clamped() const { return clamped_; }
-  const Vec3& last_force_n() const { return last_force_n_; }
 
  private:
   Vec3 half_workspace_m_;
   DeviceReading newest_;
-  Vec3 last_force_n_ = Vec3::Zero();
   std::uint64_t rejected_non_finite_ = 0;
   std::uint64_t clamped_ = 0;
 };

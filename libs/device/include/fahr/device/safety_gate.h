@@ -95,7 +95,6 @@ class SafetyGate {
 
   SafetyState state() const { return state_; }
   const SafetyCounters& counters() const { return counters_; }
-  const Vec3& last_output_n() const { return last_output_n_; }
 
  private:
   Vec3 next_target(const Vec3& candidate_n, const Vec3& commanded_n, bool accepted_now);

@@ -37,10 +37,6 @@ class SimulatedBackend final : public Backend {
   DeviceReading read(std::chrono::nanoseconds now) override;
   void apply(const Vec3& force_n) override;
 
-  // Script time elapsed, s.
-  double script_time_s() const { return time_s_; }
-  bool script_done() const { return time_s_ >= script_.duration().count(); }
-
  private:
   Trajectory script_;
   HandImpedance hand_;

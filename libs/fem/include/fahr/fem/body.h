@@ -136,7 +136,6 @@ class Body {
   void clear_external_forces();
   // Teleports a node (a test's yank), m; velocity unchanged. Wakes the body.
   void set_node_position(std::uint32_t node, const Eigen::Vector3d& position_m);
-  void set_velocities_zero();
   void wake();
   // Back to the state create() left: rest positions, no motion, no external
   // force, awake, the rest factorisation (refactorised, so a body that ran is
@@ -149,7 +148,6 @@ class Body {
   Energy energy();
 
   std::size_t node_count() const { return mass_kg_.size(); }
-  std::size_t element_count() const { return rest_.size(); }
   const ElementRest& element_rest() const { return rest_; }
   std::span<const double> positions_m() const {
     return {x_.data(), static_cast<std::size_t>(x_.size())};

@@ -53,9 +53,6 @@ class ComplianceBlock {
                      std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
                      WarpedFactor& warp, double time_step_s, std::span<float> out);
 
-  // Spheres whose columns the last compute() solved (the others were kept).
-  std::size_t last_solved_spheres() const { return last_solved_; }
-
  private:
   struct Slot {
     std::uint32_t sphere = 0;
@@ -82,7 +79,6 @@ class ComplianceBlock {
   std::vector<double> rhs_;                 // one chunk of right-hand sides
   std::vector<double> solution_;
   std::uint64_t uses_ = 0;
-  std::size_t last_solved_ = 0;
 };
 
 }  // namespace fahr::fem

@@ -18,7 +18,7 @@ enum class ContactKind : std::uint8_t {
 
 enum class ContactState : std::uint8_t {
   kActive,     // (c' - q) . n >= r
-  kFrozen,     // c' = c, where the step found it (or hold_centre_m: projection.h FrozenTarget)
+  kFrozen,     // c' = c, where the step found it (projection.h)
   kCandidate,  // near, not touching: only its compliance is wanted
 };
 
@@ -31,7 +31,8 @@ struct Contact {
   Eigen::Vector3d plane_point_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
   // The haptic side's estimate of where the tool holds a frozen sphere, m;
-  // the FEM holds it there only with FrozenTarget::kHoldCentre.
+  // carried on the wire and reported only: the FEM holds a frozen sphere
+  // where its step started (docs/design/retired-modes.md, the hold centre).
   Eigen::Vector3d hold_centre_m = Eigen::Vector3d::Zero();
   double penetration_m = 0.0;  // as the haptic side saw it, m (reported only)
   double force_n = 0.0;        // contact force lambda the haptic solve found, N

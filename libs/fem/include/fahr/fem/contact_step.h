@@ -54,11 +54,6 @@ struct ContactStepSettings {
   bool apply_contact_forces = true;
   // Spheres in the compliance block at most (a DeformationState carries 64).
   std::size_t max_compliance_spheres = 64;
-  // How the ContactSet's sphere corrections are shared by the nodes
-  // (projection.h); overrides the body's projection setting.
-  SphereSpread spread = SphereSpread::kMassWeighted;
-  // Where a frozen tool contact holds its sphere (projection.h).
-  FrozenTarget frozen_target = FrozenTarget::kStepStart;
   // W along each sphere's normal in the ContactSet, one column a sphere
   // ((3k x k), Body::compliance_along), instead of 3x3 blocks: the same
   // solves buy three times the spheres. Ignored with fixed spheres (they
@@ -94,28 +89,6 @@ class ContactStep {
   // Allocates: call at set-up.
   void set_obstacles(std::span<const ObstacleField* const> fields,
                      const ObstacleProjectionSettings& settings = {});
-  bool has_obstacles() const { return obstacles_ != nullptr; }
-
-  // Experimental: the tool as an obstacle the whole body is kept out of,
-  // beside the ContactSet's spheres (which carry the force). The ContactSet
-  // names at most a few dozen spheres (the contact solve's rows and the
-  // held ones) while a pressed blade touches hundreds; the others would
-  // otherwise flow into the blade (the tool obstacle:
-  // docs/design/anatomy-contact.md). `field` (null: off) is the tool where
-  // the haptic side put it:
-  // the caller moves it before each step and tells the step how it moved
-  // (set_tool_motion), so no clearance is kept from one step to the next.
-  // Its pass runs after the spheres' projection in each round, before the
-  // anatomy's; it adds no support springs (W must not feel the tool: the
-  // contact solve is what decides the tool's force). Allocates: call at
-  // set-up.
-  void set_tool_obstacle(const ObstacleField* field);
-  // The tool's rigid motion since the last step, world frame (new pose times
-  // the inverse of the old). A node's path is followed relative to the tool,
-  // from its start carried along by this motion: a thin blade that moved
-  // onto a node then pushes it back out of the face it came through, not
-  // out of the nearer face (through the blade).
-  void set_tool_motion(const Eigen::Isometry3d& new_from_old) { tool_motion_ = new_from_old; }
 
   // One step. `contacts` may be null (no usable ContactSet); `extra_forces_n`
   // (3 per node, N, empty for none) acts in this step only (the penalty
@@ -184,11 +157,6 @@ class ContactStep {
   std::vector<Eigen::Vector3d> free_centres_;
   ProjectionSettings projection_settings_;
   std::unique_ptr<ObstacleProjection> obstacles_;
-  const ObstacleField* tool_field_ = nullptr;
-  std::unique_ptr<ObstacleProjection> tool_pass_;
-  Eigen::Isometry3d tool_motion_ = Eigen::Isometry3d::Identity();
-  std::vector<double>
-      tool_start_;  // the step's start positions carried by the tool's motion, 3 per node, m
   std::unique_ptr<ObstacleSupport> supports_;  // with obstacles_ and a ratio > 0
   std::unique_ptr<VolumeFloor> volume_floor_;  // with a floor ratio > 0
   ProjectionReport projection_;

@@ -82,15 +82,6 @@ struct ObstacleProjectionSettings {
   // until it is home, m (> 0). A node sliding over a bone's ridge has a
   // chord only the ridge's sagitta deep (3 mm over a 5 mm radius: 0.23 mm).
   double beyond_depth_m = 1e-3;
-  // false: a node whose path enters the margin stops where it enters (as if
-  // the bone held it fast). true: the rest of its path slides along the
-  // surface (frictionless). Stopped, a node whose path clips a bone's corner
-  // by micrometres can stay put for seconds; sliding, the tongue recovers
-  // from an overshoot with fewer tets left inverted, but at 100 kPa its
-  // strain grew under the held blade (bench/overshoot;
-  // docs/design/anatomy-contact.md). Off until that is
-  // settled.
-  bool slide_after_entry = false;
 };
 
 class ObstacleProjection {
@@ -120,14 +111,11 @@ class ObstacleProjection {
   int nodes_returned() const { return nodes_returned_; }
   int nodes_beyond() const { return nodes_beyond_; }
 
-  // Nodes moved since begin_step().
-  int nodes_moved() const { return nodes_moved_; }
   // Whether `node` was moved since begin_step(), and the outward unit normal
   // of the obstacle that moved it last (where it put the node).
   bool moved(std::size_t node) const { return moved_[node] != 0; }
   const Eigen::Vector3d& move_normal(std::size_t node) const { return move_normal_[node]; }
   std::size_t node_count() const { return moved_.size(); }
-  std::size_t field_count() const { return fields_.size(); }
   const ObstacleProjectionSettings& settings() const { return settings_; }
 
  private:

@@ -2,44 +2,12 @@
 // constraints are projected on positions by Gauss-Seidel, in the given order.
 #pragma once
 
-#include <cstdint>
 #include <span>
 
 #include "fahr/fem/contact_set.h"
 #include "fahr/fem/sphere_links.h"
 
 namespace fahr::fem {
-
-// How a sphere's centre correction dc is shared by its nodes.
-enum class SphereSpread : std::uint8_t {
-  // Node i moves by (w_i / m_i) dc / sum_j (w_j^2 / m_j): the smallest
-  // mass-weighted move (Algorithm 1 as written). With weights that do not
-  // follow the nodal masses the lightest node takes nearly all of it.
-  kMassWeighted,
-  // Every free node of the sphere moves by the same dc / sum_free w_j: the
-  // sphere's nodes translate together, so no tet among them is deformed,
-  // let alone inverted, by its own sphere's correction, whatever its weights.
-  kTranslation,
-};
-
-// Where a frozen contact holds its sphere.
-enum class FrozenTarget : std::uint8_t {
-  // The sphere's centre at the start of the step, on the FEM's own
-  // positions: the paper's c' = c, "the old position of the sphere". Every
-  // frozen sphere's target comes from one node configuration, so the holds
-  // can all be met at once and the projection settles.
-  kStepStart,
-  // Contact::hold_centre_m, the haptic side's estimate of where the tool
-  // keeps the sphere (contact_response.cpp capture_holds). It is made from
-  // an older state and, without W, a fallback compliance, so on the pressed
-  // neonatal tongue the holds sat millimetres from the FEM's centres and
-  // from each other; pulled to such targets through shared nodes, alternated
-  // with the anatomy, the projection moved a node past the divergence limit
-  // in one step (fahr_overshoot_bench --response force-aware at ae54ed4,
-  // the first frozen step).
-  // Kept to compare.
-  kHoldCentre,
-};
 
 struct ProjectionSettings {
   // Gauss-Seidel sweeps over all constraints at most (one sweep suffices for
@@ -52,12 +20,6 @@ struct ProjectionSettings {
   // of the anatomy (ObstacleProjection) turns this off: those entries are
   // spheres against planes the haptic side found one FEM step earlier.
   bool project_obstacle_contacts = true;
-  // kMassWeighted is the contract's; kTranslation made the neonatal
-  // overshoot run diverge (docs/design/anatomy-contact.md) and is kept to compare.
-  SphereSpread spread = SphereSpread::kMassWeighted;
-  // kStepStart needs the step's start positions (project_contacts'
-  // step_start_m); without them a frozen contact uses its hold centre.
-  FrozenTarget frozen_target = FrozenTarget::kStepStart;
 };
 
 struct ProjectionReport {
@@ -75,9 +37,8 @@ struct ProjectionReport {
   int obstacle_unresolved = 0;      // nodes left inside the margin by the last pass
   int obstacle_non_finite = 0;      // nodes with a non-finite position or sample, left alone
   double obstacle_deepest_m = 0.0;  // deepest node inside an obstacle before its move, m (>= 0)
-  int obstacle_supported =
-      0;               // nodes held by a support spring from the next step on (obstacle_support.h)
-  int tool_nodes = 0;  // node moves out of the tool obstacle (ContactStep::set_tool_obstacle)
+  int obstacle_supported = 0;       // nodes held by a support spring from the next step on
+                                    // (obstacle_support.h)
   // Nodes beyond a bone this step (obstacle_projection.h): let back through
   // it on their way home, and left alone by it.
   int obstacle_returned = 0;
@@ -96,21 +57,21 @@ bool contact_is_projected(const Contact& contact, const ProjectionSettings& sett
 
 // Moves `positions_m` (3 per node) so that every active contact satisfies
 // (c' - q) . n >= r (the sphere, radius included, stays on its side of the
-// rigid surface, which is the plane) and every frozen contact c' = its
-// target (ProjectionSettings::frozen_target; step_start_m: the positions at
-// the start of the step, empty to use the hold centres).
+// rigid surface, which is the plane) and every frozen contact c' = c, its
+// sphere's centre on step_start_m, the positions at the start of the step
+// (the paper's "old position of the sphere": every target comes from one
+// node configuration, so the holds can all be met at once).
 // A correction dc moves node i by (w_i / m_i) dc / sum_j (w_j^2 / m_j):
 // inverse_mass_per_node is 0 for fixed nodes, which therefore never move.
 ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks& links,
                                   std::span<const double> inverse_mass_per_node,
                                   const ProjectionSettings& settings, std::span<double> positions_m,
-                                  std::span<const double> step_start_m = {});
+                                  std::span<const double> step_start_m);
 
 // The correction of one sphere, exposed for tests: returns false if all of
 // its nodes are fixed (nothing can move).
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
                         std::span<const double> inverse_mass_per_node, const Eigen::Vector3d& dc_m,
-                        std::span<double> positions_m,
-                        SphereSpread spread = SphereSpread::kMassWeighted);
+                        std::span<double> positions_m);
 
 }  // namespace fahr::fem

@@ -16,7 +16,14 @@ enum class ContactResponse {
   kPenalty,     // baseline: force proportional to penetration
 };
 
+// What the force-aware tool does while the device has lost track.
+enum class HeldProxy {
+  kLoad,  // stays; the tissue is held by the limited load, force only (default)
+  kStay,  // stays; the spheres are held where the FEM's step found them (the paper's c' = c)
+};
+
 std::string_view to_string(ContactResponse response);
+std::string_view to_string(HeldProxy held);
 
 // Two indices into Scene::bodies, first < second.
 using BodyIndexPair = std::pair<std::size_t, std::size_t>;
@@ -28,6 +35,7 @@ struct ContactSettings {
   // Fraction of the renderable force below which frozen tool constraints
   // re-activate: they do at (1 - hysteresis) * limit, [0, 0.9].
   double force_aware_hysteresis = kDefaultForceAwareHysteresis;
+  HeldProxy held_proxy = HeldProxy::kLoad;
   double penalty_stiffness_npm = kDefaultPenaltyStiffnessNPerM;  // N/m, (0, 1e6]
   // Deformable/obstacle pairs whose world boxes come within this are tested, m, [0, 1].
   double deformable_obstacle_margin_m = kDefaultDeformableObstacleMarginM;

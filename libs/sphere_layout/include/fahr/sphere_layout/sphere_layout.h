@@ -83,7 +83,6 @@ class SphereLayout {
   std::size_t node_count() const { return node_count_; }
   int finest_level() const { return finest_level_; }
   double coarse_radius_m() const { return coarse_radius_m_; }  // level-0 radius, m
-  double max_rest_radius_m() const { return max_rest_radius_m_; }
   std::size_t count(SphereOrigin origin) const;
   std::size_t count_at_level(int level) const;  // grid spheres of one level
 
@@ -102,7 +101,6 @@ class SphereLayout {
   std::size_t node_count_ = 0;
   int finest_level_ = 0;
   double coarse_radius_m_ = 0.0;
-  double max_rest_radius_m_ = 0.0;
 };
 
 // Weights that sum to 1 within this are accepted: they are formed in double

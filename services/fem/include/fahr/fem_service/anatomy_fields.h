@@ -1,8 +1,7 @@
 // The scene's rigid anatomy as the FEM body sees it: each obstacle the body
 // is held out of (the scene plan's hard pairs) as a fem::ObstacleField over
 // the same signed distance field the haptic service builds (libs/runtime),
-// so the FEM keeps its own nodes out of bone in every step. The same adapter,
-// moved each step, gives the tool as an obstacle (ContactStep::set_tool_obstacle).
+// so the FEM keeps its own nodes out of bone in every step.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -25,9 +24,6 @@ class AnatomyField final : public fem::ObstacleField {
   fem::ObstacleSample sample(const Eigen::Vector3d& p_m) const noexcept override;
 
   const runtime::RigidField& field() const { return *field_; }
-  // Moves the body (the tool, which follows the haptic side's proxy; the
-  // anatomy never moves). Not thread-safe against sample().
-  void set_world_from_body(const Eigen::Isometry3d& world_from_body);
 
  private:
   std::unique_ptr<runtime::RigidField> field_;
@@ -35,10 +31,6 @@ class AnatomyField final : public fem::ObstacleField {
   Eigen::Matrix3d world_from_body_rotation_;
   double far_error_m_;  // the grid's error beyond the exact band, m
 };
-
-// The scene's tool as an obstacle field at its scene pose; null when the
-// scene has no tool. Throws std::runtime_error if its field cannot be built.
-std::unique_ptr<AnatomyField> load_tool_field(const scene::Scene& scene);
 
 // Throws std::runtime_error naming the body whose field cannot be built.
 std::vector<std::unique_ptr<AnatomyField>> load_anatomy_fields(const scene::Scene& scene,

@@ -14,10 +14,6 @@ namespace fahr::fem_service {
 
 void to_fem(const msg::ContactSet& wire, fem::ContactSet& out);
 
-// The set's tool pose (world_from_tool); false when it has none (a zero or
-// non-finite quaternion, a non-finite position).
-bool tool_pose(const msg::ContactSet& wire, Eigen::Isometry3d& world_from_tool);
-
 void fill_state(const fem::Body& body, std::uint32_t body_id, msg::DeformationState& out);
 
 }  // namespace fahr::fem_service

@@ -31,21 +31,13 @@ struct FemBodySetup {
   std::vector<std::unique_ptr<AnatomyField>> anatomy;
   fem::ObstacleProjectionSettings anatomy_settings;
   // false: the step leaves the anatomy to the ContactSet's obstacle entries
-  // (the fields stay loaded, for diagnostics); for comparisons.
+  // (the fields stay loaded, for diagnostics); only a benchmark's comparison
+  // sets it (stack_sim::Experiments::haptic_side_anatomy).
   bool enforce_anatomy = true;
-  // How a tool contact's correction moves the sphere's nodes (projection.h).
-  fem::SphereSpread sphere_spread = fem::SphereSpread::kMassWeighted;
-  // Where a frozen tool contact holds its sphere (projection.h).
-  fem::FrozenTarget frozen_target = fem::FrozenTarget::kStepStart;
   // The scene's solver.compliance_columns: normals (ContactStepSettings).
   bool compliance_along_normals = false;
   // The scene's solver.volume_floor_ratio (libs/fem volume_floor.h).
   fem::VolumeFloorSettings volume_floor{};
-  // Experimental (null: off): the tool's field, which the step moves to the
-  // ContactSet's tool pose and keeps the whole body out of
-  // (fem::ContactStep::set_tool_obstacle). Set before the ServiceStep is
-  // made (load_tool_field).
-  std::unique_ptr<AnatomyField> tool;
 };
 
 // Throws std::runtime_error naming the body and what is wrong.

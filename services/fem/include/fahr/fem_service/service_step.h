@@ -49,8 +49,6 @@ class ServiceStep {
   // spent beyond a bone, left alone by it (fem obstacle_projection.h).
   std::uint64_t anatomy_returned() const { return anatomy_returned_; }
   std::uint64_t anatomy_beyond_steps() const { return anatomy_beyond_steps_; }
-  // Deepest a node went into the anatomy before the step moved it out, m.
-  double anatomy_depth_max_m() const { return anatomy_depth_max_m_; }
 
   // The service's own ServiceStatus metrics.
   void metrics(std::vector<std::pair<std::string, double>>& out) const;
@@ -62,11 +60,6 @@ class ServiceStep {
   fem::ContactStep contact_step_;
   fem::ContactSet contacts_;
   bool have_contacts_ = false;
-  // The newest ContactSet's tool pose (setup.tool): where the step puts the
-  // tool obstacle, and where it was at the last step.
-  bool have_tool_pose_ = false;
-  Eigen::Isometry3d world_from_tool_ = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d world_from_tool_at_last_step_ = Eigen::Isometry3d::Identity();
   std::uint64_t applied_contact_seq_ = 0;
   msg::DeformationState state_;
   fem::StepReport last_report_;

@@ -103,9 +103,8 @@ class HapticLoop {
   collision::PrePenetrationMemory tool_memory_;
   collision::ContactBuffer tool_contacts_;
   std::vector<std::uint32_t>
-      order_;  // indices into tool_contacts_, deepest first when over capacity
-  std::vector<double>
-      row_key_;  // per contact: select_rows' key (RowCompliance other than kDeepest)
+      order_;                    // indices into tool_contacts_, deepest first when over capacity
+  std::vector<double> row_key_;  // per contact: select_rows' key (RowCompliance::kFreeDepth)
   // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
   std::vector<collision::TriangleContact> triangle_contacts_;
   std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1

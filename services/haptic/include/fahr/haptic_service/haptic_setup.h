@@ -48,19 +48,12 @@ struct TriangleCollisionSetup {
 // neonatal scene's FEM sends W (and free centres) for 16 of them. kDeepest:
 // the 64 deepest rows; the others are on the response's fallback compliance
 // and their projected centres, and most rows change each FEM state (after
-// its projection the W spheres are the shallowest). kKeep: the spheres the
-// newest state has W for come first, then the deepest of the rest, so the
-// FEM computes W for the same spheres again. kFreeDepth: the deepest, a W
-// sphere's depth taken on its free-motion centre (the published one reads
-// about zero after the FEM's projection; the others were not projected, so
-// theirs is already free): the depths the solve then uses.
-enum class RowCompliance { kDeepest, kKeep, kFreeDepth };
-// "deepest", "keep" or "free" (the benches' --row-compliance); kDeepest otherwise.
-inline RowCompliance row_compliance_named(std::string_view name) {
-  if (name == "keep") return RowCompliance::kKeep;
-  if (name == "free") return RowCompliance::kFreeDepth;
-  return RowCompliance::kDeepest;
-}
+// its projection the W spheres are the shallowest). kFreeDepth: the
+// deepest, a W sphere's depth taken on its free-motion centre (the published
+// one reads about zero after the FEM's projection; the others were not
+// projected, so theirs is already free): the depths the solve then uses.
+// The scene decides (HapticSetup::row_compliance).
+enum class RowCompliance { kDeepest, kFreeDepth };
 
 struct HapticSetup {
   const scene::Scene* scene = nullptr;

@@ -34,40 +34,35 @@
 
 namespace fahr::stack_sim {
 
+// Choices the shipped services do not offer, kept so that a benchmark can
+// rerun a comparison (docs/design/retired-modes.md): only bench code sets
+// them; no scene key or service flag reaches them. The defaults are the
+// services' own behaviour.
+struct Experiments {
+  // The FEM without its own anatomy pass: the haptic side finds the
+  // tongue's obstacle contacts and the FEM projects them, as before the FEM
+  // kept its nodes out of bone (haptic_service::set_up's fem_keeps_anatomy).
+  bool haptic_side_anatomy = false;
+  // Overrides the FEM's anatomy support springs (obstacle_support.h), their
+  // stiffness over the node's diagonal of A; 0 turns them off.
+  std::optional<double> fem_support_ratio;
+  // Overrides the FEM's tool/anatomy alternation rounds per step
+  // (ObstacleProjectionSettings::max_rounds) when > 0.
+  int fem_anatomy_rounds = 0;
+  // The held proxy backs off to keep the tissue at the limit
+  // (contact::HeldProxy::kBackOff) instead of the scene's hold.
+  bool back_off_held_proxy = false;
+  // Overrides HapticSetup::candidate_margin_m when set, m.
+  std::optional<double> candidate_margin_m;
+};
+
 struct StackOptions {
   device::Script script = device::Script::kIntubation;
   // Overshoot script: how far past the device's peak force the hand pulls.
   double overshoot_factor = 3.0;
   haptic_service::CollisionMethod collision = haptic_service::CollisionMethod::kAist;
   std::uint32_t device_id = 0;  // the gateway's default --device-id
-  // The FEM keeps its nodes out of the anatomy itself (the FEM service's
-  // default); false leaves that to the haptic side's obstacle contacts, as
-  // before, for comparison.
-  bool fem_anatomy = true;
-  // Overrides the FEM's anatomy support springs (obstacle_support.h), their
-  // stiffness over the node's diagonal of A; 0 turns them off.
-  std::optional<double> fem_support_ratio;
-  // The FEM's anatomy pass slides a node along the bone after its path
-  // enters the margin (ObstacleProjectionSettings::slide_after_entry).
-  bool fem_anatomy_slide = false;
-  // Overrides the FEM's tool/anatomy alternation rounds per step
-  // (ObstacleProjectionSettings::max_rounds) when > 0.
-  int fem_anatomy_rounds = 0;
-  // Overrides the FEM service's sphere spread (projection.h) when set.
-  std::optional<fem::SphereSpread> sphere_spread;
-  // Overrides the FEM service's frozen target (projection.h) when set.
-  std::optional<fem::FrozenTarget> frozen_target;
-  // What the proxy held while the device has lost track does past the limit
-  // (contact ForceAwareSettings::held_proxy).
-  contact::HeldProxy held_proxy = contact::HeldProxy::kHoldLoad;
-  // Experimental: the FEM keeps the whole tongue out of the tool at the
-  // ContactSet's tool pose (FemBodySetup::tool), not only the set's spheres;
-  // the FEM service's --tool-obstacle.
-  bool fem_tool_obstacle = false;
-  // Overrides HapticSetup::row_compliance (the scene's choice) when set.
-  std::optional<haptic_service::RowCompliance> row_compliance;
-  // Overrides HapticSetup::candidate_margin_m when set, m.
-  std::optional<double> candidate_margin_m;
+  Experiments experiments;
 };
 
 class StackSim {
@@ -90,7 +85,6 @@ class StackSim {
   const msg::DevicePose& pose() const { return pose_; }
   const msg::ForceCommand& command() const { return command_; }
   const msg::ContactSet& contacts() const { return contacts_; }
-  const msg::DeformationState& fem_state() const { return fem_->state(); }
   bool fem_stepped() const { return fem_stepped_; }  // in the last step
 
   const fem::Body& body() const { return *fem_setup_.body; }

@@ -73,7 +73,6 @@ class LockstepRun {
            const std::function<void(const TickRecord&)>& observe);
 
   ContactResponse& response() { return response_; }
-  std::uint64_t tick_index() const { return tick_; }
 
  private:
   void haptic_tick(const Eigen::Vector3d& device_m, TickRecord& record);

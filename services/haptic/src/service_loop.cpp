@@ -1,0 +1,177 @@
+// The haptic service's run over DDS (see service_loop.h).
+#include "fahr/haptic_service/service_loop.h"
+
+#include <chrono>
+#include <cstdio>
+#include <optional>
+
+#include "fahr/common/background_publisher.h"
+#include "fahr/common/clock.h"
+#include "fahr/common/lockstep.h"
+#include "fahr/common/publisher.h"
+#include "fahr/common/realtime.h"
+#include "fahr/common/stop_signal.h"
+#include "fahr/common/subscriber.h"
+#include "fahr/haptic_service/run_report.h"
+#include "fahr/haptic_service/tissue_snapshot.h"
+
+namespace fahr::haptic_service {
+
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop& loop,
+                  common::TickRecorder& recorder, double duration_s, const WaitPolicy& wait) {
+  common::Subscriber<msg::DevicePose> poses(participant);
+  common::Publisher<msg::ForceCommand> commands(participant);
+  // The ContactSet's write (tens of microseconds: serialisation and send)
+  // leaves the tick for a thread of its own, which looks for a new set
+  // every 0.5 ms; the FEM takes the newest set at its own rate (5 ms) anyway.
+  // The ForceCommand, which the gateway's servo loop waits on, is written
+  // on the tick.
+  common::BackgroundPublisher<msg::ContactSet> contact_sets(participant, 500us, [] {
+    msg::ContactSet contacts;
+    contacts.contacts().reserve(msg::MAX_CONTACTS);
+    return contacts;
+  });
+  msg::ForceCommand command;
+  const auto start = Clock::now();
+  const auto duration = std::chrono::duration<double>(duration_s);
+  RunReport report;
+  if (wait.rt_priority > 0) {
+    // Opt-in; without the privilege the loop runs on as before.
+    const std::string refused = common::request_realtime_priority(wait.rt_priority);
+    std::printf("fahr_haptic_service: real-time priority %d: %s\n", wait.rt_priority,
+                refused.empty() ? "granted" : refused.c_str());
+  }
+  std::uint64_t seen = 0;
+  std::uint64_t tick = 0;
+  std::uint64_t polls = 0;
+  while (!common::stop_requested()) {
+    if (wait.spin) {
+      // Check the clock and the stop flag every 4096 polls only.
+      if ((++polls & 4095u) == 0 && duration_s > 0 && Clock::now() - start > duration) break;
+      if (!poses.fetch_newest()) continue;
+    } else {
+      if (duration_s > 0 && Clock::now() - start > duration) break;
+      // 50 ms: short enough to notice a stop request, long enough not to spin.
+      seen = poses.wait_for_samples(seen, 50ms);
+      if (!poses.fetch_newest()) continue;
+    }
+    const std::int64_t t0 = common::monotonic_now_ns();
+    const std::int64_t c0 = common::thread_cpu_now_ns();
+    loop.tick(poses.newest(), feed.newest(), command, contact_sets.back());
+    const std::int64_t c1 = common::thread_cpu_now_ns();
+    commands.write(command);
+    contact_sets.publish();
+    const std::int64_t c2 = common::thread_cpu_now_ns();
+    recorder.push({tick++, t0, common::monotonic_now_ns() - t0, c2 - c0});
+    report.record(t0, c0, c1, c2, loop.last_phases());
+  }
+  report.print(contact_sets.handed(), contact_sets.written(), contact_sets.refused(),
+               feed.metrics());
+}
+
+// One tick per granted base step (the haptic rate is the base rate). At
+// step k the pose is the gateway's of step k-1 and the tissue the FEM's
+// newest step before k (common/lockstep.h); step 0 has no pose yet and
+// answers with no force, so the gateway's step 1 has a command to read.
+int run_lockstep(common::Participant& participant, const HapticSetup& setup, HapticLoop& loop,
+                 common::TickRecorder& recorder) {
+  const scene::Scene& scene = *setup.scene;
+  const auto base = scene.run.base_period;
+  const auto haptic_steps = static_cast<std::uint64_t>(scene.rates.haptic_period() / base);
+  const auto fem_steps = static_cast<std::uint64_t>(scene.rates.fem_period() / base);
+  if (haptic_steps != 1) {
+    std::fprintf(
+        stderr,
+        "fahr_haptic_service: lockstep needs the haptic rate to be the base rate (%.0f Hz)\n",
+        1e9 / static_cast<double>(base.count()));
+    return 2;
+  }
+  common::StepInput<msg::DevicePose> poses(participant);
+  common::StepInput<msg::DeformationState> states(participant);
+  common::Publisher<msg::ForceCommand> commands(participant,
+                                                common::lockstep_output_qos<msg::ForceCommand>());
+  common::Publisher<msg::ContactSet> contact_sets(participant,
+                                                  common::lockstep_output_qos<msg::ContactSet>());
+  common::LockstepClient client(participant, "haptic");
+  client.join();
+  TissueDigest digest(setup);
+  TissueSnapshot tissue = digest.make_snapshot();
+  msg::ForceCommand command;
+  msg::ContactSet contacts;
+  contacts.contacts().reserve(msg::MAX_CONTACTS);
+  contacts.body_id(setup.deformable->id);
+  common::OutputHash hash;
+  std::optional<std::uint64_t> digested_fem_step;
+  for (std::uint64_t k = 0; !common::stop_requested() && client.wait_for_grant(k, 60s); ++k) {
+    const std::int64_t t0 = common::monotonic_now_ns();
+    const std::int64_t c0 = common::thread_cpu_now_ns();
+    if (const auto f = common::producer_step_for(k, fem_steps); f && f != digested_fem_step) {
+      const msg::DeformationState* state = states.wait(*f, 60s);
+      if (state == nullptr) {
+        std::fprintf(stderr, "fahr_haptic_service: DeformationState of FEM step %llu never came\n",
+                     static_cast<unsigned long long>(*f));
+        return 1;
+      }
+      if (!digest.digest(*state, tissue)) {
+        std::fprintf(
+            stderr,
+            "fahr_haptic_service: DeformationState of FEM step %llu does not fit the mesh\n",
+            static_cast<unsigned long long>(*f));
+        return 1;
+      }
+      digested_fem_step = f;
+    }
+    if (const auto p = common::producer_step_for(k, 1)) {
+      const msg::DevicePose* pose = poses.wait(*p, 60s);
+      if (pose == nullptr) {
+        std::fprintf(stderr, "fahr_haptic_service: DevicePose of step %llu never came\n",
+                     static_cast<unsigned long long>(*p));
+        return 1;
+      }
+      loop.tick(*pose, tissue, command, contacts);
+    }
+    command.header().sim_step(k);
+    command.header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+    contacts.header().sim_step(k);
+    contacts.header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+    commands.write(command);
+    contact_sets.write(contacts);
+    hash.add(command);
+    hash.add(contacts);
+    recorder.push({k, t0, common::monotonic_now_ns() - t0, common::thread_cpu_now_ns() - c0});
+    client.complete_through(k, hash.value());
+  }
+  std::printf("fahr_haptic_service: lockstep output hash %016llx\n",
+              static_cast<unsigned long long>(hash.value()));
+  return 0;
+}
+
+void print_ready_line(const common::Participant& participant, const HapticSetup& setup,
+                      const std::string& collision, bool lockstep, double setup_s) {
+  std::printf(
+      "fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres), tool '%s' (%zu surface "
+      "samples), "
+      "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s\n",
+      std::string(common::vendor_name(participant.vendor())).c_str(),
+      setup.deformable->name.c_str(), setup.mesh.node_count(), setup.layout.size(),
+      setup.tool->scene_body->name.c_str(), setup.tool_samples.points_m().size(),
+      setup.tissue_obstacles.size(), setup.tool_obstacles.size(), collision.c_str(),
+      setup.scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s);
+}
+
+void print_end_line(const HapticLoop& loop) {
+  const auto& m = loop.metrics();
+  std::printf(
+      "fahr_haptic_service: %llu ticks on %llu FEM states, lost-track episodes %llu, peak |F| %.3f "
+      "N, "
+      "worst tick %.0f us\n",
+      static_cast<unsigned long long>(m.ticks.load()),
+      static_cast<unsigned long long>(m.snapshots.load()),
+      static_cast<unsigned long long>(m.lost_track_episodes.load()), m.peak_force_n.load(),
+      m.tick_us_peak.load());
+}
+
+}  // namespace fahr::haptic_service
