@@ -141,14 +141,20 @@ int run(int argc, char** argv) {
        scene->rates.status_period() > 0ns
            ? std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period())
            : 250ms},
-      recorder, [&](auto& metrics) { fem_step.metrics(metrics); });
+      recorder, [&](auto& metrics) { fem_step.metrics(metrics); },
+      [&](auto& errors) {
+        // Refused ContactSets: said here, off the step, once per change.
+        if (std::string error = fem_step.layout_check().take_error(); !error.empty())
+          errors.push_back(std::move(error));
+      });
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // launchers wait for the start line
   std::printf(
-      "fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres), %.0f Hz, "
-      "%s\n",
+      "fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres, layout "
+      "0x%016llx), %.0f Hz, %s\n",
       std::string(common::vendor_name(participant.vendor())).c_str(),
       setup.scene_body->name.c_str(), setup.mesh.node_count(), setup.mesh.tet_count(),
-      setup.fixed_nodes.size(), setup.links.size(), scene->rates.fem_hz,
+      setup.fixed_nodes.size(), setup.links.size(),
+      static_cast<unsigned long long>(setup.layout_fingerprint), scene->rates.fem_hz,
       lockstep ? "lockstep" : "realtime");
   reporter.set_state(msg::SERVICE_RUNNING);
   const int status = lockstep ? run_lockstep(participant, fem_step, *scene, recorder)
@@ -156,10 +162,11 @@ int run(int argc, char** argv) {
   reporter.set_state(msg::SERVICE_STOPPING);
   reporter.report();
   std::printf(
-      "fahr_fem_service: %llu steps, stale contact sets %llu, max inverted elements %llu, "
-      "resets after divergence %llu\n",
+      "fahr_fem_service: %llu steps, stale contact sets %llu, refused (another sphere layout) "
+      "%llu, max inverted elements %llu, resets after divergence %llu\n",
       static_cast<unsigned long long>(setup.body->step_index()),
       static_cast<unsigned long long>(fem_step.stale_sets()),
+      static_cast<unsigned long long>(fem_step.layout_check().refused()),
       static_cast<unsigned long long>(fem_step.inverted_max()),
       static_cast<unsigned long long>(fem_step.divergence_resets()));
   return status;

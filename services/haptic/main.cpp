@@ -187,6 +187,7 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
   msg::ContactSet contacts;
   contacts.contacts().reserve(msg::MAX_CONTACTS);
   contacts.body_id(setup.deformable->id);
+  contacts.layout_fingerprint(loop.layout_fingerprint());  // step 0 answers with no tick
   common::OutputHash hash;
   std::optional<std::uint64_t> digested_fem_step;
   for (std::uint64_t k = 0; !common::stop_requested() && client.wait_for_grant(k, 60s); ++k) {
@@ -285,11 +286,12 @@ int run(int argc, char** argv) {
   for (auto& d : descriptions) scene_out.write(d);
 
   std::printf(
-      "fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres), tool '%s' (%zu surface "
-      "samples), "
+      "fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres, layout 0x%016llx), "
+      "tool '%s' (%zu surface samples), "
       "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s\n",
       std::string(common::vendor_name(participant.vendor())).c_str(),
       setup.deformable->name.c_str(), setup.mesh.node_count(), setup.layout.size(),
+      static_cast<unsigned long long>(loop.layout_fingerprint()),
       setup.tool->scene_body->name.c_str(), setup.tool_samples.points_m().size(),
       setup.tissue_obstacles.size(), setup.tool_obstacles.size(), collision.c_str(),
       scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s);

@@ -91,6 +91,7 @@ FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body) {
   setup.volume_floor.ratio = scene.solver.volume_floor_ratio;
   const sphere_layout::SphereLayout layout =
       sphere_layout::fill_spheres(setup.mesh, runtime::fill_settings_for(body));
+  setup.layout_fingerprint = layout.fingerprint();
   try {
     setup.links = layout_links::to_fem_links(layout);
   } catch (const std::invalid_argument& e) {
