@@ -10,6 +10,9 @@ build="${FAHR_BUILD_DIR:-$root/build}"
 bash "$root/tools/setup.sh"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DFAHR_WERROR="${FAHR_WERROR:-ON}"
 cmake --build "$build" -j2
+# The dependency rules, on CMake's link graph: no FEM target nor the shared
+# runtime reaches the collision library or Bullet, no library a service.
+bash "$root/tools/check_deps.sh" "$build"
 # Multi-process tests are RUN_SERIAL (they measure timing); the rest share the cores.
 ctest --test-dir "$build" --output-on-failure -j2
 if [ -x "$root/tools/run_fuzzers.sh" ]; then

@@ -22,6 +22,7 @@
 #include "fahr/collision/field_grid.h"
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
+#include "fahr/layout_links/fem_links.h"
 #include "fahr/sphere_layout/fill_spheres.h"
 #include "sections.h"
 #include "sphere_contact_set.h"
@@ -142,7 +143,7 @@ std::size_t select_rows(const collision::SphereTree& tree, const collision::Rigi
 void record_states(const Scene& scene, const Options& options, const std::string& path) {
   const sphere_layout::SphereLayout layout =
       sphere_layout::fill_spheres(scene.tongue, trajectory_fill(options));
-  const fem::SphereLinks links = to_fem_links(layout, options.skin_m);
+  const fem::SphereLinks links = layout_links::to_fem_links(layout, options.skin_m);
   auto body = make_tongue_body(scene);
   collision::SphereState state(layout);
   collision::SphereTree tree(layout);

@@ -143,14 +143,4 @@ std::unique_ptr<fem::Body> make_tongue_body(const Scene& scene) {
   return std::move(made.body);
 }
 
-fem::SphereLinks to_fem_links(const sphere_layout::SphereLayout& layout, double skin_m) {
-  fem::SphereLinks links;
-  for (std::size_t i = 0; i < layout.size(); ++i) {
-    const std::string error = links.add_sphere(layout.nodes(i), layout.weights(i),
-                                               layout.sphere(i).rest_radius_m + skin_m);
-    if (!error.empty()) throw std::runtime_error("sphere links: " + error);
-  }
-  return links;
-}
-
 }  // namespace fahr::aist_bench

@@ -9,11 +9,9 @@
 #include <vector>
 
 #include "fahr/fem/body.h"
-#include "fahr/fem/sphere_links.h"
 #include "fahr/geometry/signed_distance_field.h"
 #include "fahr/geometry/surface_mesh.h"
 #include "fahr/geometry/tet_mesh.h"
-#include "fahr/sphere_layout/sphere_layout.h"
 
 namespace fahr::aist_bench {
 
@@ -49,9 +47,5 @@ Eigen::Isometry3d blade_pose(const Scene& scene, double s, double lever_depth_m)
 // The FEM body of the tongue: gravity -x (supine), CHOLMOD on the rest matrix
 // (factorised once) so a step costs a solve, not a factorisation.
 std::unique_ptr<fem::Body> make_tongue_body(const Scene& scene);
-
-// The sphere layout as the FEM's SphereLinks.
-// skin_m is added to every radius (the AIST contact skin).
-fem::SphereLinks to_fem_links(const sphere_layout::SphereLayout& layout, double skin_m);
 
 }  // namespace fahr::aist_bench

@@ -11,6 +11,7 @@
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
 #include "fahr/collision/triangle_baseline.h"
+#include "fahr/layout_links/fem_links.h"
 #include "fahr/sphere_layout/coverage.h"
 #include "fahr/sphere_layout/fill_spheres.h"
 #include "sections.h"
@@ -76,7 +77,7 @@ Row run(const Scene& scene, const Options& options, double ratio, int levels,
                          .hausdorff_m() *
                      1e3;
   collision::SphereTree tree(layout);
-  const fem::SphereLinks links = to_fem_links(layout, options.skin_m);
+  const fem::SphereLinks links = layout_links::to_fem_links(layout, options.skin_m);
   auto body = make_tongue_body(scene);
   collision::PrePenetrationMemory memory(layout.size());
   collision::ContactBuffer buffer(8192);

@@ -15,6 +15,7 @@
 #include "fahr/collision/sphere_query.h"
 #include "fahr/collision/sphere_tree.h"
 #include "fahr/collision/triangle_baseline.h"
+#include "fahr/layout_links/fem_links.h"
 #include "fahr/sphere_layout/fill_spheres.h"
 #include "node_metrics.h"
 #include "sections.h"
@@ -119,7 +120,7 @@ collision::QuerySettings trajectory_query(const Options& options) {
 void trajectory_table(const Scene& scene, const Options& options) {
   const sphere_layout::FillSettings fill = trajectory_fill(options);
   const sphere_layout::SphereLayout layout = sphere_layout::fill_spheres(scene.tongue, fill);
-  const fem::SphereLinks links = to_fem_links(layout, options.skin_m);
+  const fem::SphereLinks links = layout_links::to_fem_links(layout, options.skin_m);
   auto body = make_tongue_body(scene);
   std::vector<double> rest;
   for (const auto& p : scene.tongue.rest_positions())

@@ -11,8 +11,8 @@ namespace fahr::collision {
 namespace {
 
 TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
-  const auto& mesh = test::neonatal_tongue();
-  const sphere_layout::SphereLayout& layout = test::neonatal_layout();
+  const auto& mesh = fahr::test::neonatal_tongue();
+  const sphere_layout::SphereLayout& layout = fahr::test::neonatal_layout();
   SphereState state(layout);
   SphereTree tree(layout);
   std::vector<double> rest;
@@ -21,7 +21,7 @@ TEST(Allocation, UpdateRefitAndQueryAllocateNothing) {
   geometry::SdfOptions options;
   options.cell_size_m = 1e-3;
   const geometry::SignedDistanceField slab(
-      test::box_surface({-0.06, -0.04, -0.02}, {0.0, -0.005, 0.02}), options);
+      fahr::test::box_surface({-0.06, -0.04, -0.02}, {0.0, -0.005, 0.02}), options);
   const FieldGrid slab_grid(slab);
   RigidBody body{0, &slab, Eigen::Isometry3d::Identity()};
   PrePenetrationMemory memory(layout.size());

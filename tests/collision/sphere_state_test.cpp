@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -57,6 +58,26 @@ TEST(SphereState, SmallestStretchRuleRefusesShortRestPositions) {
       sphere_layout::fill_spheres(mesh, sphere_layout::FillSettings{});
   const std::vector<double> too_short(3, 0.0);
   EXPECT_THROW(SphereState(layout, too_short), std::invalid_argument);
+}
+
+TEST(SphereState, RestStateCentresFollowTheNodes) {
+  // A rigid translation of every node moves every centre by the same amount
+  // and keeps every radius.
+  const auto& mesh = test::neonatal_tongue();
+  const sphere_layout::SphereLayout& layout = test::neonatal_layout();
+  const Eigen::Vector3d shift(0.002, -0.001, 0.0005);
+  std::vector<double> x;
+  for (const auto& p : mesh.rest_positions()) {
+    for (int a = 0; a < 3; ++a) x.push_back(p[a] + shift[a]);
+  }
+  SphereState state(layout);
+  ASSERT_TRUE(state.update(layout, x));
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    ASSERT_LT((state.centres_m()[i] - layout.sphere(i).rest_centre_m - shift).norm(), 1e-12);
+    ASSERT_NEAR(state.radii_m()[i], layout.sphere(i).rest_radius_m, 1e-12);
+  }
+  x[0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(state.update(layout, x)) << "a NaN position is refused";
 }
 
 }  // namespace

@@ -134,6 +134,7 @@ void fill(msg::ContactSet& s, std::uint64_t seed, std::size_t n) {
   s.body_id(v.u32());
   s.haptic_tick(v.u64());
   s.fem_step(v.u64());
+  s.layout_fingerprint(v.u64());
   s.tool_frozen(v.flag());
   s.contacts().resize(std::min<std::size_t>(n, msg::MAX_CONTACTS));
   for (auto& c : s.contacts()) {
@@ -175,6 +176,7 @@ void fill(msg::SceneDescription& s, std::uint64_t seed, std::size_t n) {
   s.body_name(v.text(12));
   s.role(v.pick<msg::BodyRole>(3));
   s.mesh_uri(v.text(40));
+  s.layout_fingerprint(v.u64());
   const std::string text = v.text(std::min<std::size_t>(n * 8, msg::MAX_SCENE_TEXT));
   s.scene_text_utf8().assign(text.begin(), text.end());
   v.floats(s.rest_positions_m(), 3 * n);
@@ -231,6 +233,11 @@ void fill(msg::ServiceEvents& s, std::uint64_t seed, std::size_t n) {
     t.start_ns(v.i64());
     t.duration_ns(v.i64());
     t.cpu_ns(v.i64());
+  }
+  s.errors().resize(std::min<std::size_t>(n, 8));
+  for (auto& e : s.errors()) {
+    e.time_ns(v.i64());
+    e.text(v.text(120));
   }
 }
 

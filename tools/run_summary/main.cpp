@@ -1,8 +1,9 @@
 // fahr_run_summary: listens to a running co-simulation for a fixed time and
 // prints what a training-lab run should be judged by: each service's rate,
-// late periods and tick CPU time, deadline misses from its ServiceEvents,
-// motion-to-force latency (from the gateway's metrics), peak force against
-// the device's limit and lost-track episodes (from ForceCommand).
+// late periods and tick CPU time, deadline misses and errors from its
+// ServiceEvents, motion-to-force latency (from the gateway's metrics), peak
+// force against the device's limit and lost-track episodes (from
+// ForceCommand).
 //
 //   fahr_run_summary --duration-s S [--dds V] [--domain N] [--dds-profile F]
 #include <CLI/CLI.hpp>
@@ -12,7 +13,10 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <set>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "fahr/common/config_error.h"
 #include "fahr/common/subscriber.h"
@@ -32,6 +36,10 @@ struct ServiceTally {
   std::int64_t worst_period_max_ns = 0;
   std::map<std::string, double> metrics;  // newest value of each
   std::map<int, long> qos_events;         // kind -> count
+  std::vector<std::string> errors;        // as reported, oldest first
+  // (writer, seq) of the ServiceEvents that carried errors: a sample the
+  // transport delivers twice adds its errors once.
+  std::set<std::pair<std::uint32_t, std::uint64_t>> error_samples;
 };
 
 struct Tally {
@@ -95,6 +103,15 @@ void print(const Tally& t, double duration_s) {
       }
     }
   }
+  // Only when there were any, so a clean run's summary is as before.
+  bool heading = false;
+  for (const auto& [name, s] : t.services) {
+    for (const std::string& error : s.errors) {
+      if (!heading) std::printf("\nErrors the services reported:\n\n");
+      heading = true;
+      std::printf("- %s: %s\n", name.c_str(), error.c_str());
+    }
+  }
 }
 
 }  // namespace
@@ -146,6 +163,10 @@ int main(int argc, char** argv) {
           auto& t = tally.services[e.service_name().to_string()];
           for (const auto& q : e.qos_events())
             t.qos_events[q.kind()] += std::max(q.total_count_change(), 0);
+          if (!e.errors().empty() &&
+              t.error_samples.emplace(e.header().writer_id(), e.header().seq()).second) {
+            for (const auto& error : e.errors()) t.errors.push_back(error.text().to_string());
+          }
         });
     common::Subscriber<msg::ForceCommand> commands(
         participant, common::QosProfile::for_role(common::TopicRole::kServoStream),

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <numeric>
 
 #include "fahr/common/clock.h"
@@ -32,6 +33,8 @@ namespace {
 constexpr std::size_t kMaxSpansPerReport = 1024;
 constexpr std::size_t kMaxQosEventsPerReport = 128;
 constexpr std::size_t kMaxMetrics = 32;
+constexpr std::size_t kMaxErrorsPerReport = 8;
+constexpr std::size_t kMaxErrorChars = 200;
 
 msg::QosEventKind to_msg(EventKind kind) {
   return static_cast<msg::QosEventKind>(static_cast<int>(kind));
@@ -45,11 +48,12 @@ std::string host_name() {
 }  // namespace
 
 ServiceReporter::ServiceReporter(Participant& participant, ReporterSettings settings,
-                                 TickRecorder& ticks, MetricsSource metrics)
+                                 TickRecorder& ticks, MetricsSource metrics, ErrorSource errors)
     : participant_(participant),
       settings_(std::move(settings)),
       recorder_(ticks),
       metrics_(std::move(metrics)),
+      errors_(std::move(errors)),
       status_(participant),
       events_(participant),
       last_report_ns_(monotonic_now_ns()),
@@ -157,6 +161,19 @@ void ServiceReporter::report() {
         q.not_alive_count(e.not_alive_count);
         events.qos_events().push_back(q);
       }));
+  error_texts_.clear();
+  if (errors_) errors_(error_texts_);
+  for (const std::string& text : error_texts_) {
+    std::fprintf(stderr, "%s: %s\n", settings_.service_name.c_str(), text.c_str());
+    if (events.errors().size() >= kMaxErrorsPerReport) {
+      ++dropped_events;
+      continue;
+    }
+    msg::ServiceError error;
+    error.time_ns(wall_now_ns());
+    error.text(text.substr(0, kMaxErrorChars));
+    events.errors().push_back(error);
+  }
   events.dropped_events(dropped_events);
   events.dropped_spans(dropped_spans);
   events.tick_spans(spans_);

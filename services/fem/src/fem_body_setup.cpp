@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fahr/layout_links/fem_links.h"
 #include "fahr/runtime/scene_bodies.h"
 #include "fahr/sphere_layout/fill_spheres.h"
 
@@ -90,10 +91,11 @@ FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body) {
   setup.volume_floor.ratio = scene.solver.volume_floor_ratio;
   const sphere_layout::SphereLayout layout =
       sphere_layout::fill_spheres(setup.mesh, runtime::fill_settings_for(body));
-  for (std::size_t i = 0; i < layout.size(); ++i) {
-    const std::string error =
-        setup.links.add_sphere(layout.nodes(i), layout.weights(i), layout.sphere(i).rest_radius_m);
-    if (!error.empty()) throw std::runtime_error("body '" + body.name + "': " + error);
+  setup.layout_fingerprint = layout.fingerprint();
+  try {
+    setup.links = layout_links::to_fem_links(layout);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("body '" + body.name + "': " + e.what());
   }
   std::vector<fem::Tet> tets;
   tets.reserve(setup.mesh.tet_count());

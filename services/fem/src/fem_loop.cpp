@@ -107,20 +107,22 @@ int run_lockstep(common::Participant& participant, ServiceStep& fem_step, const 
 void print_start_line(const common::Participant& participant, const FemBodySetup& setup,
                       const scene::Scene& scene, bool lockstep) {
   std::printf(
-      "fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres), %.0f Hz, "
-      "%s\n",
+      "fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres, layout "
+      "0x%016llx), %.0f Hz, %s\n",
       std::string(common::vendor_name(participant.vendor())).c_str(),
       setup.scene_body->name.c_str(), setup.mesh.node_count(), setup.mesh.tet_count(),
-      setup.fixed_nodes.size(), setup.links.size(), scene.rates.fem_hz,
+      setup.fixed_nodes.size(), setup.links.size(),
+      static_cast<unsigned long long>(setup.layout_fingerprint), scene.rates.fem_hz,
       lockstep ? "lockstep" : "realtime");
 }
 
 void print_end_line(const ServiceStep& fem_step) {
   std::printf(
-      "fahr_fem_service: %llu steps, stale contact sets %llu, max inverted elements %llu, "
-      "resets after divergence %llu\n",
+      "fahr_fem_service: %llu steps, stale contact sets %llu, refused (another sphere layout) "
+      "%llu, max inverted elements %llu, resets after divergence %llu\n",
       static_cast<unsigned long long>(fem_step.setup().body->step_index()),
       static_cast<unsigned long long>(fem_step.stale_sets()),
+      static_cast<unsigned long long>(fem_step.layout_check().refused()),
       static_cast<unsigned long long>(fem_step.inverted_max()),
       static_cast<unsigned long long>(fem_step.divergence_resets()));
 }

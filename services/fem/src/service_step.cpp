@@ -27,7 +27,8 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
                                    .max_compliance_spheres = setup.settings.max_compliance_spheres,
                                    .compliance_along_normals = setup.compliance_along_normals,
                                    .divergence_limit_m = divergence_limit_m(setup.mesh),
-                                   .volume_floor = setup.volume_floor}) {
+                                   .volume_floor = setup.volume_floor}),
+      layout_check_(setup.layout_fingerprint) {
   const std::size_t cap = setup.settings.max_compliance_spheres;
   std::vector<const fem::ObstacleField*> anatomy;
   if (setup.enforce_anatomy) {
@@ -44,6 +45,13 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
 }
 
 void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
+  if (!layout_check_.accept(wire.layout_fingerprint())) {
+    // Its sphere ids name other spheres: nothing of it is applied, nor the
+    // set before it (which it supersedes).
+    have_contacts_ = false;
+    have_tool_pose_ = false;
+    return;
+  }
   to_fem(wire, contacts_);
   have_contacts_ = true;
   applied_contact_seq_ = seq;
@@ -91,6 +99,7 @@ void ServiceStep::fill_compliance() {
 
 void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) const {
   out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets_));
+  out.emplace_back("layout_refused_sets", static_cast<double>(layout_check_.refused()));
   out.emplace_back("compliance_reuses", static_cast<double>(contact_step_.compliance_reuses()));
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));
   out.emplace_back("divergence_resets", static_cast<double>(divergence_resets_));

@@ -62,6 +62,7 @@ std::size_t keep_deepest(std::vector<std::uint32_t>& indices, std::size_t n, std
 
 HapticLoop::HapticLoop(const HapticSetup& setup)
     : setup_(setup),
+      layout_fingerprint_(setup.layout.fingerprint()),
       nominal_period_s_(1.0 / setup.scene->rates.haptic_hz),
       response_(setup.response),
       penalty_(setup.penalty_settings),
@@ -326,6 +327,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   contacts.body_id(setup_.deformable->id);
   contacts.haptic_tick(tick_);
   contacts.fem_step(tissue.fem_step);
+  contacts.layout_fingerprint(layout_fingerprint_);
   if (setup_.penalty) {
     contacts.tool_frozen(false);
     fill_contacts({penalty_contacts_.data(), penalty_count_}, tool_body_.id,

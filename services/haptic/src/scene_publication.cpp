@@ -29,6 +29,7 @@ void describe_deformable(const HapticSetup& setup, msg::SceneDescription& d) {
     for (auto n : f.nodes) d.triangles().push_back(static_cast<std::uint32_t>(n));
   }
   const auto& layout = setup.layout;
+  d.layout_fingerprint(layout.fingerprint());
   for (std::size_t i = 0; i < layout.size(); ++i) {
     const auto& s = layout.sphere(i);
     for (int k = 0; k < 3; ++k) d.sphere_rest_m().push_back(static_cast<float>(s.rest_centre_m[k]));

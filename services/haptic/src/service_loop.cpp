@@ -103,6 +103,7 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
   msg::ContactSet contacts;
   contacts.contacts().reserve(msg::MAX_CONTACTS);
   contacts.body_id(setup.deformable->id);
+  contacts.layout_fingerprint(setup.layout.fingerprint());  // step 0 answers with no tick
   common::OutputHash hash;
   std::optional<std::uint64_t> digested_fem_step;
   for (std::uint64_t k = 0; !common::stop_requested() && client.wait_for_grant(k, 60s); ++k) {
@@ -152,11 +153,12 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
 void print_ready_line(const common::Participant& participant, const HapticSetup& setup,
                       const std::string& collision, bool lockstep, double setup_s) {
   std::printf(
-      "fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres), tool '%s' (%zu surface "
-      "samples), "
+      "fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres, layout 0x%016llx), "
+      "tool '%s' (%zu surface samples), "
       "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s\n",
       std::string(common::vendor_name(participant.vendor())).c_str(),
       setup.deformable->name.c_str(), setup.mesh.node_count(), setup.layout.size(),
+      static_cast<unsigned long long>(setup.layout.fingerprint()),
       setup.tool->scene_body->name.c_str(), setup.tool_samples.points_m().size(),
       setup.tissue_obstacles.size(), setup.tool_obstacles.size(), collision.c_str(),
       setup.scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s);

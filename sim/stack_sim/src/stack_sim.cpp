@@ -63,6 +63,9 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   next_contacts_.contacts().reserve(msg::MAX_CONTACTS);
   contacts_.body_id(haptic_setup_.deformable->id);
   next_contacts_.body_id(haptic_setup_.deformable->id);
+  // As the haptic service's lockstep loop: step 0 answers with no tick.
+  contacts_.layout_fingerprint(haptic_->layout_fingerprint());
+  next_contacts_.layout_fingerprint(haptic_->layout_fingerprint());
   pose_.device_id(options.device_id);
 }
 

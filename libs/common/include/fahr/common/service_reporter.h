@@ -1,8 +1,8 @@
 // Publishes a service's ServiceStatus and ServiceEvents from its own
 // thread: tick statistics from a TickRecorder (percentiles of period, work
 // time and CPU time; periods longer than 1.5x nominal counted as late), the
-// transport's QoS events, and service-specific metrics. Nothing here runs in
-// the service's loop except TickRecorder::push.
+// transport's QoS events, service-specific metrics and errors. Nothing here
+// runs in the service's loop except TickRecorder::push.
 #pragma once
 
 #include <atomic>
@@ -27,11 +27,18 @@ struct ReporterSettings {
 
 // Adds service-specific figures (name with unit suffix, value) to a report.
 using MetricsSource = std::function<void(std::vector<std::pair<std::string, double>>& metrics)>;
+// Adds the errors the service has seen since the previous report, each one
+// sentence, said once (the source keeps track of what it already gave).
+// Called on the reporter's thread: a source that formats text here keeps
+// the formatting, and its allocations, off the service's loop.
+using ErrorSource = std::function<void(std::vector<std::string>& errors)>;
 
 class ServiceReporter {
  public:
+  // Each error of `errors` goes out in the next ServiceEvents and on stderr
+  // as "<service_name>: <error>".
   ServiceReporter(Participant& participant, ReporterSettings settings, TickRecorder& ticks,
-                  MetricsSource metrics = {});
+                  MetricsSource metrics = {}, ErrorSource errors = {});
   ~ServiceReporter();
   ServiceReporter(const ServiceReporter&) = delete;
   ServiceReporter& operator=(const ServiceReporter&) = delete;
@@ -49,6 +56,8 @@ class ServiceReporter {
   ReporterSettings settings_;
   TickRecorder& recorder_;
   MetricsSource metrics_;
+  ErrorSource errors_;
+  std::vector<std::string> error_texts_;
   std::atomic<msg::ServiceState> state_{msg::SERVICE_STARTING};
   Publisher<msg::ServiceStatus> status_;
   Publisher<msg::ServiceEvents> events_;

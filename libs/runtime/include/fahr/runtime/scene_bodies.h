@@ -1,7 +1,7 @@
 // What every service builds alike from a scene body, so the FEM and haptic
 // services agree exactly: the tet mesh in the world frame and the AIST
 // filling settings (the same deterministic filling gives the same sphere
-// ids in both processes, with no handshake).
+// ids in both processes; the ContactSet's layout fingerprint checks it).
 #pragma once
 
 #include "fahr/geometry/tet_mesh.h"

@@ -1,10 +1,12 @@
 // Builds a scene's deformable body for the FEM service: the tet mesh in the
-// world frame, fixed nodes, FEM settings from the scene, and the AIST
-// sphere links the ContactSets refer to (the same deterministic filling the
-// haptic service computes, so sphere ids agree without a handshake), and the
-// rigid anatomy the body keeps its nodes out of.
+// world frame, fixed nodes, FEM settings from the scene, the AIST sphere
+// links the ContactSets refer to (the same deterministic filling the haptic
+// service computes, so sphere ids agree; the layout's fingerprint, which
+// every ContactSet must carry, proves it), and the rigid anatomy the body
+// keeps its nodes out of.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +27,9 @@ struct FemBodySetup {
   std::vector<std::uint32_t> fixed_nodes;
   fem::BodySettings settings;
   fem::SphereLinks links;
+  // SphereLayout::fingerprint() of the layout the links come from: a
+  // ContactSet must carry the same (layout_check.h).
+  std::uint64_t layout_fingerprint = 0;
   std::unique_ptr<fem::Body> body;
   // The obstacles of the scene's hard pairs with this body (world frame),
   // enforced by the FEM step itself (docs/design/anatomy-contact.md).

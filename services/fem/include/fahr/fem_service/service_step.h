@@ -18,6 +18,7 @@
 #include "fahr/fem/contact_set.h"
 #include "fahr/fem/contact_step.h"
 #include "fahr/fem_service/fem_body_setup.h"
+#include "fahr/fem_service/layout_check.h"
 
 namespace fahr::fem_service {
 
@@ -28,6 +29,8 @@ class ServiceStep {
 
   // The newest ContactSet and its sample sequence number; kept until the
   // next one (a set older than the body's max_contact_age_steps is ignored).
+  // A set of another sphere layout than the body's (layout_check.h) is
+  // refused: the steps until the next set apply no contacts.
   void take(const msg::ContactSet& wire, std::uint64_t seq);
 
   // One FEM step and the DeformationState that reports it (the header is
@@ -40,6 +43,9 @@ class ServiceStep {
   const fem::ContactStep& contact_step() const { return contact_step_; }
 
   const FemBodySetup& setup() const { return setup_; }
+  // Refused ContactSets and their error (the service's reporter takes it).
+  LayoutCheck& layout_check() { return layout_check_; }
+  const LayoutCheck& layout_check() const { return layout_check_; }
   std::uint64_t stale_sets() const { return stale_sets_; }
   std::uint64_t inverted_max() const { return inverted_max_; }
   // Steps after which the body had diverged and was reset to rest
@@ -58,6 +64,7 @@ class ServiceStep {
 
   FemBodySetup& setup_;
   fem::ContactStep contact_step_;
+  LayoutCheck layout_check_;
   fem::ContactSet contacts_;
   bool have_contacts_ = false;
   std::uint64_t applied_contact_seq_ = 0;

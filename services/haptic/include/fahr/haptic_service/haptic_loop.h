@@ -77,6 +77,8 @@ class HapticLoop {
   const contact::ContactResponse& response() const { return response_; }
   const LoopMetrics& metrics() const { return metrics_; }
   const TickPhases& last_phases() const { return phases_; }
+  // SphereLayout::fingerprint() of the setup's layout, in every ContactSet.
+  std::uint64_t layout_fingerprint() const { return layout_fingerprint_; }
   // Also resets the per-report maxima (reporter thread).
   void append_metrics(std::vector<std::pair<std::string, double>>& out);
 
@@ -90,6 +92,7 @@ class HapticLoop {
                                            const TissueSnapshot& tissue);
 
   const HapticSetup& setup_;
+  std::uint64_t layout_fingerprint_;
   double nominal_period_s_;
   contact::ContactResponse response_;
   // The penalty baseline (setup.penalty) and its ContactSet entries.

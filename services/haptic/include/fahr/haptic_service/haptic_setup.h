@@ -1,6 +1,7 @@
 // Builds what the haptic service's loop needs from a scene, once, before
 // the first tick: the deformable body's AIST (the same deterministic filling
-// as fahr_fem_service, so sphere ids agree without a handshake), the tool's
+// as fahr_fem_service, so sphere ids agree; every ContactSet carries the
+// layout's fingerprint and the FEM refuses a set of another), the tool's
 // signed distance field in its own frame, the obstacles' fields in theirs,
 // and the contact response settings.
 #pragma once

@@ -9,7 +9,7 @@
 
 #include "fahr/geometry/tetgen_loader.h"
 
-namespace fahr::collision::test {
+namespace fahr::test {
 
 geometry::TetMesh block_tet_mesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int n) {
   std::vector<Eigen::Vector3d> x;
@@ -102,4 +102,4 @@ const sphere_layout::SphereLayout& neonatal_layout() {
   return layout;
 }
 
-}  // namespace fahr::collision::test
+}  // namespace fahr::test

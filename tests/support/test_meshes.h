@@ -1,4 +1,5 @@
-// Small meshes and the neonatal scene for the haptic tests.
+// Small meshes and the neonatal tongue for the tests of the sphere layout
+// and of the collision library.
 #pragma once
 
 #include <Eigen/Core>
@@ -9,7 +10,7 @@
 #include "fahr/geometry/tet_mesh.h"
 #include "fahr/sphere_layout/fill_spheres.h"
 
-namespace fahr::collision::test {
+namespace fahr::test {
 
 // An axis-aligned block [lo, hi] of n^3 cubes, six tets each (Kuhn split), m.
 geometry::TetMesh block_tet_mesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int n);
@@ -23,4 +24,4 @@ const geometry::TetMesh& neonatal_tongue();
 // Its default sphere layout (filled once per process).
 const sphere_layout::SphereLayout& neonatal_layout();
 
-}  // namespace fahr::collision::test
+}  // namespace fahr::test
