@@ -49,7 +49,6 @@ void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
     // Its sphere ids name other spheres: nothing of it is applied, nor the
     // set before it (which it supersedes).
     have_contacts_ = false;
-    have_tool_pose_ = false;
     return;
   }
   to_fem(wire, contacts_);
