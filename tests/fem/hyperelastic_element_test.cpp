@@ -273,14 +273,13 @@ TEST(HyperelasticElement, AffineDeformationLeavesInteriorNodesInBalance) {
 }
 
 // The stress-stretch curve of the same energy, written here from its
-// principal-stretch form: for F = diag(s, ty, tz), I_C = s^2 + ty^2 + tz^2,
+// principal-stretch form: for F = diag(s, ty, tz), I = s^2 + ty^2 + tz^2,
 // J = s ty tz,
-//   Psi = mu/2 (I_C - 3) - [mu/2 log(I_C + 1)] + c20 (I_C - 3)^2
-//         + lambda/2 (J - alpha)^2,
-// with the paper's mapping from E, nu (the log term: mu = 4/3 mu_LE, lambda =
-// lambda_LE + 5/6 mu_LE, alpha = 1 + 3 mu / (4 lambda); without: mu = mu_LE,
-// lambda = lambda_LE + mu_LE, alpha = 1 + mu / lambda), lambda lowered by the
-// Yeoh term's 8 c20, c20 = ratio mu_LE / 2.
+//   Psi = mu/2 (I - 3) - [mu/2 log(I + 1)] + lambda/2 (J - alpha)^2 + c20 D^2,
+// D = I - 2 J - 1, with the paper's mapping from E, nu (the log term:
+// mu = 4/3 mu_LE, lambda = lambda_LE + 5/6 mu_LE, alpha = 1 + 3 mu /
+// (4 lambda); without: mu = mu_LE, lambda = lambda_LE + mu_LE, alpha = 1 +
+// mu / lambda) and c20 = ratio mu_LE / 2.
 struct UniaxialCurve {
   double mu, lambda, alpha, c20;
   bool log_term;
@@ -290,19 +289,25 @@ struct UniaxialCurve {
     const double lambda_le = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
     c20 = ratio * mu_le / 2.0;
     mu = log ? 4.0 / 3.0 * mu_le : mu_le;
-    lambda = lambda_le + (log ? 5.0 / 6.0 : 1.0) * mu_le - 8.0 * c20;
+    lambda = lambda_le + (log ? 5.0 / 6.0 : 1.0) * mu_le;
     alpha = 1.0 + (log ? 0.75 : 1.0) * mu / lambda;
   }
-  // dPsi/dI_C
-  double shear(double i_c) const {
-    return 0.5 * mu - (log_term ? 0.5 * mu / (i_c + 1.0) : 0.0) + 2.0 * c20 * (i_c - 3.0);
+  // dPsi/dI and dPsi/dJ.
+  double psi_i(double i, double j) const {
+    return 0.5 * mu - (log_term ? 0.5 * mu / (i + 1.0) : 0.0) + 2.0 * c20 * (i - 2.0 * j - 1.0);
   }
-  // dPsi/ds and dPsi/dty at ty = tz = t.
+  double psi_j(double i, double j) const {
+    return lambda * (j - alpha) - 4.0 * c20 * (i - 2.0 * j - 1.0);
+  }
+  // dPsi/ds and dPsi/dty at ty = tz = t (dI/ds = 2 s, dJ/ds = t^2; dI/dty =
+  // 2 t, dJ/dty = s t).
   double axial(double s, double t) const {
-    return 2.0 * s * shear(s * s + 2.0 * t * t) + lambda * (s * t * t - alpha) * t * t;
+    const double i = s * s + 2.0 * t * t, j = s * t * t;
+    return 2.0 * s * psi_i(i, j) + t * t * psi_j(i, j);
   }
   double lateral(double s, double t) const {
-    return 2.0 * t * shear(s * s + 2.0 * t * t) + lambda * (s * t * t - alpha) * s * t;
+    const double i = s * s + 2.0 * t * t, j = s * t * t;
+    return 2.0 * t * psi_i(i, j) + s * t * psi_j(i, j);
   }
   // The traction-free lateral stretch by bisection (lateral < 0 at small t,
   // > 0 at large t).
@@ -381,6 +386,22 @@ TEST(HyperelasticElement, UniaxialCompressionFollowsTheEnergysStressStretchCurve
         EXPECT_LT(nominal, 0.0);
       }
     }
+  }
+  // The Yeoh fit's invariant is I1bar - 3 = J^(-2/3) I - 3. Along the
+  // tongue material's path, where the element loses volume, D follows it
+  // (to first order in J - 1) and I - 3 does not: I - 3 counts the lost
+  // volume as negative distortion.
+  const UniaxialCurve tongue_curve(m.youngs_modulus_pa, m.poisson_ratio, kTongueYeohC20OverC10,
+                                   true);
+  std::printf("\nthe Yeoh invariant along the snh+yeoh path\n");
+  std::printf("| stretch | J | D = I - 2 J - 1 | I1bar - 3 | I - 3 |\n|---|---|---|---|---|\n");
+  for (const double s : {0.9, 0.7, 0.5}) {
+    const double t = tongue_curve.lateral_stretch(s);
+    const double i = s * s + 2.0 * t * t, j = s * t * t;
+    const double d = i - 2.0 * j - 1.0;
+    const double i1_bar = i / std::cbrt(j * j) - 3.0;
+    std::printf("| %.2f | %.3f | %.3f | %.3f | %.3f |\n", s, j, d, i1_bar, i - 3.0);
+    EXPECT_LT(std::abs(d - i1_bar), 0.5 * std::abs(i - 3.0 - i1_bar)) << s;
   }
 }
 

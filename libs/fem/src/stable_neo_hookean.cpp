@@ -1,4 +1,4 @@
-// Stable Neo-Hookean with a Yeoh term in I_C: energy, stress, Hessian and its
+// Stable Neo-Hookean with a Yeoh term: energy, stress, Hessian and its
 // analytic eigensystem (formulas and sources in stable_neo_hookean.h).
 #include "fahr/fem/stable_neo_hookean.h"
 
@@ -16,25 +16,26 @@ struct Parameters {
   double c20 = 0.0;
 };
 
-// Linearising at F = I + dF (cof F changes by tr(dF) I - dF^T there, and
-// I_C = 3, J = 1) gives the stress
-//   kappa(3) (dF + dF^T) + (lambda + beta(3) - kappa(3)) tr(dF) I,
-// using lambda (1 - alpha) = -kappa(3), the rest-stability condition. Equal
-// to 2 mu_LE eps + lambda_LE tr(eps) I when kappa(3) = mu_LE and
-// lambda = lambda_LE + kappa(3) - beta(3). With the log term kappa(3) =
-// 3/4 mu and beta(3) = mu/8 + 8 c20, so mu = 4/3 mu_LE and lambda =
-// lambda_LE + 5/6 mu_LE - 8 c20 (the paper's mapping for c20 = 0); without,
-// kappa(3) = mu and beta(3) = 8 c20.
+// Linearising at F = I + dF (I_C = 3, J = 1, D = 0; cof F changes by
+// tr(dF) I - dF^T) gives the stress
+//   2 Psi_I (dF + dF^T) + (4 Psi_II + 4 Psi_IJ + Psi_JJ - 2 Psi_I) tr(dF) I,
+// using Psi_J = lambda (1 - alpha) = -2 Psi_I there (rest stability). The
+// Yeoh term's share of 4 Psi_II + 4 Psi_IJ + Psi_JJ is 8 c20 - 16 c20 +
+// 8 c20 = 0. Equal to 2 mu_LE eps + lambda_LE tr(eps) I when 2 Psi_I = mu_LE
+// and lambda + 4 Psi_II(log) - 2 Psi_I = lambda_LE. With the log term
+// 2 Psi_I = 3/4 mu and 4 Psi_II = mu/8: mu = 4/3 mu_LE, lambda = lambda_LE +
+// 5/6 mu_LE; without it 2 Psi_I = mu and Psi_II = 0: mu = mu_LE, lambda =
+// lambda_LE + mu_LE. lambda > 0 for every valid nu (> -1).
 Parameters map_parameters(const Material& material, bool log_term) {
   const LameParameters lame = lame_parameters(material);
   Parameters p;
   p.c20 = material.yeoh_c20_over_c10 * lame.mu_pa / 2.0;
   if (log_term) {
     p.mu = 4.0 / 3.0 * lame.mu_pa;
-    p.lambda = lame.lambda_pa + 5.0 / 6.0 * lame.mu_pa - 8.0 * p.c20;
+    p.lambda = lame.lambda_pa + 5.0 / 6.0 * lame.mu_pa;
   } else {
     p.mu = lame.mu_pa;
-    p.lambda = lame.lambda_pa + lame.mu_pa - 8.0 * p.c20;
+    p.lambda = lame.lambda_pa + lame.mu_pa;
   }
   return p;
 }
@@ -87,59 +88,63 @@ constexpr int kPairs[3][3] = {{1, 2, 0}, {0, 2, 1}, {0, 1, 2}};
 }  // namespace
 
 StableNeoHookean::StableNeoHookean(const Material& material, StableNeoHookeanOptions options) {
-  assert(validate_stable_neo_hookean(material, options)[0] == '\0');
+  assert(validate(material)[0] == '\0');
   const Parameters p = map_parameters(material, options.log_term);
   mu_ = p.mu;
   lambda_ = p.lambda;
   c20_ = p.c20;
   log_term_ = options.log_term;
-  // P(I) = kappa(3) I + lambda (1 - alpha) I = 0.
-  alpha_ = 1.0 + kappa(3.0) / lambda_;
+  // P(I) = (2 Psi_I + lambda (1 - alpha)) I = 0, with 2 Psi_I = mu - mu/4 or
+  // mu (the Yeoh term's D = 0 at rest).
+  alpha_ = 1.0 + (log_term_ ? 0.75 : 1.0) * mu_ / lambda_;
   rest_volume_energy_ = 0.5 * lambda_ * (1.0 - alpha_) * (1.0 - alpha_);
 }
 
-double StableNeoHookean::kappa(double i_c) const {
-  // 2 dPsi/dI_C: mu from mu/2 (I_C - 3), -mu / (I_C + 1) from the log term,
-  // 4 c20 (I_C - 3) from the Yeoh term. I_C >= 0, so I_C + 1 >= 1.
-  const double log_part = log_term_ ? mu_ / (i_c + 1.0) : 0.0;
-  return mu_ - log_part + 4.0 * c20_ * (i_c - 3.0);
-}
-
-double StableNeoHookean::beta(double i_c) const {
-  // 4 d2Psi/dI_C^2.
-  const double log_part = log_term_ ? 2.0 * mu_ / ((i_c + 1.0) * (i_c + 1.0)) : 0.0;
-  return log_part + 8.0 * c20_;
+StableNeoHookean::Partials StableNeoHookean::partials(double i_c, double j) const {
+  // Psi = mu/2 (I - 3) - [mu/2 log(I + 1)] + lambda/2 (J - alpha)^2 + c20 D^2,
+  // D = I - 2 J - 1. I >= 0, so I + 1 >= 1.
+  const double d = i_c - 2.0 * j - 1.0;
+  const double log_i = log_term_ ? 0.5 * mu_ / (i_c + 1.0) : 0.0;
+  const double log_ii = log_term_ ? 0.5 * mu_ / ((i_c + 1.0) * (i_c + 1.0)) : 0.0;
+  Partials p;
+  p.i = 0.5 * mu_ - log_i + 2.0 * c20_ * d;
+  p.j = lambda_ * (j - alpha_) - 4.0 * c20_ * d;
+  p.ii = log_ii + 2.0 * c20_;
+  p.ij = -4.0 * c20_;
+  p.jj = lambda_ + 8.0 * c20_;
+  return p;
 }
 
 double StableNeoHookean::energy_density(const Eigen::Matrix3d& f) const {
   const double i_c = f.squaredNorm();
   const double j = f.determinant();
+  const double d = i_c - 2.0 * j - 1.0;
   // log((I_C + 1) / 4) rather than log(I_C + 1): a constant, so that Psi(I) = 0.
   const double log_part = log_term_ ? 0.5 * mu_ * std::log((i_c + 1.0) / 4.0) : 0.0;
-  const double shear = 0.5 * mu_ * (i_c - 3.0) - log_part + c20_ * (i_c - 3.0) * (i_c - 3.0);
+  const double shear = 0.5 * mu_ * (i_c - 3.0) - log_part;
   const double volume = 0.5 * lambda_ * (j - alpha_) * (j - alpha_) - rest_volume_energy_;
-  return shear + volume;
+  return shear + volume + c20_ * d * d;
 }
 
 Eigen::Matrix3d StableNeoHookean::first_piola(const Eigen::Matrix3d& f) const {
-  const double i_c = f.squaredNorm();
-  const double j = f.determinant();
-  return kappa(i_c) * f + lambda_ * (j - alpha_) * cofactor(f);
+  const Partials p = partials(f.squaredNorm(), f.determinant());
+  return 2.0 * p.i * f + p.j * cofactor(f);
 }
 
 Matrix9d StableNeoHookean::hessian(const Eigen::Matrix3d& f) const {
-  const double i_c = f.squaredNorm();
-  const double j = f.determinant();
+  const Partials p = partials(f.squaredNorm(), f.determinant());
   const Vector9d vec_f = vec(f);
   const Vector9d g = vec(cofactor(f));
-  Matrix9d h = beta(i_c) * vec_f * vec_f.transpose() + lambda_ * g * g.transpose();
-  h.diagonal().array() += kappa(i_c);
-  // H_J: J = f0 . (f1 x f2) is linear in each column, so its diagonal blocks
-  // vanish and block (a, b) is d(dJ/df_a)/df_b, e.g. d(f1 x f2)/df2 = [f1]x.
-  const double volume_slope = lambda_ * (j - alpha_);
-  const Eigen::Matrix3d x0 = volume_slope * cross_matrix(f.col(0));
-  const Eigen::Matrix3d x1 = volume_slope * cross_matrix(f.col(1));
-  const Eigen::Matrix3d x2 = volume_slope * cross_matrix(f.col(2));
+  Matrix9d h = 4.0 * p.ii * vec_f * vec_f.transpose() + p.jj * g * g.transpose();
+  const Matrix9d coupling = vec_f * g.transpose();
+  h += 2.0 * p.ij * (coupling + coupling.transpose());
+  h.diagonal().array() += 2.0 * p.i;
+  // Psi_J H_J: J = f0 . (f1 x f2) is linear in each column, so H_J's
+  // diagonal blocks vanish and block (a, b) is d(dJ/df_a)/df_b, e.g.
+  // d(f1 x f2)/df2 = [f1]x.
+  const Eigen::Matrix3d x0 = p.j * cross_matrix(f.col(0));
+  const Eigen::Matrix3d x1 = p.j * cross_matrix(f.col(1));
+  const Eigen::Matrix3d x2 = p.j * cross_matrix(f.col(2));
   h.block<3, 3>(0, 3) -= x2;
   h.block<3, 3>(0, 6) += x1;
   h.block<3, 3>(3, 0) += x2;
@@ -150,17 +155,19 @@ Matrix9d StableNeoHookean::hessian(const Eigen::Matrix3d& f) const {
 }
 
 Eigen::Matrix3d StableNeoHookean::scaling_hessian(const Eigen::Vector3d& s) const {
-  // The Hessian of Psi(s0, s1, s2) = a(I_C) + b(J) in the singular values:
-  // kappa I + beta s s^T + lambda c c^T + lambda (J - alpha) d2J/ds2 with
-  // c = dJ/ds = (s1 s2, s0 s2, s0 s1).
-  const double i_c = s.squaredNorm();
-  const double volume_slope = lambda_ * (s.prod() - alpha_);
+  // Psi(s0, s1, s2) through I = |s|^2 and J = s0 s1 s2: with c = dJ/ds =
+  // (s1 s2, s0 s2, s0 s1) and d2J/ds2 = [[0, s2, s1], [s2, 0, s0], [s1, s0, 0]],
+  // 2 Psi_I I + 4 Psi_II s s^T + 2 Psi_IJ (s c^T + c s^T) + Psi_JJ c c^T
+  // + Psi_J d2J/ds2.
+  const Partials p = partials(s.squaredNorm(), s.prod());
   const Eigen::Vector3d c(s(1) * s(2), s(0) * s(2), s(0) * s(1));
-  Eigen::Matrix3d a = beta(i_c) * s * s.transpose() + lambda_ * c * c.transpose();
-  a.diagonal().array() += kappa(i_c);
-  a(0, 1) += volume_slope * s(2);
-  a(0, 2) += volume_slope * s(1);
-  a(1, 2) += volume_slope * s(0);
+  const Eigen::Matrix3d coupling = s * c.transpose();
+  Eigen::Matrix3d a = 4.0 * p.ii * s * s.transpose() + p.jj * c * c.transpose() +
+                      2.0 * p.ij * (coupling + coupling.transpose());
+  a.diagonal().array() += 2.0 * p.i;
+  a(0, 1) += p.j * s(2);
+  a(0, 2) += p.j * s(1);
+  a(1, 2) += p.j * s(0);
   a(1, 0) = a(0, 1);
   a(2, 0) = a(0, 2);
   a(2, 1) = a(1, 2);
@@ -169,8 +176,7 @@ Eigen::Matrix3d StableNeoHookean::scaling_hessian(const Eigen::Vector3d& s) cons
 
 HessianEigensystem StableNeoHookean::hessian_eigensystem(const Eigen::Matrix3d& f) const {
   const RotationVariantSvd svd = rotation_variant_svd(f);
-  const double k = kappa(svd.s.squaredNorm());
-  const double volume_slope = lambda_ * (svd.s.prod() - alpha_);
+  const Partials partial = partials(svd.s.squaredNorm(), svd.s.prod());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> scaling(scaling_hessian(svd.s));
   HessianEigensystem out;
   for (int m = 0; m < 3; ++m) {
@@ -183,9 +189,9 @@ HessianEigensystem StableNeoHookean::hessian_eigensystem(const Eigen::Matrix3d& 
     const Eigen::Matrix3d ab = svd.u.col(kPairs[p][0]) * svd.v.col(kPairs[p][1]).transpose();
     const Eigen::Matrix3d ba = svd.u.col(kPairs[p][1]) * svd.v.col(kPairs[p][0]).transpose();
     const double s_k = svd.s(kPairs[p][2]);
-    out.values(3 + 2 * p) = k + volume_slope * s_k;
+    out.values(3 + 2 * p) = 2.0 * partial.i + partial.j * s_k;
     out.vectors.col(3 + 2 * p) = half_sqrt2 * vec(ab - ba);
-    out.values(4 + 2 * p) = k - volume_slope * s_k;
+    out.values(4 + 2 * p) = 2.0 * partial.i - partial.j * s_k;
     out.vectors.col(4 + 2 * p) = half_sqrt2 * vec(ab + ba);
   }
   return out;
@@ -198,13 +204,12 @@ Matrix9d StableNeoHookean::projected_hessian(const Eigen::Matrix3d& f) const {
   // compressed element; scaling modes only in strong compression).
   Matrix9d h = hessian(f);
   const RotationVariantSvd svd = rotation_variant_svd(f);
-  const double k = kappa(svd.s.squaredNorm());
-  const double volume_slope = lambda_ * (svd.s.prod() - alpha_);
+  const Partials partial = partials(svd.s.squaredNorm(), svd.s.prod());
   const double half_sqrt2 = std::sqrt(0.5);
   for (int p = 0; p < 3; ++p) {
     const double s_k = svd.s(kPairs[p][2]);
     for (const double sign : {-1.0, 1.0}) {  // twist, flip
-      const double value = k - sign * volume_slope * s_k;
+      const double value = 2.0 * partial.i - sign * partial.j * s_k;
       if (value >= 0.0) continue;
       const Eigen::Matrix3d ab = svd.u.col(kPairs[p][0]) * svd.v.col(kPairs[p][1]).transpose();
       const Eigen::Matrix3d ba = svd.u.col(kPairs[p][1]) * svd.v.col(kPairs[p][0]).transpose();
@@ -228,19 +233,6 @@ Matrix9d StableNeoHookean::projected_hessian(const Eigen::Matrix3d& f) const {
     }
   }
   return h;
-}
-
-const char* validate_stable_neo_hookean(const Material& material, StableNeoHookeanOptions options) {
-  const char* error = validate(material);
-  if (error[0] != '\0') return error;
-  // lambda <= 0 would make the volume term concave (or absent) and alpha
-  // infinite; it happens when the Yeoh term's bulk share, 8 c20, exceeds
-  // what the small-strain lambda has to give (low nu, high C20/C10).
-  if (!(map_parameters(material, options.log_term).lambda > 0.0)) {
-    return "material.poisson_ratio too low for material.yeoh_c20_over_c10: the Stable "
-           "Neo-Hookean lambda would be <= 0";
-  }
-  return "";
 }
 
 }  // namespace fahr::fem
