@@ -28,11 +28,12 @@ int main(int argc, char** argv) {
       execv("/proc/self/exe", original.data());
       std::perror("re-exec with OMP_THREAD_LIMIT=1 failed; continuing");
     }
-    results.begin("contact-property");
+    results.begin("contact-property", fahr::bench_support::MarkdownResults::Output::kText);
     return fahr::contact::bench::run_property(argc - 2, argv + 2);
   }
   const bool all = std::strcmp(which, "all") == 0;
-  results.begin(std::string("contact-") + which);
+  results.begin(std::string("contact-") + which,
+                fahr::bench_support::MarkdownResults::Output::kText);
   int failures = 0;
   if (all || std::strcmp(which, "punch") == 0) failures += fahr::contact::bench::run_punch();
   if (all || std::strcmp(which, "overshoot") == 0)

@@ -97,6 +97,23 @@ TEST(MarkdownResults, FileHoldsTheHeaderAndWhatWasPrinted) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(MarkdownResults, FencesPlainTextOutput) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("fahr-bench-support-text-" + std::to_string(::getpid()) + ".md");
+  Args args({"bench", "--markdown=" + path.string()});
+  {
+    MarkdownResults results(args.argc, args.pointers.data());
+    results.begin("text", MarkdownResults::Output::kText);
+    std::printf("  runs  froze\n    10      2\n");
+  }
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("```text\n  runs  froze\n    10      2\n```\n"), std::string::npos)
+      << text.str();
+  std::filesystem::remove(path);
+}
+
 TEST(MarkdownResults, WithoutTheFlagWritesNothing) {
   Args args({"bench"});
   MarkdownResults results(args.argc, args.pointers.data());

@@ -288,8 +288,9 @@ MarkdownResults::~MarkdownResults() {
   }
 }
 
-void MarkdownResults::begin(std::string_view name) {
+void MarkdownResults::begin(std::string_view name, Output output) {
   if (!requested_ || fd_ >= 0) return;
+  output_ = output;
   if (path_.empty()) path_ = default_results_path(name);
   const std::filesystem::path path(path_);
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
@@ -311,6 +312,7 @@ void MarkdownResults::begin(std::string_view name) {
   header += std::string("| build | ") + FAHR_BUILD_TYPE + ", " + kCompiler + " |\n";
   header += "| date | " + utc_date() + " |\n";
   header += "| load average at start (1, 5, 15 min) | " + load_average() + " |\n\n";
+  if (output_ == Output::kText) header += "```text\n";
   write_text(fd_, header);
   std::fflush(stdout);
   static constexpr cookie_io_functions_t kTee{nullptr, write_tee, nullptr, nullptr};
@@ -334,6 +336,7 @@ void MarkdownResults::finish() {
                 now_s() - start_s_, load_average().c_str());
   const int fd = fd_;
   fd_ = -1;
+  if (output_ == Output::kText) write_text(fd, "```\n");
   write_text(fd, footer.data());
   ::close(fd);
   std::fprintf(stderr, "results: wrote %s\n", path_.c_str());

@@ -54,6 +54,10 @@ std::string default_results_path(std::string_view name);
 
 class MarkdownResults {
  public:
+  // What the bench prints: Markdown, or aligned plain text, which the file
+  // fences as a code block so that it reads as printed.
+  enum class Output { kMarkdown, kText };
+
   // Records the command line, then takes `--markdown`, `--markdown FILE`
   // (FILE ending in .md) or `--markdown=FILE` out of argv, so the bench's
   // own parser never sees it; argc and argv are updated. Arguments after
@@ -74,7 +78,7 @@ class MarkdownResults {
   // Without --markdown, nothing. Otherwise opens the file (FILE, or the
   // default path for `name`), writes the header and from now on copies
   // stdout into it. Throws std::runtime_error when the file cannot be written.
-  void begin(std::string_view name);
+  void begin(std::string_view name, Output output = Output::kMarkdown);
   // Stops copying, appends the footer (wall time, load at the end), closes
   // the file and says on stderr where it is. The destructor calls it.
   void finish();
@@ -85,6 +89,7 @@ class MarkdownResults {
   std::string path_;
   std::string command_;
   int fd_ = -1;
+  Output output_ = Output::kMarkdown;
   std::FILE* original_stdout_ = nullptr;
   std::FILE* tee_ = nullptr;
   double start_s_ = 0.0;
