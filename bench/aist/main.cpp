@@ -5,17 +5,19 @@
 // [coverage|trajectory|detection|sweep|all] [--scene-dir DIR] [--max-spheres N] [--ticks N]
 // [--fem-every K] [--radius-rule volume|stretch] [--skin-mm S] [--anchor-gap-mm G] [--surface-probe
 // anchor|face] [--spread W] [--driver-subdivision N] [--sweep-steps N] [--file PATH] [--evict-kb K]
-// [--replay-only K] [--replay-passes P]
+// [--replay-only K] [--replay-passes P] [--markdown [FILE]]
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <string>
 
+#include "fahr/bench_support/results_file.h"
 #include "sections.h"
 
 int main(int argc, char** argv) {
   using namespace fahr::aist_bench;
+  fahr::bench_support::MarkdownResults results(argc, argv);
   std::string section = "all";
   Options options;
   std::string scene_dir = FAHR_NEONATAL_DIR;
@@ -75,6 +77,7 @@ int main(int argc, char** argv) {
     }
   }
   try {
+    results.begin("aist-" + section);
     const auto scene = load_scene(0.5e-3, scene_dir);
     std::printf("# AIST benchmark (neonatal scene, Miller 1 blade)\n\n");
     if (scene_dir != FAHR_NEONATAL_DIR) std::printf("scene: %s\n\n", scene_dir.c_str());

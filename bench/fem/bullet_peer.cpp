@@ -1,7 +1,7 @@
 // fem_bullet_peer: fahr against Bullet 3.24's implicit deformable solver
 // (btDeformableMultiBodyDynamicsWorld + btDeformableLinearElasticityForce),
 // side by side in one run, on the ArtiSynth tongue: E 10 kPa, nu 0.45,
-// h 10 ms, lowest 10 mm fixed, gravity. Usage: fem_bullet_peer [steps]
+// h 10 ms, lowest 10 mm fixed, gravity. Usage: fem_bullet_peer [steps] [--markdown [FILE]]
 //
 // Bullet pitfalls handled (../shared/notes/dependency-facts.md): double
 // precision build (bullet-float64) and a mesh centred on the origin; the
@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "bench_util.h"
+#include "fahr/bench_support/results_file.h"
 #include "fahr/fem/lumped_mass.h"
 #include "tetgen_reader.h"
 
@@ -193,6 +194,8 @@ int main(int argc, char** argv) {
     setenv("OPENBLAS_NUM_THREADS", "1", 1);
     execv("/proc/self/exe", argv);
   }
+  fahr::bench_support::MarkdownResults markdown(argc, argv);
+  markdown.begin("fem-bullet-peer");
   const int steps = argc > 1 ? std::atoi(argv[1]) : 150;
   const std::string stem = std::string(FAHR_TONGUE_DIR) + "/tongue.1";
   BodyMesh mesh;

@@ -1,7 +1,7 @@
 // fem_bench: tables for the FEM library. Usage:
 //   fem_bench [cantilever|scale|target|compliance|all] [--quick]
 //             [--static-max n] [--dynamic-max n]   (cantilever cross-section cells,
-//             defaults 16 and 16; --quick: 6 and 4, no 80k mesh)
+//             defaults 16 and 16; --quick: 6 and 4, no 80k mesh) [--markdown [FILE]]
 #include <unistd.h>
 
 #include <cstdio>
@@ -10,6 +10,7 @@
 #include <string>
 
 #include "bench_util.h"
+#include "fahr/bench_support/results_file.h"
 
 namespace fahr::fem::bench {
 void run_cantilever(int max_dynamic_n, int max_static_n, int steps);
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
     execv("/proc/self/exe", argv);
     std::perror("re-exec with OMP_THREAD_LIMIT=1 failed; continuing");
   }
+  fahr::bench_support::MarkdownResults results(argc, argv);
   std::string what = "all";
   bool quick = false;
   int static_max = 0;
@@ -49,6 +51,7 @@ int main(int argc, char** argv) {
   }
   if (static_max == 0) static_max = quick ? 6 : 16;
   if (dynamic_max == 0) dynamic_max = quick ? 4 : 16;
+  results.begin("fem-" + what + (quick ? "-quick" : ""));
   std::printf("# fem_bench (%s)\n%s\n", what.c_str(), pin_blas_to_one_thread().c_str());
   if (what == "cantilever" || what == "all") run_cantilever(dynamic_max, static_max, 60);
   if (what == "scale" || what == "all") run_scale(quick);

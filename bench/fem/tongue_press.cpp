@@ -16,7 +16,7 @@
 // also give each configuration's cost on identical inputs.
 //
 //   fem_tongue_press [--scene FILE] [--seconds 8] [--configs shipped,pcg-it8,...]
-//                    [--support-ratio R]
+//                    [--support-ratio R] [--markdown [FILE]]
 //
 // Prints, per configuration: FEM step CPU (thread CPU, the step and its
 // DeformationState) while the blade touches and over all steps, closed loop
@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "fahr/bench_support/results_file.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/solver_threads.h"
@@ -286,8 +287,10 @@ void print_kernel_costs(const fahr::fem::Body& body) {
 int main(int argc, char** argv) {
   fahr::common::run_solver_libraries_on_one_thread(argv);
   using namespace fahr;
+  bench_support::MarkdownResults markdown(argc, argv);
   CLI::App app{
       "FEM solvers on the pressed neonatal tongue against the exact step, in the whole loop"};
+  app.footer(bench_support::kMarkdownHelp);
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
   double seconds = 8.0;
   std::string config_list = "shipped,lagged,pcg-it8";
@@ -307,6 +310,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
+    markdown.begin("fem-tongue-press");
     const auto scene = scene::load_scene(scene_path);
     std::vector<Run> runs;
     // The first configuration is the reference the others are compared with.

@@ -4,7 +4,8 @@
 // (../shared/meshes/artisynth-tongue beside the checkout; the bench fails without them) and
 // meshes/neonatal/*.obj.
 //
-// usage: geometry_bench [--cell-mm C] [--neonatal-unit U] [--queries N] [extra.obj ...]
+// usage: geometry_bench [--cell-mm C] [--neonatal-unit U] [--queries N] [--markdown [FILE]]
+//                       [extra.obj ...]
 //   C: grid cell (mm, default 1); U: unit of the neonatal OBJ files in metres
 //   (default 0.001, millimetres); extra files are read in millimetres.
 #include <Eigen/Geometry>
@@ -18,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "fahr/bench_support/results_file.h"
 #include "fahr/geometry/load_error.h"
 #include "fahr/geometry/signed_distance_field.h"
 #include "fahr/geometry/surface_loader.h"
@@ -187,6 +189,7 @@ void load_into(std::vector<Input>& inputs, const std::string& label,
 }  // namespace
 
 int main(int argc, char** argv) {
+  fahr::bench_support::MarkdownResults results(argc, argv);
   double cell_mm = 1.0;
   double neonatal_unit_m = 0.001;
   int queries = 20000;
@@ -201,7 +204,8 @@ int main(int argc, char** argv) {
       queries = std::atoi(argv[++i]);
     } else if (!arg.empty() && arg[0] == '-') {
       std::fprintf(stderr,
-                   "usage: %s [--cell-mm C] [--neonatal-unit U] [--queries N] [extra.obj ...]\n",
+                   "usage: %s [--cell-mm C] [--neonatal-unit U] [--queries N] [--markdown [FILE]] "
+                   "[extra.obj ...]\n",
                    argv[0]);
       return 2;
     } else {
@@ -212,6 +216,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "--cell-mm and --queries must be positive\n");
     return 2;
   }
+  results.begin("geometry");
 
   std::vector<Input> inputs;
   const std::filesystem::path artisynth = FAHR_ARTISYNTH_DIR;

@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "fahr/bench_support/results_file.h"
 #include "fahr/common/solver_threads.h"
 #include "fahr/common/wire_eigen.h"
 #include "fahr/fem/strain.h"
@@ -471,7 +472,9 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
 
 int main(int argc, char** argv) {
   fahr::common::run_solver_libraries_on_one_thread(argv);
+  fahr::bench_support::MarkdownResults results(argc, argv);
   CLI::App app{"fahr overshoot benchmark (paper Figure 7, neonatal tongue)"};
+  app.footer(fahr::bench_support::kMarkdownHelp);
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
   RunChoices choices;
   bool check = false;
@@ -533,6 +536,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
+    results.begin("overshoot");
     const auto scene = scene::load_scene(scene_path);
     choices.fem_anatomy = fem_anatomy == "on";
     const Result fa = response != "penalty" ? run(scene, false, choices) : Result{};

@@ -4,7 +4,7 @@
 // Cyclone DDS and across vendors. Prints a Markdown table.
 //
 //   fahr_transport_latency [--round-trips N] [--large-round-trips M]
-//                          [--sizes small,100k,1m] [--pairs ff,cc,fc,cf]
+//                          [--sizes small,100k,1m] [--pairs ff,cc,fc,cf] [--markdown [FILE]]
 //   (the pong side runs as: fahr_transport_latency --pong VENDOR DOMAIN SIZE)
 #include <signal.h>
 #include <sys/wait.h>
@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/bench_support/results_file.h"
 #include "fahr/common/clock.h"
 #include "ping_path.h"
 
@@ -205,6 +206,8 @@ int main(int argc, char** argv) {
     const auto vendor = common::resolve_vendor(args[1]);
     return bench::run_pong(vendor, static_cast<std::uint32_t>(std::stoul(args[2])), args[3]);
   }
+  bench_support::MarkdownResults results(argc, argv);
+  args.assign(argv + 1, argv + argc);
   int round_trips = 10000;
   int large_round_trips = 1000;
   std::string sizes = "small,100k,1m";
@@ -223,6 +226,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  results.begin("transport-latency");
   return bench::run_benchmark(round_trips, large_round_trips, bench::split(sizes),
                               bench::split(pairs));
 }
