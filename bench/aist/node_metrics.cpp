@@ -44,8 +44,8 @@ void NodeMetrics::add_tick(const collision::ContactBuffer& aist,
   const auto& centres = state.centres_m();
   const auto& radii = state.radii_m();
   for (const auto node : nodes_) {
-    const Eigen::Vector3d p(positions_m[3 * node], positions_m[3 * node + 1],
-                            positions_m[3 * node + 2]);
+    const std::size_t first = 3 * static_cast<std::size_t>(node);
+    const Eigen::Vector3d p(positions_m[first], positions_m[first + 1], positions_m[first + 2]);
     const double exact = -scene_.blade_sdf.query(blade_from_world * p).distance_m;
     if (!(exact > 0.0)) continue;
     bool recalled = false, near = false;

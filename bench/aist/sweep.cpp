@@ -134,7 +134,8 @@ Row run(const Scene& scene, const Options& options, double ratio, int levels,
     sum += d * d;
     row.max_mm = std::max(row.max_mm, d * 1e3);
   }
-  row.rms_mm = std::sqrt(sum / static_cast<double>(x.size() / 3)) * 1e3;
+  const std::size_t nodes = x.size() / 3;
+  row.rms_mm = std::sqrt(sum / static_cast<double>(nodes)) * 1e3;
   return row;
 }
 

@@ -75,6 +75,7 @@ int run_property(int argc, char** argv) {
     }
   };
   std::vector<std::thread> threads;
+  threads.reserve(static_cast<std::size_t>(o.threads));
   for (int t = 0; t < o.threads; ++t) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
   const double wall_s =

@@ -19,10 +19,10 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Six times the signed volume of a tet from flat positions, m^3.
 double six_volume(const geometry::Tet& t, const double* x) {
-  const Eigen::Vector3d a(x + 3 * t[0]);
-  const Eigen::Vector3d b = Eigen::Vector3d(x + 3 * t[1]) - a;
-  const Eigen::Vector3d c = Eigen::Vector3d(x + 3 * t[2]) - a;
-  const Eigen::Vector3d d = Eigen::Vector3d(x + 3 * t[3]) - a;
+  const Eigen::Vector3d a(x + 3 * std::ptrdiff_t{t[0]});
+  const Eigen::Vector3d b = Eigen::Vector3d(x + 3 * std::ptrdiff_t{t[1]}) - a;
+  const Eigen::Vector3d c = Eigen::Vector3d(x + 3 * std::ptrdiff_t{t[2]}) - a;
+  const Eigen::Vector3d d = Eigen::Vector3d(x + 3 * std::ptrdiff_t{t[3]}) - a;
   return b.dot(c.cross(d));
 }
 

@@ -103,11 +103,12 @@ void SphereTree::refit(const SphereState& state) {
       const Eigen::Vector3d middle = 0.5 * (node.box_min_m + node.box_max_m);
       node.reach_m = 0.0;
       for (std::int32_t i = 0; i < node.count; ++i) {
-        const std::uint32_t s = order_[node.first + i];
-        slot_spheres_[static_cast<std::size_t>(node.first + i)] << centres[s], radii[s];
+        const std::int32_t slot = node.first + i;
+        const std::uint32_t s = order_[slot];
+        slot_spheres_[static_cast<std::size_t>(slot)] << centres[s], radii[s];
         if (anchored_) {
-          slot_anchors_[static_cast<std::size_t>(node.first + i)] = anchors[s];
-          slot_faces_[static_cast<std::size_t>(node.first + i)] = faces[s];
+          slot_anchors_[static_cast<std::size_t>(slot)] = anchors[s];
+          slot_faces_[static_cast<std::size_t>(slot)] = faces[s];
         }
         node.reach_m = std::max(node.reach_m, (centres[s] - middle).norm() + radii[s]);
       }

@@ -42,7 +42,7 @@ void SystemAssembly::build(std::size_t node_count, const ElementRest& rest,
     for (std::size_t c = 0; c < 3; ++c) {
       auto k = static_cast<std::size_t>(outer[3 * j + c]);
       for (const std::uint32_t i : neighbours[j]) {
-        for (std::size_t r = 0; r < 3; ++r) inner[k++] = static_cast<int>(3 * i + r);
+        for (std::size_t r = 0; r < 3; ++r) inner[k++] = static_cast<int>(3 * std::size_t{i} + r);
       }
     }
   }
@@ -66,7 +66,7 @@ void SystemAssembly::build(std::size_t node_count, const ElementRest& rest,
         const std::size_t rank = rank_of(tet[b], tet[a]);
         for (std::size_t c = 0; c < 3; ++c) {
           block_column_start_[48 * e + 12 * a + 3 * b + c] = static_cast<std::uint32_t>(
-              static_cast<std::size_t>(outer[3 * tet[b] + c]) + 3 * rank);
+              static_cast<std::size_t>(outer[3 * std::size_t{tet[b]} + c]) + 3 * rank);
         }
       }
     }

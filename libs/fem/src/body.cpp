@@ -74,7 +74,7 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
   fixed_dof_.assign(3 * n, 0);
   for (const std::uint32_t node : fixed_nodes) {
     if (node >= n) return "fixed node " + std::to_string(node) + " out of range";
-    for (std::size_t d = 0; d < 3; ++d) fixed_dof_[3 * node + d] = 1;
+    for (std::size_t d = 0; d < 3; ++d) fixed_dof_[3 * std::size_t{node} + d] = 1;
   }
   total_mass_kg_ = 0.0;
   for (const double m : mass_kg_) total_mass_kg_ += m;

@@ -17,7 +17,8 @@ BodyMesh make_box_mesh(const std::array<int, 3>& cells, const Eigen::Vector3d& s
   auto index = [&](int i, int j, int k) {
     return static_cast<std::uint32_t>(i + (nx + 1) * (j + (ny + 1) * k));
   };
-  mesh.nodes_m.reserve(static_cast<std::size_t>((nx + 1) * (ny + 1) * (nz + 1)));
+  mesh.nodes_m.reserve(static_cast<std::size_t>(nx + 1) * static_cast<std::size_t>(ny + 1) *
+                       static_cast<std::size_t>(nz + 1));
   for (int k = 0; k <= nz; ++k) {
     for (int j = 0; j <= ny; ++j) {
       for (int i = 0; i <= nx; ++i) {
@@ -28,7 +29,8 @@ BodyMesh make_box_mesh(const std::array<int, 3>& cells, const Eigen::Vector3d& s
   }
   static constexpr std::array<std::array<int, 3>, 6> kPermutations = {
       {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
-  mesh.tets.reserve(static_cast<std::size_t>(6 * nx * ny * nz));
+  mesh.tets.reserve(6 * static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) *
+                    static_cast<std::size_t>(nz));
   for (int k = 0; k < nz; ++k) {
     for (int j = 0; j < ny; ++j) {
       for (int i = 0; i < nx; ++i) {

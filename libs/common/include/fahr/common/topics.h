@@ -39,8 +39,3 @@ FAHR_TOPIC(StepAck, kLockstep);
 #undef FAHR_TOPIC
 
 }  // namespace fahr::common
-
-namespace fahr {
-// The generated types live in fahr::msg.
-namespace msg = ::fahr::msg;
-}  // namespace fahr
