@@ -84,7 +84,9 @@ tables() {
     echo
     echo "### Run summary, $collision"
     echo
-    grep -E '^\|' "$out/$collision.txt" || echo "(no summary table)"
+    # Its table lines, a blank line between two tables.
+    awk '/^\|/ { if (gap && seen) print ""; print; seen = 1; gap = 0; next } { gap = 1 }
+         END { if (!seen) print "(no summary table)" }' "$out/$collision.txt"
   done
 }
 
