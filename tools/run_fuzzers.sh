@@ -13,9 +13,8 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${2:-${root}/build-fuzz}"
 targets=(fuzz_tetgen fuzz_gmsh fuzz_vtk)
 
-# tests/ is only added with FAHR_BUILD_TESTS=ON, so it stays ON here, and
-# tools stay ON because some test folders link tool libraries; only the fuzz
-# targets are built, never the test suite or the tools.
+# tests/ is only added with FAHR_BUILD_TESTS=ON, so it stays ON here; the
+# benches are left out. Only the fuzz targets are built, never the suite.
 CC=clang CXX=clang++ cmake -S "${root}" -B "${build}" -G Ninja \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFAHR_FUZZ=ON -DFAHR_BUILD_TESTS=ON -DFAHR_BUILD_BENCHES=OFF >/dev/null
 cmake --build "${build}" --target "${targets[@]}"
