@@ -86,7 +86,7 @@ struct Mesh {
     for (std::size_t e = 0; e < rest.size(); ++e) {
       const Eigen::Matrix3d def = deformation_gradient(rest.dm_inv[e], positions(e, x));
       const Vector12d fe = nodal_forces(df_dx[e], rest.volume_m3[e], snh.first_piola(def));
-      for (int a = 0; a < 4; ++a) {
+      for (Eigen::Index a = 0; a < 4; ++a) {
         f.segment<3>(3 * static_cast<Eigen::Index>(rest.tets[e][static_cast<std::size_t>(a)])) +=
             fe.segment<3>(3 * a);
       }
@@ -101,8 +101,8 @@ struct Mesh {
     for (std::size_t e = 0; e < rest.size(); ++e) {
       const Eigen::Matrix3d def = deformation_gradient(rest.dm_inv[e], positions(e, x));
       const Matrix12d ke = element_stiffness(df_dx[e], rest.volume_m3[e], snh.hessian(def));
-      for (int a = 0; a < 4; ++a) {
-        for (int b = 0; b < 4; ++b) {
+      for (Eigen::Index a = 0; a < 4; ++a) {
+        for (Eigen::Index b = 0; b < 4; ++b) {
           const auto na = static_cast<Eigen::Index>(rest.tets[e][static_cast<std::size_t>(a)]);
           const auto nb = static_cast<Eigen::Index>(rest.tets[e][static_cast<std::size_t>(b)]);
           k.block<3, 3>(3 * na, 3 * nb) += ke.block<3, 3>(3 * a, 3 * b);
@@ -123,7 +123,7 @@ struct Mesh {
 // nodes so that det F < 0.
 struct RandomTet {
   Eigen::Matrix3d dm_inv;
-  double volume_m3;
+  double volume_m3 = 0.0;
   TetPositions x;
 };
 
@@ -209,7 +209,8 @@ TEST(HyperelasticElement, ForcesAndStiffnessAreEnergyDerivatives) {
       EXPECT_LT((force.reshaped(3, 4).rowwise().sum()).norm(), 1e-12 * force.norm());
       EXPECT_LT((k - k.transpose()).norm(), 1e-12 * k.norm());
       Vector12d translation;
-      for (int a = 0; a < 4; ++a) translation.segment<3>(3 * a) = Eigen::Vector3d(0.2, -0.5, 0.8);
+      for (Eigen::Index a = 0; a < 4; ++a)
+        translation.segment<3>(3 * a) = Eigen::Vector3d(0.2, -0.5, 0.8);
       EXPECT_LT((k * translation).norm(), 1e-10 * k.norm());
       // With a projected Hessian, K is positive semi-definite.
       const Matrix12d k_projected = element_stiffness(j, t.volume_m3, snh.projected_hessian(f));

@@ -27,21 +27,21 @@ Matrix12d element_stiffness(const Matrix9x12d& df_dx, double volume_m3, const Ma
   // 0.6k multiplications where the dense 12x9 * 9x9 * 9x12 product takes
   // 2.3k (five times the time); the result is the same to round-off.
   Eigen::Matrix<double, 3, 4> g;
-  for (int a = 0; a < 4; ++a) {
-    for (int j = 0; j < 3; ++j) g(j, a) = df_dx(3 * j, 3 * a);
+  for (Eigen::Index a = 0; a < 4; ++a) {
+    for (Eigen::Index j = 0; j < 3; ++j) g(j, a) = df_dx(3 * j, 3 * a);
   }
   // hg[a][k] = sum_j g_a[j] H_jk.
   Eigen::Matrix3d hg[4][3];
-  for (int a = 0; a < 4; ++a) {
-    for (int k = 0; k < 3; ++k) {
+  for (Eigen::Index a = 0; a < 4; ++a) {
+    for (Eigen::Index k = 0; k < 3; ++k) {
       hg[a][k] = g(0, a) * h.block<3, 3>(0, 3 * k) + g(1, a) * h.block<3, 3>(3, 3 * k) +
                  g(2, a) * h.block<3, 3>(6, 3 * k);
     }
   }
   // H is symmetric, so block (b, a) is block (a, b) transposed.
   Matrix12d k;
-  for (int a = 0; a < 4; ++a) {
-    for (int b = a; b < 4; ++b) {
+  for (Eigen::Index a = 0; a < 4; ++a) {
+    for (Eigen::Index b = a; b < 4; ++b) {
       const Eigen::Matrix3d block =
           volume_m3 * (g(0, b) * hg[a][0] + g(1, b) * hg[a][1] + g(2, b) * hg[a][2]);
       k.block<3, 3>(3 * a, 3 * b) = block;

@@ -24,9 +24,8 @@ struct ElementRest {
   std::size_t size() const { return tets.size(); }
 };
 
-// Column a is the rest gradient of the linear shape function of node a,
-// 1/m: dN_a/dX for a = 1..3 are the rows of Dm^-1, and N_0 = 1 - N_1 - N_2
-// - N_3.
+// The rest gradients of the linear shape functions, 1/m: column a is
+// dN_a/dX. For a = 1..3 they are the rows of Dm^-1; N_0 = 1 - N_1 - N_2 - N_3.
 inline Eigen::Matrix<double, 3, 4> shape_gradients(const Eigen::Matrix3d& dm_inv) {
   Eigen::Matrix<double, 3, 4> g;
   g.block<3, 3>(0, 1) = dm_inv.transpose();

@@ -105,7 +105,7 @@ class StableNeoHookean {
  private:
   // First and second partial derivatives of Psi in I = I_C and J, Pa.
   struct Partials {
-    double i, j, ii, ij, jj;
+    double i = 0.0, j = 0.0, ii = 0.0, ij = 0.0, jj = 0.0;
   };
   Partials partials(double i_c, double j) const;
   // The 3x3 Hessian of Psi in the signed singular values s.

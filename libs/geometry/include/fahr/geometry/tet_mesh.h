@@ -1,6 +1,7 @@
 // The rest state of a tetrahedral body: rest positions, tets, outward
-// boundary faces, per-tet volumes and quality statistics, all computed once. Per-step state
-// (deformed positions, velocities) lives with whoever simulates the body, never here.
+// boundary faces, per-tet volumes and quality statistics, all computed
+// once. Per-step state (deformed positions, velocities) lives with whoever
+// simulates the body, never here.
 #pragma once
 
 #include <Eigen/Core>
