@@ -17,6 +17,8 @@ packages=(
   libyaml-cpp-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   # fuzzing (libFuzzer ships with clang's runtime) and sanitizers
   clang libclang-rt-14-dev
+  # style checks (tools/lint.sh): Debian's clang-format and clang-tidy 14
+  clang-format clang-tidy
   # network namespaces for multi-process tests
   iproute2 nftables
 )
