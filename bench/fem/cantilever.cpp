@@ -9,21 +9,21 @@
 namespace fahr::fem::bench {
 namespace {
 
-constexpr double kLength_m = 0.1;
-constexpr double kSide_m = 0.01;
-constexpr double kYoungs_pa = 1e6;
+constexpr double kLengthM = 0.1;
+constexpr double kSideM = 0.01;
+constexpr double kYoungsPa = 1e6;
 constexpr double kPoisson = 0.3;
 constexpr double kDensity = 1000.0;
 // Tip deflection of 0.1 mm (L / 1000): small enough that geometric
 // nonlinearity (which the corotated model has and Euler-Bernoulli lacks)
 // stays below 1e-5 relative.
-constexpr double kTargetDeflection_m = 1e-4;
+constexpr double kTargetDeflectionM = 1e-4;
 
 double second_moment() {
-  return kSide_m * kSide_m * kSide_m * kSide_m / 12.0;
+  return kSideM * kSideM * kSideM * kSideM / 12.0;
 }
 double tip_load_n() {
-  return 3.0 * kYoungs_pa * second_moment() * kTargetDeflection_m / std::pow(kLength_m, 3);
+  return 3.0 * kYoungsPa * second_moment() * kTargetDeflectionM / std::pow(kLengthM, 3);
 }
 
 struct Row {
@@ -41,12 +41,12 @@ struct Row {
 };
 
 TetMesh beam(int n) {
-  return make_box_mesh({10 * n, n, n}, Eigen::Vector3d(kLength_m, kSide_m, kSide_m));
+  return make_box_mesh({10 * n, n, n}, Eigen::Vector3d(kLengthM, kSideM, kSideM));
 }
 
 Material beam_material(double rayleigh_mass) {
   Material m;
-  m.youngs_modulus_pa = kYoungs_pa;
+  m.youngs_modulus_pa = kYoungsPa;
   m.poisson_ratio = kPoisson;
   m.density_kg_per_m3 = kDensity;
   m.rayleigh_mass_per_s = rayleigh_mass;
@@ -60,7 +60,7 @@ std::unique_ptr<Body> loaded_beam(const TetMesh& mesh, const BodySettings& setti
   tip.clear();
   for (std::size_t i = 0; i < mesh.nodes_m.size(); ++i) {
     if (mesh.nodes_m[i].x() < 1e-9) fixed.push_back(static_cast<std::uint32_t>(i));
-    if (mesh.nodes_m[i].x() > kLength_m - 1e-9) tip.push_back(static_cast<std::uint32_t>(i));
+    if (mesh.nodes_m[i].x() > kLengthM - 1e-9) tip.push_back(static_cast<std::uint32_t>(i));
   }
   BodyOrError made = Body::create(settings, mesh.nodes_m, mesh.tets, fixed);
   if (!made.error.empty()) {
@@ -80,7 +80,7 @@ double tip_deflection(const Body& body, const std::vector<std::uint32_t>& tip) {
 }
 
 double euler_bernoulli() {
-  return tip_load_n() * std::pow(kLength_m, 3) / (3.0 * kYoungs_pa * second_moment());
+  return tip_load_n() * std::pow(kLengthM, 3) / (3.0 * kYoungsPa * second_moment());
 }
 
 // Linear static solution: one implicit step of h = 1000 s from rest without
@@ -121,11 +121,11 @@ void run_cantilever(int max_dynamic_n, int max_static_n, int steps) {
   const double reference = euler_bernoulli();
   // Critical damping of the first bending mode, so that `steps` steps of
   // 10 ms reach equilibrium when the solve is exact.
-  const double area = kSide_m * kSide_m;
+  const double area = kSideM * kSideM;
   const double omega1 =
-      3.516 / (kLength_m * kLength_m) * std::sqrt(kYoungs_pa * second_moment() / (kDensity * area));
-  std::printf("\n## Cantilever: %g x %g x %g mm, E %g Pa, nu %g, tip load %.4g N\n",
-              1e3 * kLength_m, 1e3 * kSide_m, 1e3 * kSide_m, kYoungs_pa, kPoisson, tip_load_n());
+      3.516 / (kLengthM * kLengthM) * std::sqrt(kYoungsPa * second_moment() / (kDensity * area));
+  std::printf("\n## Cantilever: %g x %g x %g mm, E %g Pa, nu %g, tip load %.4g N\n", 1e3 * kLengthM,
+              1e3 * kSideM, 1e3 * kSideM, kYoungsPa, kPoisson, tip_load_n());
   std::printf(
       "Euler-Bernoulli tip deflection P L^3/(3 E I) = %.6f mm. Mesh n: %d x n x n cells of 6 "
       "tets.\n",
@@ -144,7 +144,7 @@ void run_cantilever(int max_dynamic_n, int max_static_n, int steps) {
     std::printf("| %d | %zu | %zu | %.3f | %.6f | %+.3f | %.0f |\n", n, mesh.tets.size(),
                 3 * mesh.nodes_m.size(), 10.0 / n, 1e3 * d, error, ms);
     ns.push_back(n);
-    cells.push_back(kSide_m / n);
+    cells.push_back(kSideM / n);
     errors.push_back(std::abs(error));
     deflections.push_back(d);
   }

@@ -9,7 +9,7 @@
 namespace fahr::fem::bench {
 namespace {
 
-constexpr double kBoxSide_m = 0.04;  // a tongue-sized block, 40 mm
+constexpr double kBoxSideM = 0.04;  // a tongue-sized block, 40 mm
 
 struct Size {
   const char* label;
@@ -18,9 +18,9 @@ struct Size {
 };
 
 TetMesh block(const Size& size) {
-  const double cell = kBoxSide_m / size.cells[0];
+  const double cell = kBoxSideM / size.cells[0];
   return make_box_mesh(size.cells,
-                       Eigen::Vector3d(kBoxSide_m, cell * size.cells[1], cell * size.cells[2]));
+                       Eigen::Vector3d(kBoxSideM, cell * size.cells[1], cell * size.cells[2]));
 }
 
 std::unique_ptr<Body> block_body(const TetMesh& mesh, const SolverSettings& solver, double step_s) {

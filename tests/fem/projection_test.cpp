@@ -42,10 +42,10 @@ TEST(Projection, CentreMovesExactlyByCorrectionAndHeavyNodesMoveLess) {
   ASSERT_TRUE(move_sphere_centre(0, links, inverse_mass, dc, positions));
   const Eigen::Vector3d after = links.centre(0, positions.data());
   EXPECT_NEAR((after - before - dc).norm(), 0.0, 1e-15);
-  auto moved = [&](int node) {
-    return Eigen::Vector3d(positions[3 * node] - start[3 * node],
-                           positions[3 * node + 1] - start[3 * node + 1],
-                           positions[3 * node + 2] - start[3 * node + 2])
+  // Init-captures: clang before 16 cannot capture a structured binding (C++20 allows it).
+  auto moved = [&now = positions, &then = start](std::size_t node) {
+    return Eigen::Vector3d(now[3 * node] - then[3 * node], now[3 * node + 1] - then[3 * node + 1],
+                           now[3 * node + 2] - then[3 * node + 2])
         .norm();
   };
   EXPECT_EQ(moved(0), 0.0);
@@ -63,7 +63,7 @@ TEST(Projection, TranslationSpreadMovesEveryFreeNodeAlike) {
       move_sphere_centre(0, links, inverse_mass, dc, positions, SphereSpread::kTranslation));
   EXPECT_NEAR((links.centre(0, positions.data()) - before - dc).norm(), 0.0, 1e-15);
   const Eigen::Vector3d expected = dc / 0.9;  // the free nodes carry 0.9 of the centre
-  for (int node = 1; node < 4; ++node) {
+  for (std::size_t node = 1; node < 4; ++node) {
     const Eigen::Vector3d moved(positions[3 * node] - start[3 * node],
                                 positions[3 * node + 1] - start[3 * node + 1],
                                 positions[3 * node + 2] - start[3 * node + 2]);
