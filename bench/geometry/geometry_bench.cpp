@@ -26,7 +26,6 @@
 namespace {
 
 using fahr::geometry::SdfOptions;
-using fahr::geometry::SdfSample;
 using fahr::geometry::SignedDistanceField;
 using fahr::geometry::SurfaceMesh;
 using Clock = std::chrono::steady_clock;

@@ -174,7 +174,7 @@ Eigen::Vector3d ContactResponse::catch_up_step(const Eigen::Vector3d& toward, do
 Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input,
                                             const EffectiveCoupling& coupling) {
   const DeviceSample& device = input.device;
-  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  Eigen::Vector3d zero = Eigen::Vector3d::Zero();  // not const: returned (moved)
   const double limit = device.renderable_force_n;
   const bool hold_load = settings_.force_aware.held_proxy == HeldProxy::kHoldLoad;
   // kHoldLoad decides on the hand's pull into the tissue along the push the
@@ -206,7 +206,7 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input,
     if (!release) {
       solver_.solve_pinned(zero, settings_.pgs);
       if (settings_.force_aware.held_proxy != HeldProxy::kBackOff) return zero;
-      const Eigen::Vector3d back = yield_to_limit(zero, limit);
+      Eigen::Vector3d back = yield_to_limit(zero, limit);
       if (back != zero) capture_holds(input.compliance);
       return back;
     }
@@ -257,9 +257,9 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input,
     held_push_direction_ =
         push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
     const HeldProxy held = settings_.force_aware.held_proxy;
-    const Eigen::Vector3d back = held == HeldProxy::kStay || held == HeldProxy::kHoldLoad
-                                     ? zero
-                                     : yield_to_limit(zero, limit);
+    Eigen::Vector3d back = held == HeldProxy::kStay || held == HeldProxy::kHoldLoad
+                               ? zero
+                               : yield_to_limit(zero, limit);
     if (!hold_load) capture_holds(input.compliance);  // kHoldLoad holds no sphere
     return back;
   }
