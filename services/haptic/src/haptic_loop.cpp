@@ -176,7 +176,7 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
     if (free_centres && row.compliance_index >= 0) {
       // Penetration on the free-motion centre (services/contact README,
       // "Which centre"): the projected one reads zero at a steady contact.
-      const float* c = tissue.free_centres_m.data() + 3 * row.compliance_index;
+      const float* c = tissue.free_centres_m.data() + 3 * std::ptrdiff_t{row.compliance_index};
       row.other_point_m = Eigen::Vector3d(c[0], c[1], c[2]);
     }
   }
@@ -232,7 +232,7 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
     row.radius_m = 0.0;
     row.compliance_index = tissue.compliance_index[sphere];
     if (free_centres && row.compliance_index >= 0) {
-      const float* f = tissue.free_centres_m.data() + 3 * row.compliance_index;
+      const float* f = tissue.free_centres_m.data() + 3 * std::ptrdiff_t{row.compliance_index};
       row.other_point_m += Eigen::Vector3d(f[0], f[1], f[2]) - tissue.spheres.centres_m()[sphere];
     }
   }

@@ -30,7 +30,10 @@ void fill_command(const contact::ForceOutput& output, std::uint32_t device_id,
   put(output.force_n, out.force_n());
   auto& k = out.stiffness_npm().m();
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) k[static_cast<std::size_t>(3 * r + c)] = output.stiffness_npm(r, c);
+    for (int c = 0; c < 3; ++c) {
+      const int i = 3 * r + c;
+      k[static_cast<std::size_t>(i)] = output.stiffness_npm(r, c);
+    }
   }
   put(Eigen::Vector3d::Zero(), out.torque_nm());  // the rigid blade's torque is not computed yet
   put(output.proxy_position_m, out.world_from_proxy().position_m());
