@@ -28,7 +28,7 @@
 namespace fahr::fem::bench {
 namespace {
 
-constexpr double kStep_s = 0.01;
+constexpr double kStepS = 0.01;
 
 Material peer_material() {
   Material m;
@@ -61,7 +61,7 @@ PeerResult run_fahr(const std::string& name, const BodyMesh& mesh,
                     int steps) {
   BodySettings settings;
   settings.material = peer_material();
-  settings.time_step = std::chrono::duration<double>(kStep_s);
+  settings.time_step = std::chrono::duration<double>(kStepS);
   settings.solver = solver;
   settings.sleep.enabled = false;
   BodyOrError made = Body::create(settings, mesh.nodes_m, mesh.tets, fixed);
@@ -150,7 +150,7 @@ PeerResult run_bullet(const BodyMesh& mesh, const std::vector<std::uint32_t>& fi
   double cpu_in_steps = 0.0;
   for (int k = 0; k < steps; ++k) {
     const double before = thread_cpu_ms();
-    world.stepSimulation(static_cast<btScalar>(kStep_s), 0);
+    world.stepSimulation(static_cast<btScalar>(kStepS), 0);
     cpu_in_steps += thread_cpu_ms() - before;
     if ((k + 1) % 25 == 0) {
       double largest = 0.0;
@@ -223,7 +223,7 @@ int main(int argc, char** argv) {
   std::printf(
       "# fem_bullet_peer: ArtiSynth tongue, %zu tets, %zu nodes (%zu fixed), E 10 kPa, nu 0.45, "
       "h 10 ms, %d steps (%.2f s), gravity -y\n\n",
-      mesh.tets.size(), mesh.nodes_m.size(), fixed.size(), steps, steps * kStep_s);
+      mesh.tets.size(), mesh.nodes_m.size(), fixed.size(), steps, steps * kStepS);
   std::vector<PeerResult> results;
   // Converged fahr reference: exact step, run four times as long.
   const PeerResult reference = run_fahr("fahr reference (cholmod every step, 4x longer)", mesh,

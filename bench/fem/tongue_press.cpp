@@ -29,6 +29,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -157,7 +158,8 @@ void start_audit(Shadow& shadow) {
   shadow.audit_warp.set_enabled(false);
   shadow.fixed_dof.assign(3 * body.node_count(), 0);
   for (std::uint32_t i = 0; i < body.node_count(); ++i) {
-    for (std::size_t d = 0; d < 3; ++d) shadow.fixed_dof[3 * i + d] = body.fixed(i) ? 1 : 0;
+    for (std::size_t d = 0; d < 3; ++d)
+      shadow.fixed_dof[3 * std::size_t{i} + d] = body.fixed(i) ? 1 : 0;
   }
 }
 
@@ -284,7 +286,8 @@ void print_kernel_costs(const fahr::fem::Body& body) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// A function-try-block: what the set-up before the inner try throws ends in a message too.
+int main(int argc, char** argv) try {
   fahr::common::run_solver_libraries_on_one_thread(argv);
   using namespace fahr;
   bench_support::MarkdownResults markdown(argc, argv);
@@ -348,7 +351,7 @@ int main(int argc, char** argv) {
         start_audit(run.shadow);
       runs.push_back(std::move(run));
     }
-    const auto steps = static_cast<std::uint64_t>(seconds * 1000.0 + 0.5);
+    const auto steps = static_cast<std::uint64_t>(std::llround(seconds * 1000.0));
     for (std::uint64_t k = 0; k < steps; ++k) {
       const bool fem_steps = common::executes_at(k, runs.front().sim->fem_period_steps());
       for (Run& run : runs) {
@@ -476,4 +479,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fem_tongue_press: %s\n", e.what());
     return 2;
   }
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "fem_tongue_press: %s\n", e.what());
+  return 1;
 }

@@ -28,7 +28,6 @@
 namespace {
 
 using fahr::geometry::SdfOptions;
-using fahr::geometry::SdfSample;
 using fahr::geometry::SignedDistanceField;
 using fahr::geometry::SurfaceMesh;
 using Clock = std::chrono::steady_clock;

@@ -32,8 +32,8 @@ using namespace std::chrono_literals;
 
 Payload payload_named(const std::string& name) {
   if (name == "small") return {"DevicePose (~200 B)", true, 0};
-  if (name == "100k") return {"100 KB", false, 100 * 1024};
-  if (name == "1m") return {"1 MB", false, 1024 * 1024};
+  if (name == "100k") return {"100 KB", false, 100 * std::size_t{1024}};
+  if (name == "1m") return {"1 MB", false, 1024 * std::size_t{1024}};
   std::fprintf(stderr, "unknown size '%s' (small, 100k, 1m)\n", name.c_str());
   std::exit(2);
 }

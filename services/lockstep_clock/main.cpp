@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -77,5 +78,8 @@ int main(int argc, char** argv) {
   } catch (const common::ConfigError& e) {
     std::fprintf(stderr, "fahr_lockstep_clock: %s\n", e.what());
     return 2;
+  } catch (const std::exception& e) {  // anything else: a message rather than terminate()
+    std::fprintf(stderr, "fahr_lockstep_clock: %s\n", e.what());
+    return 1;
   }
 }

@@ -14,7 +14,9 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <exception>
 #include <memory>
 #include <vector>
 
@@ -22,7 +24,8 @@
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
 
-int main(int argc, char** argv) {
+// A function-try-block: what the set-up before the inner try throws ends in a message too.
+int main(int argc, char** argv) try {
   fahr::common::run_solver_libraries_on_one_thread(argv);
   using namespace fahr;
   CLI::App app{"fahr in-process lockstep run"};
@@ -70,7 +73,7 @@ int main(int argc, char** argv) {
       scene->solver.max_candidate_contacts = w_normals;
     }
     stack_sim::StackSim sim(scene, options);
-    const auto steps = static_cast<std::uint64_t>(seconds * 1000.0 + 0.5);
+    const auto steps = static_cast<std::uint64_t>(std::llround(seconds * 1000.0));
     const auto start = std::chrono::steady_clock::now();
     double peak_force = 0.0;
     // The contact solve's share of a tick: PGS row visits x rows (the cost
@@ -187,4 +190,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fahr_stack_sim_run: %s\n", e.what());
     return 2;
   }
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "fahr_stack_sim_run: %s\n", e.what());
+  return 1;
 }

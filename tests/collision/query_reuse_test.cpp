@@ -120,7 +120,7 @@ TEST(QueryReuse, DeferredContactsGiveTheSameRowsBitForBit) {
       EXPECT_EQ(x.normal_without_history, y.normal_without_history);
       EXPECT_FALSE(y.deferred);
     }
-    expect_same_memory(full_memory, deferred_memory, static_cast<std::uint64_t>(q + 1),
+    expect_same_memory(full_memory, deferred_memory, static_cast<std::uint64_t>(q) + 1,
                        full.max_memory_age);
   }
   EXPECT_GT(over_budget, 5u) << "the slab touches more spheres than the rows take";
@@ -158,7 +158,7 @@ TEST(QueryReuse, GridFloorsGiveTheSameContactsAndMemoryBitForBit) {
       EXPECT_EQ(a[i].depth_m, b[i].depth_m);
       EXPECT_EQ(a[i].normal_without_history, b[i].normal_without_history);
     }
-    expect_same_memory(with, without, static_cast<std::uint64_t>(q + 1), settings.max_memory_age);
+    expect_same_memory(with, without, static_cast<std::uint64_t>(q) + 1, settings.max_memory_age);
   }
   EXPECT_GT(bounded, 0u);
   std::printf("grid reads with floors %llu, without %llu\n",

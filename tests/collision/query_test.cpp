@@ -70,7 +70,8 @@ TEST(SphereTree, BoxesBoundTheirSpheresAndRefitNeverRebuilds) {
   for (const auto& node : b.tree.nodes()) {
     if (node.count == 0) continue;
     for (std::int32_t k = 0; k < node.count; ++k) {
-      const auto s = b.tree.order()[static_cast<std::size_t>(node.first + k)];
+      const auto s =
+          b.tree.order()[static_cast<std::size_t>(node.first) + static_cast<std::size_t>(k)];
       const Eigen::Vector3d r = Eigen::Vector3d::Constant(b.state.radii_m()[s]);
       EXPECT_TRUE(((b.state.centres_m()[s] - r).array() >= node.box_min_m.array() - 1e-15).all());
       EXPECT_TRUE(((b.state.centres_m()[s] + r).array() <= node.box_max_m.array() + 1e-15).all());
@@ -272,7 +273,7 @@ TEST(Query, DeepestOnlyFindsTheDeepestContactsOfTheFullQuery) {
   PrePenetrationMemory full_memory(b.layout.size());
   ContactBuffer full(8192);
   const QueryStats full_stats = query_spheres(b.tree, b.state, body, settings, full_memory, full);
-  constexpr std::size_t k = 16;
+  const std::size_t k = 16;
   ASSERT_GT(full.size(), 4 * k);
   settings.deepest_only = k;
   PrePenetrationMemory memory(b.layout.size());

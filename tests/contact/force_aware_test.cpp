@@ -205,7 +205,7 @@ TEST(ForceAware, ATickNeverThrowsAHeldToolFartherThanAFastHandMoves) {
   const ContactRow rows[] = {below, above};
   const std::uint32_t ids[] = {0, 1};
   std::vector<float> w(36, 0.0f);
-  for (int d = 0; d < 6; ++d) w[static_cast<std::size_t>(7 * d)] = static_cast<float>(compliance);
+  for (std::size_t d = 0; d < 6; ++d) w[7 * d] = static_cast<float>(compliance);
   ASSERT_NEAR(rows[0].penetration_m(), 0.020, 1e-12);
   ASSERT_NEAR(rows[1].penetration_m(), 0.022, 1e-12);
 

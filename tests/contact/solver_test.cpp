@@ -31,8 +31,8 @@ TEST(Pgs, SolvesAKnownComplementarityProblem) {
 // half the right-hand sides separating. The solution satisfies the
 // complementarity conditions, and the residual handed back is b - S lambda.
 TEST(Pgs, CoupledRowsMeetTheComplementarityConditions) {
-  constexpr std::size_t k = 48;
-  constexpr std::size_t stride = 50;
+  const std::size_t k = 48;
+  const std::size_t stride = 50;
   std::mt19937 random(7);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   std::vector<double> g(k * 6);

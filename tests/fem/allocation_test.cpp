@@ -108,7 +108,7 @@ TEST(Allocation, ComplianceOfChangingSpheresAllocatesNothing) {
   SphereLinks links;
   const std::array<double, 4> w = {0.25, 0.25, 0.25, 0.25};
   for (std::size_t s = 0; s < 40; ++s) ASSERT_EQ(links.add_sphere(mesh.tets[s], w, 0.001), "");
-  std::vector<float> out(9 * 16 * 16);
+  std::vector<float> out(std::size_t{9} * 16 * 16);
   std::vector<std::uint32_t> spheres;
   const auto window = [&](std::uint32_t first, std::uint32_t count) {
     spheres.clear();

@@ -56,7 +56,7 @@ TEST(Compliance, MatchesTheResponseOfOneStep) {
     for (std::size_t d = 0; d < 3; ++d) {
       for (std::size_t e = 0; e < 3; ++e) {
         predicted[static_cast<Eigen::Index>(d)] +=
-            w[(3 * s + d) * 9 + 3 + e] * force[static_cast<Eigen::Index>(e)];
+            w[(3 * std::size_t{s} + d) * 9 + 3 + e] * force[static_cast<Eigen::Index>(e)];
       }
     }
     // float storage: 1e-6 relative.
@@ -116,8 +116,8 @@ TEST(Compliance, KeptColumnsGiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
   auto fresh = test::make_body(settings, mesh, test::fixed_x0(mesh));
   ASSERT_NE(used, nullptr);
   ASSERT_NE(fresh, nullptr);
-  std::vector<float> w_used(9 * 16);
-  std::vector<float> w_fresh(9 * 16);
+  std::vector<float> w_used(std::size_t{9} * 16);
+  std::vector<float> w_fresh(std::size_t{9} * 16);
   const auto expect_same = [&](const std::vector<std::uint32_t>& spheres, const char* when) {
     ASSERT_TRUE(used->compliance(spheres, links, w_used)) << when;
     ASSERT_TRUE(fresh->compliance(spheres, links, w_fresh)) << when;
@@ -127,7 +127,7 @@ TEST(Compliance, KeptColumnsGiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
     for (std::size_t i = 0; i < n; ++i)
       EXPECT_NEAR(w_used[i], w_fresh[i], 1e-6f * largest) << when << " entry " << i;
   };
-  std::vector<float> scratch(9 * 16);
+  std::vector<float> scratch(std::size_t{9} * 16);
   ASSERT_TRUE(used->compliance(std::vector<std::uint32_t>{0, 1, 2}, links, scratch));
   ASSERT_TRUE(used->compliance(std::vector<std::uint32_t>{3, 4}, links, scratch));
   expect_same({4, 1, 5, 2}, "kept columns, new order");

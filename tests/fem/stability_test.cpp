@@ -9,7 +9,7 @@ namespace {
 
 // "Back to rest": every node within 0.1 mm of its rest position (the bar is
 // 30 mm long; 0.1 mm is below what the haptic and visual loops resolve).
-constexpr double kRestTolerance_m = 1e-4;
+constexpr double kRestToleranceM = 1e-4;
 // Energy after release may exceed the energy at release by at most this
 // factor. A linearised implicit step moves nodes along the tangent of the
 // current rotation; with h = 50 ms and a bar bent by its own weight at the
@@ -65,7 +65,7 @@ TEST_P(LoadAbuse, StaysFiniteBoundedAndReturnsToRest) {
   std::printf("[ info ] h %.3f s, load %.0fx weight: energy at release %.3g J, peak after %.3g J\n",
               abuse.step_s, abuse.load_in_body_weights, released.total_j(), peak_elastic);
   EXPECT_LE(peak_elastic, kEnergyOvershootBound * released.total_j() + 1e-12);
-  EXPECT_LT(test::max_displacement(*body), kRestTolerance_m);
+  EXPECT_LT(test::max_displacement(*body), kRestToleranceM);
 }
 
 INSTANTIATE_TEST_SUITE_P(StepsAndLoads, LoadAbuse,
@@ -96,7 +96,7 @@ TEST(Stability, YankedNodeReleased) {
     std::printf("[ info ] yank, h %.3f s: energy at release %.3g J, peak after %.3g J\n", step_s,
                 yanked.total_j(), peak);
     EXPECT_LE(peak, kEnergyOvershootBound * yanked.total_j()) << step_s;
-    EXPECT_LT(test::max_displacement(*body), kRestTolerance_m) << step_s;
+    EXPECT_LT(test::max_displacement(*body), kRestToleranceM) << step_s;
   }
 }
 

@@ -163,8 +163,9 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
   std::sort(heights.begin(), heights.end(), std::greater<>());
   std::vector<std::uint32_t> centres;
   for (const auto& [y, node] : heights) {
+    const Eigen::Vector3d& at = mesh.nodes_m[node];  // clang before 16 cannot capture `node`
     const bool apart = std::all_of(centres.begin(), centres.end(), [&](std::uint32_t c) {
-      return (mesh.nodes_m[c] - mesh.nodes_m[node]).norm() > 0.008;
+      return (mesh.nodes_m[c] - at).norm() > 0.008;
     });
     if (apart) centres.push_back(node);
     if (centres.size() == 8) break;

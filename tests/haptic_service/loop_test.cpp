@@ -193,8 +193,8 @@ TEST(TissueDigest, RefusesStatesThatDoNotFit) {
   for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
     for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
   }
-  state.positions_m().erase(state.positions_m().begin(),
-                            state.positions_m().begin() + (3 * setup.mesh.node_count() - 3));
+  const auto stale = static_cast<std::ptrdiff_t>(3 * setup.mesh.node_count() - 3);
+  state.positions_m().erase(state.positions_m().begin(), state.positions_m().begin() + stale);
   ASSERT_EQ(state.positions_m().size(), 3 * setup.mesh.node_count());
   EXPECT_TRUE(digest.digest(state, snapshot));
   state.positions_m()[7] = std::numeric_limits<float>::quiet_NaN();
@@ -213,62 +213,62 @@ msg::DeformationState rest_state(const HapticSetup& setup) {
 // The neonatal scene's digest, a fresh snapshot and a state at rest.
 class TissueDigestAtRest : public ::testing::Test {
  protected:
-  const HapticSetup& setup = neonatal_scene().setup;
-  TissueDigest digest{setup};
-  TissueSnapshot snapshot = digest.make_snapshot();
-  msg::DeformationState state = rest_state(setup);
+  const HapticSetup& setup_ = neonatal_scene().setup;
+  TissueDigest digest_{setup_};
+  TissueSnapshot snapshot_ = digest_.make_snapshot();
+  msg::DeformationState state_ = rest_state(setup_);
 };
 
 TEST_F(TissueDigestAtRest, IndexesTheComplianceSpheres) {
-  state.compliance_sphere_ids({5, 9});
-  state.compliance_mpn().assign(36, 1e-3f);
-  state.compliance_free_centres_m().assign(6, 0.01f);
-  ASSERT_TRUE(digest.digest(state, snapshot));
-  EXPECT_EQ(snapshot.compliance_index[5], 0);
-  EXPECT_EQ(snapshot.compliance_index[9], 1);
-  EXPECT_EQ(snapshot.compliance_index[6], contact::kNoCompliance);
-  EXPECT_TRUE(snapshot.have_free_centres);
+  state_.compliance_sphere_ids({5, 9});
+  state_.compliance_mpn().assign(36, 1e-3f);
+  state_.compliance_free_centres_m().assign(6, 0.01f);
+  ASSERT_TRUE(digest_.digest(state_, snapshot_));
+  EXPECT_EQ(snapshot_.compliance_index[5], 0);
+  EXPECT_EQ(snapshot_.compliance_index[9], 1);
+  EXPECT_EQ(snapshot_.compliance_index[6], contact::kNoCompliance);
+  EXPECT_TRUE(snapshot_.have_free_centres);
   // The next state in the same slot forgets the old spheres.
-  state.compliance_sphere_ids({6});
-  state.compliance_mpn().assign(9, 1e-3f);
-  state.compliance_free_centres_m().clear();
-  ASSERT_TRUE(digest.digest(state, snapshot));
-  EXPECT_EQ(snapshot.compliance_index[5], contact::kNoCompliance);
-  EXPECT_EQ(snapshot.compliance_index[6], 0);
-  EXPECT_FALSE(snapshot.have_free_centres);
+  state_.compliance_sphere_ids({6});
+  state_.compliance_mpn().assign(9, 1e-3f);
+  state_.compliance_free_centres_m().clear();
+  ASSERT_TRUE(digest_.digest(state_, snapshot_));
+  EXPECT_EQ(snapshot_.compliance_index[5], contact::kNoCompliance);
+  EXPECT_EQ(snapshot_.compliance_index[6], 0);
+  EXPECT_FALSE(snapshot_.have_free_centres);
   // An id beyond the layout refuses the whole W.
-  state.compliance_sphere_ids({static_cast<std::uint32_t>(setup.layout.size())});
-  ASSERT_TRUE(digest.digest(state, snapshot));
-  EXPECT_EQ(snapshot.compliance_count, 0u);
+  state_.compliance_sphere_ids({static_cast<std::uint32_t>(setup_.layout.size())});
+  ASSERT_TRUE(digest_.digest(state_, snapshot_));
+  EXPECT_EQ(snapshot_.compliance_count, 0u);
 }
 
 TEST_F(TissueDigestAtRest, TakesWAlongTheFemsNormals) {
   // (3k x k) columns with k normals: the view reads them as W along the
   // normals; without enough normals, or with a block of the 3x3 size but
   // normals present, W is refused (rows then use the fallback).
-  state.compliance_sphere_ids({5, 9});
-  state.compliance_mpn().assign(12, 0.0f);
-  state.compliance_mpn()[(3 * 1 + 1) * 2 + 0] =
+  state_.compliance_sphere_ids({5, 9});
+  state_.compliance_mpn().assign(12, 0.0f);
+  state_.compliance_mpn()[(3 * 1 + 1) * 2 + 0] =
       2e-3f;  // sphere 9 moves +y per newton on sphere 5 along its normal
-  state.compliance_normals({0.0f, 1.0f, 0.0f, 1.0f, 0.0f, 0.0f});
-  ASSERT_TRUE(digest.digest(state, snapshot));
-  ASSERT_EQ(snapshot.compliance_count, 2u);
-  const contact::TissueCompliance w = snapshot.compliance();
+  state_.compliance_normals({0.0f, 1.0f, 0.0f, 1.0f, 0.0f, 0.0f});
+  ASSERT_TRUE(digest_.digest(state_, snapshot_));
+  ASSERT_EQ(snapshot_.compliance_count, 2u);
+  const contact::TissueCompliance w = snapshot_.compliance();
   ASSERT_TRUE(w.valid());
   ASSERT_TRUE(w.along_normals());
   EXPECT_NEAR(w.normal_compliance(1, Eigen::Vector3d::UnitY(), 0, Eigen::Vector3d::UnitY()), 2e-3,
               1e-9);
   EXPECT_NEAR(w.normal_compliance(1, Eigen::Vector3d::UnitY(), 0, -Eigen::Vector3d::UnitY()), -2e-3,
               1e-9);
-  state.compliance_normals().pop_back();
-  ASSERT_TRUE(digest.digest(state, snapshot));
-  EXPECT_EQ(snapshot.compliance_count, 0u);
+  state_.compliance_normals().pop_back();
+  ASSERT_TRUE(digest_.digest(state_, snapshot_));
+  EXPECT_EQ(snapshot_.compliance_count, 0u);
   // Back to 3x3 blocks: no normals, nine entries a sphere pair.
-  state.compliance_normals().clear();
-  state.compliance_mpn().assign(36, 1e-3f);
-  ASSERT_TRUE(digest.digest(state, snapshot));
-  EXPECT_EQ(snapshot.compliance_count, 2u);
-  EXPECT_FALSE(snapshot.compliance().along_normals());
+  state_.compliance_normals().clear();
+  state_.compliance_mpn().assign(36, 1e-3f);
+  ASSERT_TRUE(digest_.digest(state_, snapshot_));
+  EXPECT_EQ(snapshot_.compliance_count, 2u);
+  EXPECT_FALSE(snapshot_.compliance().along_normals());
 }
 
 }  // namespace

@@ -31,7 +31,7 @@ std::string joined(const std::vector<std::string>& lines) {
 // One of: drop a line, duplicate a line, cut the text short, put a YAML
 // indicator somewhere, replace a value with a troublesome scalar or structure.
 std::string mutate(const std::string& text, std::mt19937& rng) {
-  static const char* const kValues[] = {
+  static constexpr const char* kValues[] = {
       "",    "~",    "[]", "{}",  "[1, 2]", "{a: 1}",   "\"7\"",       "-1",   "1e400",
       "nan", ".inf", "x",  "- a", "&a 1",   "*missing", "[[a, b], c]", "0x10", "true"};
   std::vector<std::string> lines = lines_of(text);

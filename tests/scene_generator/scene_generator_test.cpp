@@ -55,7 +55,7 @@ fs::path run_generator(const std::string& tag) {
     ADD_FAILURE() << "cannot create a temporary directory from " << pattern;
     return {};
   }
-  const fs::path dir = pattern;
+  fs::path dir = pattern;  // not const: returned by move
   const std::string command = std::string("\"") + FAHR_SCENE_GENERATOR + "\" --out \"" +
                               dir.string() + "\" > \"" + (dir / "generator.log").string() + "\"";
   EXPECT_EQ(std::system(command.c_str()), 0) << "generator failed; see " << dir / "generator.log";

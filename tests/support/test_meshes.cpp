@@ -46,6 +46,7 @@ geometry::TetMesh block_tet_mesh(const Eigen::Vector3d& lo, const Eigen::Vector3
 
 geometry::SurfaceMesh box_surface(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   std::vector<Eigen::Vector3d> v;
+  v.reserve(8);
   for (int k = 0; k < 8; ++k)
     v.emplace_back((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
   // Two triangles per face, counter-clockwise seen from outside.

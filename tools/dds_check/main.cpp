@@ -7,13 +7,15 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <thread>
 
 #include "fahr/common/config_error.h"
 #include "fahr/common/participant.h"
 #include "fahr/common/subscriber.h"
 
-int main(int argc, char** argv) {
+// A function-try-block: what the set-up before the inner try throws ends in a message too.
+int main(int argc, char** argv) try {
   CLI::App app{"Join a fahr DDS domain and report what is there"};
   std::string dds, domain, profile;
   double listen_s = 2.0;
@@ -40,4 +42,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fahr_dds_check: %s\n", e.what());
     return 1;
   }
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "fahr_dds_check: %s\n", e.what());
+  return 1;
 }

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <map>
 #include <mutex>
 #include <set>
@@ -116,7 +117,8 @@ void print(const Tally& t, double duration_s) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// A function-try-block: what the set-up before the inner try throws ends in a message too.
+int main(int argc, char** argv) try {
   CLI::App app{"Summarise a running fahr co-simulation"};
   std::string dds, domain, profile;
   double duration_s = 10;
@@ -197,4 +199,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fahr_run_summary: %s\n", e.what());
     return 2;
   }
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "fahr_run_summary: %s\n", e.what());
+  return 1;
 }

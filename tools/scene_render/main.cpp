@@ -95,7 +95,8 @@ int main(int argc, char** argv) {
       {"larynx_trachea", Vec3(0.45, 0.60, 0.90)}};
   std::map<std::string, TriangleMesh> meshes;
   for (const auto& [name, colour] : rigid) {
-    if (!fahr::scenegen::read_obj(mesh_dir + "/" + name + ".obj", meshes[name], error)) {
+    const std::string path = std::string(mesh_dir).append("/").append(name).append(".obj");
+    if (!fahr::scenegen::read_obj(path, meshes[name], error)) {
       std::fprintf(stderr, "fahr_scene_render: %s\n", error.c_str());
       return 1;
     }

@@ -26,8 +26,9 @@ Rasterizer::Rasterizer(int width, int height, int supersample, const Camera& cam
   right_ = forward_.cross(camera.up).normalized();
   up_ = right_.cross(forward_);
   pixels_per_mm_ = w_ / camera.width_mm;
-  depth_.assign(static_cast<size_t>(w_ * h_), std::numeric_limits<double>::infinity());
-  colour_.assign(static_cast<size_t>(w_ * h_), Vec3(1.0, 1.0, 1.0));
+  depth_.assign(static_cast<size_t>(w_) * static_cast<size_t>(h_),
+                std::numeric_limits<double>::infinity());
+  colour_.assign(static_cast<size_t>(w_) * static_cast<size_t>(h_), Vec3(1.0, 1.0, 1.0));
 }
 
 void Rasterizer::draw(const scenegen::TriangleMesh& mesh, const Vec3& rgb) {
@@ -70,7 +71,8 @@ void Rasterizer::draw_triangle(const Vec3& a, const Vec3& b, const Vec3& c, cons
       const double w2 = 1.0 - w0 - w1;
       if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
       const double z = w0 * sz[0] + w1 * sz[1] + w2 * sz[2];
-      const size_t k = static_cast<size_t>(y * w_ + x);
+      const int pixel = y * w_ + x;
+      const auto k = static_cast<size_t>(pixel);
       if (z >= depth_[k]) continue;
       if (cut_.enabled) {
         const Vec3 p = w0 * a + w1 * b + w2 * c;
@@ -90,13 +92,14 @@ std::vector<uint8_t> Rasterizer::resolve() const {
       Vec3 sum = Vec3::Zero();
       for (int j = 0; j < ss_; ++j) {
         for (int i = 0; i < ss_; ++i) {
-          sum += colour_[static_cast<size_t>((y * ss_ + j) * w_ + x * ss_ + i)];
+          const int sample = (y * ss_ + j) * w_ + x * ss_ + i;
+          sum += colour_[static_cast<size_t>(sample)];
         }
       }
       const Vec3 c = (sum / samples).cwiseMax(0.0).cwiseMin(1.0) * 255.0;
       for (int ch = 0; ch < 3; ++ch) {
-        rgb[static_cast<size_t>((y * width_ + x) * 3 + ch)] =
-            static_cast<uint8_t>(std::lround(c[ch]));
+        const int byte = (y * width_ + x) * 3 + ch;
+        rgb[static_cast<size_t>(byte)] = static_cast<uint8_t>(std::lround(c[ch]));
       }
     }
   }

@@ -87,7 +87,8 @@ int folded_box_tets(const ParamBox& box) {
   const int nv = box.nv;
   const int nw = box.nw;
   std::vector<Vec3> lattice;
-  lattice.reserve(static_cast<size_t>((nu + 1) * (nv + 1) * (nw + 1)));
+  lattice.reserve(static_cast<size_t>(nu + 1) * static_cast<size_t>(nv + 1) *
+                  static_cast<size_t>(nw + 1));
   for (int i = 0; i <= nu; ++i) {
     for (int j = 0; j <= nv; ++j) {
       for (int k = 0; k <= nw; ++k) {
@@ -97,7 +98,8 @@ int folded_box_tets(const ParamBox& box) {
     }
   }
   const auto at = [&](int i, int j, int k) -> const Vec3& {
-    return lattice[static_cast<size_t>((i * (nv + 1) + j) * (nw + 1) + k)];
+    const int index = (i * (nv + 1) + j) * (nw + 1) + k;
+    return lattice[static_cast<size_t>(index)];
   };
   // Kuhn split: a monotone path from corner (0,0,0) to (1,1,1) per axis
   // permutation; the identity map gives each tet the volume sign(permutation) / 6.

@@ -125,7 +125,7 @@ bool parse_scene_parameters(const std::vector<std::string>& args, SceneParameter
       char* end = nullptr;
       const double v = std::strtod(text.c_str(), &end);
       if (end == text.c_str() || *end != '\0') {
-        error = "--" + name + ": not a number: '" + text + "'";
+        error = std::string("--").append(name).append(": not a number: '").append(text).append("'");
         return false;
       }
       *f.value = v;

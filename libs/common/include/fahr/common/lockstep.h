@@ -104,7 +104,6 @@ class LockstepClient {
   std::condition_variable changed_;
   std::int64_t granted_ = -1;
   bool stop_ = false;
-  std::uint64_t last_hash_ = 0;
   Publisher<msg::StepAck> acks_;
   Subscriber<msg::SimClock> clock_;
 };

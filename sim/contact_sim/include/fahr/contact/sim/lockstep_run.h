@@ -86,7 +86,6 @@ class LockstepRun {
   fem::ContactSet pending_;  // output of the last haptic tick
   fem::ContactSet applied_;  // what the FEM step reads
   std::vector<double> pending_forces_, applied_forces_;
-  std::uint64_t fem_state_step_ = 0;  // lockstep step that produced the FEM's newest output
   std::uint64_t tick_ = 0;
   Eigen::Vector3d previous_device_m_;
 };
