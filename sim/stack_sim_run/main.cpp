@@ -135,7 +135,20 @@ int main(int argc, char** argv) try {
         static_cast<unsigned long long>(sim.fem().anatomy_beyond_steps()));
     const auto& cpu = sim.haptic_tick_cpu();
     const auto& fem_cpu = sim.fem_step_cpu();
-    std::printf("stack_sim: FEM step CPU ms median %.2f p99 %.2f max %.2f\n",
+    // The tissue-fidelity lines, as scripts grep them: over the whole run.
+    const auto& hm = sim.haptic().metrics();
+    const auto total = [](const auto& a) {
+      return static_cast<unsigned long long>(a.load(std::memory_order_relaxed));
+    };
+    std::printf("tissue rows solved: %llu\n", total(hm.tissue_rows_total));
+    std::printf("rows without tissue compliance: %llu\n", total(hm.rows_without_compliance));
+    std::printf("rows dropped: %llu\n", total(hm.rows_dropped));
+    std::printf(
+        "stack_sim: FEM refactorisations %llu, compliance blocks solved %llu, reused %llu\n",
+        static_cast<unsigned long long>(sim.fem().refactorisations()),
+        static_cast<unsigned long long>(sim.fem().contact_step().compliance_solves()),
+        static_cast<unsigned long long>(sim.fem().contact_step().compliance_reuses()));
+    std::printf("FEM step CPU ms median %.2f p99 %.2f max %.2f\n",
                 1e-6 * static_cast<double>(fem_cpu.percentile(0.5).count()),
                 1e-6 * static_cast<double>(fem_cpu.percentile(0.99).count()),
                 1e-6 * static_cast<double>(fem_cpu.max().count()));

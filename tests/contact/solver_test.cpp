@@ -71,7 +71,7 @@ TEST(Pgs, CoupledRowsMeetTheComplementarityConditions) {
 TEST(ContactSolver, OneRowBalancesTheCouplingAgainstTheTissue) {
   test::SyntheticPatch patch = test::make_patch(1, -0.001, 0.004, 0.0);  // 1 mm penetration
   ContactSolver solver(8);
-  solver.load(patch.rows, patch.compliance(), 1e-3);
+  solver.load(patch.rows, patch.compliance());
   const double k = 500.0;
   const Eigen::Vector3d target(0, -0.002, 0);  // device 2 mm further down
   const Eigen::Vector3d step = solver.solve_coupled(k, target, PgsSettings{});
@@ -150,7 +150,7 @@ TEST(ContactSolver, LocalStiffnessIsSymmetricAndBoundedByTheCoupling) {
         Eigen::Vector3d(std::sin(angle), -std::cos(angle), 0.1 * angle).normalized();
   }
   ContactSolver solver(16);
-  solver.load(patch.rows, patch.compliance(), 1e-3);
+  solver.load(patch.rows, patch.compliance());
   const double k = 1480.0;
   solver.solve_coupled(k, Eigen::Vector3d(0.001, -0.003, 0), PgsSettings{});
   const Eigen::Matrix3d stiffness = solver.local_stiffness(k);
@@ -169,11 +169,29 @@ TEST(ContactSolver, RigidObstacleStopsTheProxy) {
   wall.tool_point_m = Eigen::Vector3d(0, 0, 0);
   wall.other_point_m = Eigen::Vector3d(0.0005, 0, 0);  // 0.5 mm gap
   ContactSolver solver(4);
-  solver.load({&wall, 1}, TissueCompliance{}, 1e-3);
+  solver.load({&wall, 1}, TissueCompliance{});
   const double k = 400.0;
   const Eigen::Vector3d step = solver.solve_coupled(k, Eigen::Vector3d(0.01, 0, 0), PgsSettings{});
   EXPECT_NEAR(step.x(), 0.0005, 1e-9);  // touches, does not enter
   EXPECT_NEAR(solver.lambda(0), k * (0.01 - 0.0005), 1e-6);
+}
+
+// A tissue row the FEM sent no compliance for is not solved on a made-up
+// constant: it is left out, counted, and pushes neither tool nor tissue.
+TEST(ContactSolver, TissueRowWithoutComplianceIsLeftOutAndCounted) {
+  test::SyntheticPatch patch = test::make_patch(4, 0.001, 0.001, 0.0001);
+  std::vector<ContactRow> rows(patch.rows.begin(), patch.rows.end());
+  rows[1].compliance_index = kNoCompliance;
+  rows[3].compliance_index = static_cast<std::int32_t>(patch.compliance().size());  // unknown
+  ContactSolver solver(8);
+  const SolverLoadReport report = solver.load(rows, patch.compliance());
+  EXPECT_EQ(report.missing_compliance, 2);
+  ASSERT_EQ(report.rows, 2u);
+  EXPECT_EQ(solver.row(0).id, rows[0].id);
+  EXPECT_EQ(solver.row(1).id, rows[2].id);
+  const SolverLoadReport none = solver.load(rows, TissueCompliance{});
+  EXPECT_EQ(none.missing_compliance, 4);
+  EXPECT_EQ(none.rows, 0u);
 }
 
 TEST(ContactSolver, WarmStartConvergesInAFewSweeps) {
@@ -181,12 +199,12 @@ TEST(ContactSolver, WarmStartConvergesInAFewSweeps) {
   test::SyntheticPatch patch = test::make_patch(30, -0.002, 0.002, 0.0001);
   ContactSolver solver(32);
   PgsSettings settings;
-  solver.load(patch.rows, patch.compliance(), 1e-3);
+  solver.load(patch.rows, patch.compliance());
   solver.solve_coupled(1000.0, Eigen::Vector3d(0, -0.001, 0), settings);
   const int cold = solver.last_report().sweeps;
   EXPECT_TRUE(solver.last_report().converged);
   solver.store_warm_start();
-  solver.load(patch.rows, patch.compliance(), 1e-3);
+  solver.load(patch.rows, patch.compliance());
   solver.solve_coupled(1000.0, Eigen::Vector3d(0, -0.001, 0), settings);
   EXPECT_LE(solver.last_report().sweeps, 2);
   EXPECT_GT(cold, 2);

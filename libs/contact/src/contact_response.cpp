@@ -425,7 +425,7 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   const EffectiveCoupling coupling =
       effective_coupling(settings_.coupling, device.max_stiffness_npm, device.dt_s,
                          device.position_m, device.velocity_mps, p0);
-  report_.load = solver_.load(input.rows, input.compliance, settings_.fallback_compliance_mpn);
+  report_.load = solver_.load(input.rows, input.compliance);
   if (settings_.mode == ResponseMode::kNaive) solver_.make_rigid();
   const Eigen::Vector3d step = keep_out_of_bone(move_proxy(input, coupling));
   solver_.store_warm_start();

@@ -39,7 +39,6 @@ ContactSolver::ContactSolver(std::size_t capacity)
       depth_(capacity, 0.0),
       lambda_(capacity, 0.0),
       residual_(capacity, 0.0),
-      fallback_diagonal_(capacity, 0.0),
       previous_keys_(capacity, 0),
       previous_lambda_(capacity, 0.0),
       active_(capacity, 0),
@@ -51,8 +50,7 @@ ContactSolver::ContactSolver(std::size_t capacity)
       projection_mu_(capacity, 0.0) {}
 
 SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows,
-                                     const TissueCompliance& compliance,
-                                     double fallback_compliance_mpn) {
+                                     const TissueCompliance& compliance) {
   SolverLoadReport report;
   k_ = 0;
   const bool have_w = compliance.valid();
@@ -62,25 +60,27 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows,
       ++report.degenerate_normals;
       continue;
     }
+    const bool has_block = row.kind == RowKind::kTissue && have_w && row.compliance_index >= 0 &&
+                           static_cast<std::size_t>(row.compliance_index) < compliance.size();
+    if (row.kind == RowKind::kTissue && !has_block) {
+      // No constant stands in for the tissue's compliance: the row is left out.
+      ++report.missing_compliance;
+      continue;
+    }
     if (k_ == capacity_) {
       report.overflow = true;
       break;
     }
     rows_[k_] = row;
-    const bool has_block = row.kind == RowKind::kTissue && have_w && row.compliance_index >= 0 &&
-                           static_cast<std::size_t>(row.compliance_index) < compliance.size();
-    if (row.kind == RowKind::kTissue && !has_block) ++report.missing_compliance;
-    rows_[k_].compliance_index = has_block ? row.compliance_index : kNoCompliance;
+    if (row.kind != RowKind::kTissue) rows_[k_].compliance_index = kNoCompliance;
     depth_[k_] = row.penetration_m();
     ++k_;
   }
-  // A_ij = n_i^T W_ij n_j for tissue rows with blocks; a fallback diagonal
-  // for tissue rows without; zero for obstacles (rigid).
+  // A_ij = n_i^T W_ij n_j for tissue rows; zero for obstacles (rigid).
   // Filled for j <= i and mirrored: W's stored blocks are symmetric only to
   // float rounding, and the PGS relies on an exactly symmetric S.
   for (std::size_t i = 0; i < k_; ++i) {
     const ContactRow& ri = rows_[i];
-    fallback_diagonal_[i] = 0.0;
     for (std::size_t j = 0; j <= i; ++j) {
       const ContactRow& rj = rows_[j];
       double value = 0.0;
@@ -88,9 +88,6 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows,
         value =
             compliance.normal_compliance(static_cast<std::size_t>(ri.compliance_index), ri.normal,
                                          static_cast<std::size_t>(rj.compliance_index), rj.normal);
-      } else if (i == j && ri.kind == RowKind::kTissue) {
-        value = fallback_compliance_mpn;
-        fallback_diagonal_[i] = 1.0;
       }
       a_[i * capacity_ + j] = value;
       a_[j * capacity_ + i] = value;
@@ -235,12 +232,7 @@ Eigen::Vector3d ContactSolver::predicted_motion(std::size_t i,
                                                 const TissueCompliance& compliance) const {
   Eigen::Vector3d motion = Eigen::Vector3d::Zero();
   const ContactRow& ri = rows_[i];
-  if (ri.compliance_index == kNoCompliance) {
-    // Fallback rows move along their own normal only.
-    return fallback_diagonal_[i] > 0.0
-               ? Eigen::Vector3d(ri.normal * a_[i * capacity_ + i] * lambda_[i])
-               : motion;
-  }
+  if (ri.compliance_index == kNoCompliance) return motion;
   for (std::size_t j = 0; j < k_; ++j) {
     const ContactRow& rj = rows_[j];
     if (rj.compliance_index == kNoCompliance || lambda_[j] == 0.0) continue;

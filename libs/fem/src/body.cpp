@@ -106,6 +106,8 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
         mass_kg_[i] * settings_.gravity_m_per_s2;
   }
   supports_.assign(n, NodeSupport{});
+  held_at_factor_.assign(n, 0);
+  factor_held_.assign(n, 0);
   rotations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
   rotations_at_factor_ = rotations_;
   stiffening_ = settings_.material.yeoh_c20_over_c10 > 0.0;
@@ -138,6 +140,7 @@ void Body::assemble_system() {
 void Body::set_supports(std::span<const NodeSupport> supports, double stiffness_ratio) {
   support_count_ = 0;
   support_ratio_ = stiffness_ratio > 0.0 ? stiffness_ratio : 0.0;
+  std::size_t held_then = 0;  // of the new set, nodes the factorisation holds too
   if (support_ratio_ > 0.0) {
     for (const NodeSupport& s : supports) {
       if (s.node >= node_count() || fixed(s.node) || !s.normal.allFinite() ||
@@ -145,9 +148,11 @@ void Body::set_supports(std::span<const NodeSupport> supports, double stiffness_
         continue;
       }
       supports_[support_count_++] = s;
+      held_then += held_at_factor_[s.node];
     }
   }
-  supports_changed_ = true;
+  // Nodes held now and not in the factorisation, and the other way round.
+  support_changes_ = (support_count_ - held_then) + (held_at_factor_count_ - held_then);
 }
 
 std::string Body::set_solver(const SolverSettings& solver) {
@@ -168,7 +173,13 @@ std::string Body::set_solver(const SolverSettings& solver) {
 bool Body::refactorise() {
   steps_since_factor_ = 0;
   refresh_due_ = false;
-  supports_changed_ = false;
+  for (std::size_t i = 0; i < held_at_factor_count_; ++i) held_at_factor_[factor_held_[i]] = 0;
+  held_at_factor_count_ = support_count_;
+  for (std::size_t i = 0; i < support_count_; ++i) {
+    factor_held_[i] = supports_[i].node;
+    held_at_factor_[supports_[i].node] = 1;
+  }
+  support_changes_ = 0;
   std::copy(rotations_.begin(), rotations_.end(), rotations_at_factor_.begin());
   std::copy(stiffening_scales_.begin(), stiffening_scales_.end(),
             stiffening_scales_at_factor_.begin());
@@ -217,14 +228,21 @@ int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_en
   return inverted;
 }
 
-// The support springs changed A as much as a rotation past the threshold
-// would: the direct solve refactorises when the rotation trigger is on (a
-// factor without them would not feel the bone at all). CG multiplies with
-// the current A, but W comes from the factor: without the springs in it W
-// was off by up to 95 % on the pressed tongue (fem_tongue_press), so a
-// lagged-factor CG refreshes too.
+// The support springs changed A: the direct solve refactorises when the
+// rotation trigger is on (a factor without them would not feel the bone at
+// all). CG multiplies with the current A, but W comes from the factor:
+// without the springs in it W was off by up to 95 % on the pressed tongue
+// (fem_tongue_press), so a lagged-factor CG refreshes too. A few nodes
+// joining or leaving the held set are a small low-rank change of A, and
+// nodes sitting on the bone with no force flicker in and out from step to
+// step: refreshing on every change refactorised in 55 % of the 20 s
+// intubation's steps, and each refresh solves W's columns again. So the
+// factor follows the held set once a quarter of it (and at least
+// kSupportChangesForRefresh nodes) changed.
 bool Body::support_changed_factor_due(bool cg) const {
-  return supports_changed_ && (cg || settings_.solver.refactor_rotation_rad > 0.0);
+  const bool many = support_changes_ >= kSupportChangesForRefresh &&
+                    4 * support_changes_ >= held_at_factor_count_;
+  return many && (cg || settings_.solver.refactor_rotation_rad > 0.0);
 }
 
 bool Body::rotated_since_factor() const {

@@ -61,10 +61,9 @@ std::size_t ComplianceBlock::slot_for(std::uint32_t sphere, std::uint64_t factor
   std::size_t oldest = slots_.size();
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     Slot& slot = slots_[i];
-    // A slot already claimed in this call (last_use == now) for the same
-    // sphere is shared, solved or not.
-    if (slot.sphere == sphere && slot.factorisation == factorisation &&
-        (slot.valid || slot.last_use == now)) {
+    // The sphere's columns, from this factorisation or an earlier one (then
+    // refreshed within the budget, oldest first), or claimed in this call.
+    if (slot.sphere == sphere && (slot.valid || slot.last_use == now)) {
       cached = slot.valid || slot.last_use == now;
       slot.last_use = now;
       return i;
@@ -96,6 +95,7 @@ void ComplianceBlock::solve_chunk(std::span<const std::size_t> slots, const Sphe
   warp.solve_columns(factor, {rhs_.data(), dofs_ * columns}, {solution_.data(), dofs_ * columns},
                      static_cast<int>(columns));
   for (std::size_t s = 0; s < slots.size(); ++s) {
+    slots_[slots[s]].factorisation = factor.factorisations();
     const auto from = solution_.begin() + static_cast<std::ptrdiff_t>(dofs_ * 3 * s);
     std::copy(from, from + static_cast<std::ptrdiff_t>(3 * dofs_),
               columns_.begin() + static_cast<std::ptrdiff_t>(dofs_ * 3 * slots[s]));
@@ -124,6 +124,26 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
     bool cached = false;
     request_slots_[s] = slot_for(spheres[s], factorisation, cached);
     if (!cached) to_solve_.push_back(request_slots_[s]);
+  }
+  // Spheres new to the block are solved in full; columns of an earlier
+  // factorisation are refreshed, the oldest first, up to the budget a call.
+  std::size_t refresh = 0;
+  while (refresh < refresh_per_call_) {
+    std::size_t stalest = slots_.size();
+    for (std::size_t s = 0; s < k; ++s) {
+      const Slot& slot = slots_[request_slots_[s]];
+      if (!slot.valid || slot.factorisation == factorisation) continue;
+      if (stalest == slots_.size() || slot.factorisation < slots_[stalest].factorisation)
+        stalest = request_slots_[s];
+    }
+    if (stalest == slots_.size()) break;
+    slots_[stalest].factorisation = factorisation;
+    to_solve_.push_back(stalest);
+    ++refresh;
+  }
+  for (std::size_t s = 0; s < k; ++s) {
+    const std::uint64_t lag = factorisation - slots_[request_slots_[s]].factorisation;
+    oldest_lag_ = std::max<std::uint64_t>(oldest_lag_, lag);
   }
   for (std::size_t done = 0; done < to_solve_.size();) {
     const std::size_t left = to_solve_.size() - done;

@@ -12,6 +12,13 @@ namespace {
 // step is let go, m: 0.1 um, far below anything visible, far above the
 // rounding of positions of a few centimetres.
 constexpr double kLiftOffM = 1e-7;
+// A held node keeps the normal it was held along while the bone's normal
+// under it stays within this angle (cos of 0.1 rad, the angle at which a
+// lagged factorisation is refreshed for an element's rotation): the spring's
+// direction is then off by less than the factor's own lag, and the field's
+// gradient, which differs in the last bits whenever the node moves, does not
+// change A in every step.
+constexpr double kSameNormalCos = 0.995004165278025766;
 
 }  // namespace
 
@@ -39,8 +46,13 @@ bool ObstacleSupport::update(const ObstacleProjection& anatomy, std::span<const 
     const std::int32_t slot = slot_of_node_[n];
     if (anatomy.moved(n)) {
       const Eigen::Vector3d& normal = anatomy.move_normal(n);
+      if (slot >= 0 &&
+          previous_[static_cast<std::size_t>(slot)].normal.dot(normal) >= kSameNormalCos) {
+        supports_[count_++] = previous_[static_cast<std::size_t>(slot)];
+        continue;
+      }
       supports_[count_++] = NodeSupport{static_cast<std::uint32_t>(n), normal};
-      changed = changed || slot < 0 || previous_[static_cast<std::size_t>(slot)].normal != normal;
+      changed = true;
       continue;
     }
     if (slot < 0) continue;

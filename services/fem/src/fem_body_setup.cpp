@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "deformation_state.h"
 #include "fahr/layout_links/fem_links.h"
 #include "fahr/runtime/scene_bodies.h"
 #include "fahr/sphere_layout/fill_spheres.h"
@@ -73,8 +74,9 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
   const double age_steps =
       std::chrono::duration<double>(scene.solver.max_contact_age).count() * scene.rates.fem_hz;
   s.max_contact_age_steps = static_cast<std::uint64_t>(std::max(1.0, std::ceil(age_steps)));
-  s.max_compliance_spheres =
-      static_cast<std::size_t>(std::min(scene.solver.max_candidate_contacts, 64));
+  // A DeformationState carries W for at most msg::MAX_COMPLIANCE_SPHERES.
+  s.max_compliance_spheres = std::min<std::size_t>(
+      static_cast<std::size_t>(scene.solver.max_candidate_contacts), msg::MAX_COMPLIANCE_SPHERES);
   return s;
 }
 

@@ -66,6 +66,7 @@ void ServiceStep::step() {
   inverted_max_ = std::max<std::uint64_t>(
       inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
   if (last_report_.diverged_reset) ++divergence_resets_;
+  if (last_report_.refactorised) ++refactorisations_;
   anatomy_returned_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_returned);
   anatomy_beyond_steps_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_beyond);
   anatomy_depth_max_m_ = std::max(anatomy_depth_max_m_, last_report_.projection.obstacle_deepest_m);

@@ -24,6 +24,9 @@ constexpr std::size_t kAnatomyContactCapacity = 128;
 // lambda = 0 unless the proxy moves into them): the solve then stops the
 // proxy within the tick instead of one tick late, m. 1 mm: a hand at 1 m/s.
 constexpr double kAnatomyMarginM = 1e-3;
+// How much deeper a contact without W must be than one with W to be the
+// row instead, m (select_rows).
+constexpr double kRowStickinessM = 1e-4;
 
 template <class T>
 void relaxed_store(std::atomic<T>& a, T v) {
@@ -71,10 +74,11 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
       tool_contacts_(kToolContactCapacity),
       order_(kToolContactCapacity, 0),
       row_key_(kToolContactCapacity, 0.0),
+      order_scratch_(setup.response.max_rows, 0),
       anatomy_contacts_(kAnatomyContactCapacity),
       anatomy_order_(kAnatomyContactCapacity, 0),
-      tissue_row_budget_(
-          std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES, setup.response.max_rows)),
+      tissue_row_budget_(std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES - kComplianceRequests,
+                                               setup.response.max_rows)),
       rows_(setup.response.max_rows) {
   if (setup.collision == CollisionMethod::kTriangle) {
     triangle_contacts_.reserve(kToolContactCapacity);
@@ -128,43 +132,79 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   return d;
 }
 
-// The rows' order of choice (haptic_setup.h RowCompliance): the k deepest,
-// or the deepest with a W sphere's depth taken on its free centre. Keys are
-// worked out once per contact, then partially sorted, as select_deepest does
-// for the depth alone.
-std::size_t HapticLoop::select_rows(const TissueSnapshot& tissue) {
-  if (setup_.row_compliance == RowCompliance::kDeepest) {
-    return collision::select_deepest(tool_contacts_, tissue_row_budget_, order_);
-  }
+// The rows: the deepest contacts (haptic_setup.h RowCompliance: by depth,
+// or with a W sphere's depth taken on its free centre) whose sphere has W in
+// this state, at most the row budget. No constant stands in for the
+// tissue: a contact that would be a row by its depth but whose sphere the
+// FEM sent no W for is counted (rows without tissue compliance) and asked
+// for, a candidate in the next ContactSet, so the FEM's next block has it.
+// order_ ends with the rows first, then the requests; keys are worked out
+// once per contact and partially sorted, allocation-free.
+void HapticLoop::select_rows(const TissueSnapshot& tissue) {
   const std::size_t n = std::min(tool_contacts_.size(), order_.size());
   std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
-  if (n <= tissue_row_budget_) return n;
   for (std::size_t i = 0; i < n; ++i) {
     const std::int32_t w = tissue.compliance_index[tool_contacts_[i].sphere_id];
     double key = tool_contacts_[i].depth_m;
     // |c - c_free| stands for (c - c_free) . n, the FEM's shift being along
     // the pushing normals.
-    if (w >= 0) key += double{tissue.free_shift_m[static_cast<std::size_t>(w)]};
+    if (w >= 0 && setup_.row_compliance == RowCompliance::kFreeDepth)
+      key += double{tissue.free_shift_m[static_cast<std::size_t>(w)]};
+    // A sphere with W keeps its place against one without unless that is
+    // deeper by kRowStickinessM: under a flat blade hundreds of spheres lie
+    // within a few micrometres of each other's depth, and a row set chosen
+    // by depth alone is a new set every tick, none of it in the FEM's block.
+    if (w >= 0) key += kRowStickinessM;
     row_key_[i] = key;
   }
-  std::partial_sort(order_.begin(),
-                    order_.begin() + static_cast<std::ptrdiff_t>(tissue_row_budget_),
+  // Twice the budget: rows past a few spheres without W still fill it.
+  const std::size_t sorted = std::min(n, 2 * tissue_row_budget_);
+  std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(sorted),
                     order_.begin() + static_cast<std::ptrdiff_t>(n),
                     [&](std::uint32_t a, std::uint32_t b) { return row_key_[a] > row_key_[b]; });
-  return tissue_row_budget_;
+  row_pick_ = 0;
+  request_count_ = 0;
+  std::size_t without_w = 0;
+  // Requests: the deepest contacts without W, those deep enough to be rows
+  // first, then the next ones down, so W is there before they get that deep.
+  for (std::size_t r = 0; r < sorted; ++r) {
+    const std::uint32_t c = order_[r];
+    if (tissue.compliance_index[tool_contacts_[c].sphere_id] >= 0) {
+      if (row_pick_ < tissue_row_budget_) order_scratch_[row_pick_++] = c;
+      continue;
+    }
+    if (r < tissue_row_budget_) ++without_w;
+    if (request_count_ < kComplianceRequests) request_of_[request_count_++] = c;
+  }
+  std::copy_n(order_scratch_.begin(), row_pick_, order_.begin());
+  std::copy_n(request_of_.begin(), request_count_,
+              order_.begin() + static_cast<std::ptrdiff_t>(row_pick_));
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, n - row_pick_);
+  rows_without_w_ = without_w;
 }
 
 void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
-  // More than W can cover: keep the deepest (touching before candidates),
-  // and only those get their point and normal (defer_outside_contacts).
-  const std::size_t keep = select_rows(tissue);
-  relaxed_add<std::uint64_t>(metrics_.rows_dropped, tool_contacts_.size() - keep);
+  select_rows(tissue);
+  // Only the rows and the requests get their point and normal
+  // (defer_outside_contacts).
   collision::complete_deferred(tissue.tree, tool_body_, tool_query_, tool_contacts_, order_.data(),
-                               keep);
+                               row_pick_ + request_count_);
+  for (std::size_t q = 0; q < request_count_; ++q) {
+    const collision::SphereContact& s = tool_contacts_[order_[row_pick_ + q]];
+    fem::Contact& c = requests_[q];
+    c.sphere_id = s.sphere_id;
+    c.kind = fem::ContactKind::kTool;
+    c.state = fem::ContactState::kCandidate;
+    c.normal = s.normal;
+    c.plane_point_m = s.point_m;
+    c.hold_centre_m = tissue.spheres.centres_m()[s.sphere_id];
+    c.penetration_m = s.depth_m;
+    c.force_n = 0.0;
+  }
   // (The penalty baseline's forces are part of the FEM's step, so it reads
   // the published centres.)
   const bool free_centres = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
-  for (std::size_t r = 0; r < keep; ++r) {
+  for (std::size_t r = 0; r < row_pick_; ++r) {
     const collision::SphereContact& s = tool_contacts_[order_[r]];
     contact::ContactRow& row = rows_[row_count_++];
     row.kind = contact::RowKind::kTissue;
@@ -286,6 +326,8 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   const Eigen::Vector3d tool_at = setup_.penalty ? device.position_m : response_.proxy().position_m;
   tool_body_.world_from_body = Eigen::Translation3d(tool_at) * device.orientation;
   row_count_ = 0;
+  request_count_ = 0;
+  rows_without_w_ = 0;
   const auto query_start = std::chrono::steady_clock::now();
   phases_.tissue_query = {};
   if (setup_.collision == CollisionMethod::kTriangle && tissue.triangles) {
@@ -336,6 +378,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
     contacts.tool_frozen(response_.tool_frozen());
     fill_contacts(response_.contacts(), tool_body_.id, tissue.tissue_obstacle_body_ids(), contacts);
   }
+  append_contacts({requests_.data(), request_count_}, tool_body_.id, contacts);
   // Where the FEM finds the tool: the proxy after this tick (the penalty
   // baseline's tool is the device).
   common::put(setup_.penalty ? device.position_m : response_.proxy().position_m,
@@ -348,8 +391,12 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   relaxed_add<std::uint64_t>(metrics_.ticks, 1);
   relaxed_store(metrics_.tool_rows, static_cast<std::uint32_t>(tissue_rows));
   relaxed_store(metrics_.active_contacts, out.active_contacts);
-  relaxed_store(metrics_.missing_compliance, static_cast<std::uint32_t>(std::max(
-                                                 0, response_.report().load.missing_compliance)));
+  const auto without_w = static_cast<std::uint32_t>(
+      rows_without_w_ +
+      static_cast<std::size_t>(std::max(0, response_.report().load.missing_compliance)));
+  relaxed_store(metrics_.missing_compliance, without_w);
+  relaxed_add<std::uint64_t>(metrics_.tissue_rows_total, tissue_rows);
+  relaxed_add<std::uint64_t>(metrics_.rows_without_compliance, without_w);
   relaxed_store(metrics_.reaction_n, out.tissue_reaction_n);
   relaxed_store(metrics_.obstacle_reaction_n, response_.report().obstacle_reaction_n);
   const double force_n = out.force_n.norm();
@@ -404,6 +451,8 @@ void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out
   out.emplace_back("rows_dropped", get(metrics_.rows_dropped));
   out.emplace_back("query_overflows", get(metrics_.query_overflows));
   out.emplace_back("missing_compliance", get(metrics_.missing_compliance));
+  out.emplace_back("tissue_rows_total", get(metrics_.tissue_rows_total));
+  out.emplace_back("rows_without_compliance", get(metrics_.rows_without_compliance));
   out.emplace_back("lost_track_ticks", get(metrics_.lost_track_ticks));
   out.emplace_back("lost_track_episodes", get(metrics_.lost_track_episodes));
   out.emplace_back("tissue_reaction_n", get(metrics_.reaction_n));

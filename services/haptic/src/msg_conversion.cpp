@@ -68,4 +68,24 @@ void fill_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_bo
   }
 }
 
+void append_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_body_id,
+                     msg::ContactSet& out) {
+  const std::size_t first = out.contacts().size();
+  const std::size_t n = std::min<std::size_t>(contacts.size(), msg::MAX_CONTACTS - first);
+  out.contacts().resize(first + n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const fem::Contact& c = contacts[i];
+    msg::Contact& w = out.contacts()[first + i];
+    w.sphere_id(c.sphere_id);
+    w.kind(msg::CONTACT_TOOL);
+    w.other_body_id(tool_body_id);
+    w.state(wire_state(c.state));
+    put(c.plane_point_m, w.point_m());
+    put(c.normal, w.normal());
+    put(c.hold_centre_m, w.hold_centre_m());
+    w.penetration_m(c.penetration_m);
+    w.force_n(c.force_n);
+  }
+}
+
 }  // namespace fahr::haptic_service

@@ -42,11 +42,6 @@ struct ResponseSettings {
   std::size_t max_contacts =
       256;  // ContactSet entries per tick, incl. held spheres and obstacle contacts
   std::size_t max_holds = 64;  // spheres held while frozen
-  // Compliance of a touching sphere whose W block the FEM did not send (it
-  // was not yet a candidate), m/N, >= 0. 1e-3 m/N is a 1 kN/m tissue spring,
-  // stiffer than the neonatal tongue under a ~3 mm sphere (~ 50 N/m), so the
-  // tool is not let in too far for the one FEM step until W arrives.
-  double fallback_compliance_mpn = 1e-3;
 };
 
 // One DevicePose as the response needs it (world frame).

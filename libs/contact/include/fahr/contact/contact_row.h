@@ -34,7 +34,7 @@ struct ContactRow {
   // Sphere radius r, m, >= 0; 0 for obstacles.
   double radius_m = 0.0;
   // Tissue: index of the sphere in TissueCompliance::sphere_ids, or
-  // kNoCompliance (the solver then uses a fallback compliance). Ignored for
+  // kNoCompliance (the solver then leaves the row out). Ignored for
   // obstacles.
   std::int32_t compliance_index = kNoCompliance;
 

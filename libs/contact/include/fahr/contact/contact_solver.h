@@ -19,7 +19,7 @@ namespace fahr::contact {
 struct SolverLoadReport {
   std::size_t rows = 0;        // rows loaded
   bool overflow = false;       // more rows than capacity: the extra rows were dropped
-  int missing_compliance = 0;  // tissue rows without a W block: fallback compliance used
+  int missing_compliance = 0;  // tissue rows without a W block: left out of the solve
   int degenerate_normals = 0;  // rows whose normal is not unit length: dropped
 };
 
@@ -29,11 +29,10 @@ class ContactSolver {
   explicit ContactSolver(std::size_t capacity);
 
   // Copies the rows (in order) and builds A from `compliance`. A tissue row
-  // without a block gets fallback_compliance_mpn on its diagonal (m/N, >= 0)
-  // and no coupling to the others; obstacle rows get 0 (rigid). Warm starts
-  // lambda from the previous stored solution with the same (kind, id).
-  SolverLoadReport load(std::span<const ContactRow> rows, const TissueCompliance& compliance,
-                        double fallback_compliance_mpn);
+  // without a block in it is left out and counted (no constant stands in
+  // for the tissue); obstacle rows get 0 (rigid). Warm starts lambda from
+  // the previous stored solution with the same (kind, id).
+  SolverLoadReport load(std::span<const ContactRow> rows, const TissueCompliance& compliance);
 
   // W = 0 for every row (the naive loop: the tissue does not yield).
   void make_rigid();
@@ -85,13 +84,12 @@ class ContactSolver {
   std::size_t capacity_;
   std::size_t k_ = 0;
   std::vector<ContactRow> rows_;
-  std::vector<double> a_;                  // Delassus A, capacity^2, m/N
-  std::vector<double> s_;                  // system matrix of the current solve, capacity^2, m/N
-  std::vector<double> b_;                  // right-hand side, m
-  std::vector<double> depth_;              // d at p0, m
-  std::vector<double> lambda_;             // N
-  std::vector<double> residual_;           // PGS workspace, m
-  std::vector<double> fallback_diagonal_;  // per row: 1 if A_ii came from the fallback
+  std::vector<double> a_;         // Delassus A, capacity^2, m/N
+  std::vector<double> s_;         // system matrix of the current solve, capacity^2, m/N
+  std::vector<double> b_;         // right-hand side, m
+  std::vector<double> depth_;     // d at p0, m
+  std::vector<double> lambda_;    // N
+  std::vector<double> residual_;  // PGS workspace, m
   std::vector<std::uint64_t> previous_keys_;
   std::vector<double> previous_lambda_;
   std::size_t previous_count_ = 0;

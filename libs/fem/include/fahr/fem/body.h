@@ -233,7 +233,13 @@ class Body {
   std::vector<NodeSupport> supports_;  // capacity: every node
   std::size_t support_count_ = 0;
   double support_ratio_ = 0.0;
-  bool supports_changed_ = false;  // since the last factorisation
+  // The held set in the last factorisation: a flag per node, its nodes, and
+  // how many nodes joined or left it since (set_supports).
+  std::vector<std::uint8_t> held_at_factor_;
+  std::vector<std::uint32_t> factor_held_;
+  std::size_t held_at_factor_count_ = 0;
+  std::size_t support_changes_ = 0;
+  static constexpr std::size_t kSupportChangesForRefresh = 8;
   int steps_since_factor_ = 0;
   // A CG solve took more than cg_refresh_iterations: refactorise next step.
   bool refresh_due_ = false;

@@ -3,11 +3,15 @@
 // newton of force on them, with the tissue's inertia, damping and stiffness.
 //
 // The solved columns A^-1 J_s^T of each sphere are kept, tagged with the
-// factorisation they came from: while the factorisation is unchanged (a
-// lagged factor, SolverSettings), a sphere that joins the block costs its
+// factorisation they came from: a sphere that joins the block costs its
 // three columns and the others cost nothing, instead of the whole block
 // being solved again whenever the set of spheres changes (on the neonatal
-// tongue it changes in most steps while the blade slides).
+// tongue it changes in most steps while the blade slides). After a
+// refactorisation the kept columns are those of the one before (a lagged
+// factor is refreshed when an element turned 0.1 rad: W from the previous
+// one differs by about that much); a budget of spheres a call
+// (refresh_per_call) is solved again on the new factor, the stalest first,
+// so a refactorisation costs no burst of solves for the whole block.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,6 +31,17 @@ class ComplianceBlock {
   // candidates. Allocates.
   void reserve(std::size_t dofs, std::size_t max_spheres);
   std::size_t capacity() const { return max_spheres_; }
+  // Spheres whose kept columns are solved again on a newer factorisation
+  // per compute() call, oldest first (default 4); 0: never (columns of a
+  // sphere stay those of its first solve while it stays in the block).
+  void set_refresh_per_call(std::size_t spheres) { refresh_per_call_ = spheres; }
+  // The most factorisations a block's columns lagged behind since the last
+  // call of this (then reset): what the refresh budget left.
+  std::uint64_t take_oldest_lag() {
+    const std::uint64_t lag = oldest_lag_;
+    oldest_lag_ = 0;
+    return lag;
+  }
 
   // Writes W, (3k x 3k) row-major float, m/N, for the k spheres listed, from
   // `factor` (a factorisation of A = M + h D + h^2 K, kg), solving only the
@@ -79,6 +94,8 @@ class ComplianceBlock {
   std::vector<double> rhs_;                 // one chunk of right-hand sides
   std::vector<double> solution_;
   std::uint64_t uses_ = 0;
+  std::size_t refresh_per_call_ = 4;
+  std::uint64_t oldest_lag_ = 0;
 };
 
 }  // namespace fahr::fem

@@ -51,6 +51,8 @@ class ServiceStep {
   // Steps after which the body had diverged and was reset to rest
   // (fem::StepReport::diverged_reset).
   std::uint64_t divergence_resets() const { return divergence_resets_; }
+  // Steps that refactorised the system matrix (fem::StepReport::refactorised).
+  std::uint64_t refactorisations() const { return refactorisations_; }
   // Nodes let back through a bone on their way home, and node-steps a node
   // spent beyond a bone, left alone by it (fem obstacle_projection.h).
   std::uint64_t anatomy_returned() const { return anatomy_returned_; }
@@ -72,6 +74,7 @@ class ServiceStep {
   fem::StepReport last_report_;
   std::uint64_t inverted_max_ = 0;
   std::uint64_t divergence_resets_ = 0;
+  std::uint64_t refactorisations_ = 0;
   std::uint64_t anatomy_returned_ = 0;
   std::uint64_t anatomy_beyond_steps_ = 0;
   double anatomy_depth_max_m_ = 0.0;

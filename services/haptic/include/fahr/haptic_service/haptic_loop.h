@@ -6,6 +6,7 @@
 // nothing once the wire samples hold their reserved capacity.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -38,7 +39,9 @@ struct LoopMetrics {
   std::atomic<std::uint32_t> active_contacts{0};     // rows with lambda > 0, last tick
   std::atomic<std::uint64_t> rows_dropped{0};        // tool contacts beyond the row budget, total
   std::atomic<std::uint64_t> query_overflows{0};     // contact buffer full, total
-  std::atomic<std::uint32_t> missing_compliance{0};  // rows on the fallback compliance, last tick
+  std::atomic<std::uint32_t> missing_compliance{0};  // rows without tissue compliance, last tick
+  std::atomic<std::uint64_t> tissue_rows_total{0};   // tissue rows solved, all ticks
+  std::atomic<std::uint64_t> rows_without_compliance{0};  // of those, rows without W, total
   std::atomic<std::uint64_t> lost_track_ticks{0};
   std::atomic<std::uint64_t> lost_track_episodes{0};
   std::atomic<double> reaction_n{0.0};  // last tissue reaction, N
@@ -65,6 +68,11 @@ struct TickPhases {
 // Rows the tool may have against rigid anatomy per tick: one per sample
 // leaf touching (~5 mm of blade each), the deepest kept.
 inline constexpr std::size_t kMaxAnatomyRows = 16;
+// Spheres a tick may ask the FEM's compliance for beyond its rows (contacts
+// deep enough to be rows whose sphere has no W yet): candidates at the end
+// of the ContactSet. The FEM's block holds the rows and these
+// (msg::MAX_COMPLIANCE_SPHERES).
+inline constexpr std::size_t kComplianceRequests = 16;
 
 class HapticLoop {
  public:
@@ -85,7 +93,7 @@ class HapticLoop {
  private:
   contact::DeviceSample device_sample(const msg::DevicePose& pose);
   void collect_tissue_rows(const TissueSnapshot& tissue);
-  std::size_t select_rows(const TissueSnapshot& tissue);
+  void select_rows(const TissueSnapshot& tissue);
   void collect_triangle_rows(const TissueSnapshot& tissue);
   void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
   const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device,
@@ -107,7 +115,13 @@ class HapticLoop {
   collision::ContactBuffer tool_contacts_;
   std::vector<std::uint32_t>
       order_;                    // indices into tool_contacts_, deepest first when over capacity
-  std::vector<double> row_key_;  // per contact: select_rows' key (RowCompliance::kFreeDepth)
+  std::vector<double> row_key_;  // per contact: select_rows' key
+  std::vector<std::uint32_t> order_scratch_;                     // select_rows: the rows' contacts
+  std::array<std::uint32_t, kComplianceRequests> request_of_{};  // select_rows: requests
+  std::array<fem::Contact, kComplianceRequests> requests_{};     // this tick's W requests
+  std::size_t row_pick_ = 0;                                     // rows select_rows took
+  std::size_t request_count_ = 0;                                // requests this tick
+  std::size_t rows_without_w_ = 0;  // contacts deep enough to be rows, without W
   // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
   std::vector<collision::TriangleContact> triangle_contacts_;
   std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1

@@ -23,5 +23,9 @@ void fill_command(const contact::ForceOutput& output, std::uint32_t device_id,
 // response copies the tissue-obstacle contacts after the tool's).
 void fill_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_body_id,
                    std::span<const std::uint32_t> obstacle_body_ids, msg::ContactSet& out);
+// Appends tool contacts after what `out` holds (the tick's compliance
+// requests), up to msg::MAX_CONTACTS in all.
+void append_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_body_id,
+                     msg::ContactSet& out);
 
 }  // namespace fahr::haptic_service
