@@ -36,6 +36,15 @@ struct SolverSettings {
   // the rotation trigger. Applies where the rotation trigger does (a factor
   // in use and refactor_period != 1).
   double refactor_stiffening_change = 0.1;
+  // With the Stable Neo-Hookean material (whose tangent depends on the
+  // whole F, not on a rotation): also refactorise when some element's
+  // deformation gradient has changed by more than this (Frobenius norm,
+  // dimensionless) since the last factorisation (0 disables). 0.1 is a turn
+  // of 0.07 rad or a 10 % change of stretch; the SNH tangent is smooth in F,
+  // so its blocks are then off by about that fraction (more where the Yeoh
+  // term stiffens a compressed element: the criterion sees the strain that
+  // stiffens it). Applies where the rotation trigger does.
+  double refactor_deformation_change = 0.1;
   // Rotate a reused factorisation per node into the current frame (see
   // warped_factor.h). Off only to measure what it buys.
   bool warp_lagged_factor = false;
