@@ -5,10 +5,13 @@
 // Equal hashes show that the in-process run is the distributed one.
 //
 //   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
-//                      [--stiffening C20/C10] [--volume-floor R] [--w-normals N] [--seconds 4]
+//                      [--stiffening C20/C10] [--material corotational|stable_neo_hookean]
+//                      [--volume-floor R] [--w-normals N] [--seconds 4]
 //
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
 // (libs/fem compression_stiffening.h; 0: off), instead of the scene's.
+// --material: the tongue's material model (material.model) instead of the
+// scene's; with stable_neo_hookean the Yeoh ratio is the energy's term.
 // --w-normals N: W along the ContactSet's normals for N spheres (the
 // scene's solver.compliance_columns: normals), with rows by free depth.
 #include <CLI/CLI.hpp>
@@ -42,6 +45,10 @@ int main(int argc, char** argv) try {
   app.add_option("--stiffening", stiffening,
                  "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
       ->check(CLI::Range(0.0, 100.0));
+  std::string material;
+  app.add_option("--material", material,
+                 "the tongue's material model, material.model (default: the scene's)")
+      ->check(CLI::IsMember({"corotational", "stable_neo_hookean"}));
   double volume_floor = -1.0;
   app.add_option("--volume-floor", volume_floor,
                  "no tet ends a FEM step below this share of its rest volume "
@@ -67,6 +74,11 @@ int main(int argc, char** argv) try {
     for (auto& body : scene->bodies) {
       if (body.deformable && stiffening >= 0.0)
         body.deformable->material.yeoh_c20_over_c10 = stiffening;
+      if (body.deformable && !material.empty()) {
+        body.deformable->material.model = material == "stable_neo_hookean"
+                                              ? scene::MaterialModel::kStableNeoHookean
+                                              : scene::MaterialModel::kCorotational;
+      }
     }
     if (w_normals > 0) {
       scene->solver.compliance_columns = scene::ComplianceColumns::kNormals;
