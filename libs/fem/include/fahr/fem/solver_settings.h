@@ -40,10 +40,15 @@ struct SolverSettings {
   // whole F, not on a rotation): also refactorise when some element's
   // deformation gradient has changed by more than this (Frobenius norm,
   // dimensionless) since the last factorisation (0 disables). 0.1 is a turn
-  // of 0.07 rad or a 10 % change of stretch; the SNH tangent is smooth in F,
-  // so its blocks are then off by about that fraction (more where the Yeoh
-  // term stiffens a compressed element: the criterion sees the strain that
-  // stiffens it). Applies where the rotation trigger does.
+  // of 0.07 rad (a turn of 0.1 rad changes F by 2 sqrt 2 sin(0.05) = 0.141)
+  // or a 10 % change of stretch; the SNH tangent is smooth in F, so its
+  // blocks are then off by about that fraction, more where the Yeoh term
+  // stiffens a compressed element, whose strain the criterion sees: a
+  // compressing tongue does not run long on a tangent much softer than the
+  // truth. A choice: in the 20 s overshoot run 0.1 refactorised 3,431 times
+  // (the corotational tongue 2,604) and let 1 node back through a bone;
+  // 0.14 refactorised 2,187 times and let 90 back (fahr_stack_sim_run
+  // --script overshoot). Applies where the rotation trigger does.
   double refactor_deformation_change = 0.1;
   // Rotate a reused factorisation per node into the current frame (see
   // warped_factor.h). Off only to measure what it buys.
