@@ -2,12 +2,9 @@
 // gravity with its lowest 10 mm fixed.
 #include <gtest/gtest.h>
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <functional>
-#include <sstream>
 
 #include "scenes.h"
 #include "tetgen.h"
@@ -113,6 +110,7 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
       return (p - mesh.nodes_m[centres[s]]).norm() < 0.006;
     });
     std::vector<double> w;
+    w.reserve(near.size());
     double mass = 0.0;
     for (const std::uint32_t n : near) mass += body.mass_kg()[n];
     for (const std::uint32_t n : near) w.push_back(body.mass_kg()[n] / mass);

@@ -4,6 +4,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "fahr/fem/compression_stiffening.h"
 #include "fahr/fem/corotation.h"
@@ -29,6 +30,9 @@ std::string validate(const SolverSettings& solver) {
   }
   if (!(solver.refactor_deformation_change >= 0.0)) {
     return "solver settings: refactor_deformation_change must be >= 0";
+  }
+  if (!(solver.tangent_reuse_change >= 0.0)) {
+    return "solver settings: tangent_reuse_change must be >= 0";
   }
   return {};
 }
@@ -118,6 +122,10 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
     snh_.emplace(settings_.material);
     deformations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
     deformations_at_factor_ = deformations_;
+    // No element has a tangent yet: NaN never compares within reach.
+    tangent_deformations_.assign(
+        rest_.size(), Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+    element_tangents_.assign(rest_.size(), Matrix12d::Zero());
   }
   stiffening_ = !snh_ && settings_.material.yeoh_c20_over_c10 > 0.0;
   if (stiffening_) {
@@ -143,12 +151,21 @@ void Body::assemble_system() {
     // The tangent at the start of the step: each element's Hessian at its
     // F, projected to positive semi-definite (its analytic eigensystem), so
     // A is positive definite however compressed or inverted the element.
+    // An element whose F has moved less than tangent_reuse_change since its
+    // tangent was computed keeps that tangent (a lag far below the refresh
+    // trigger's); the others are computed again.
     assembly_.zero();
     const double stiffness_scale = h_ * beta + h_ * h_;
+    const double reuse = settings_.solver.tangent_reuse_change;
+    const double reuse_squared = reuse * reuse;
     for (std::size_t e = 0; e < rest_.size(); ++e) {
-      const Matrix12d k = element_stiffness(shape_gradients(rest_.dm_inv[e]), rest_.volume_m3[e],
-                                            snh_->projected_hessian(deformations_[e]));
-      assembly_.add_element(e, k, stiffness_scale);
+      const Eigen::Matrix3d& f = deformations_[e];
+      if (!((f - tangent_deformations_[e]).squaredNorm() <= reuse_squared) || !(reuse > 0.0)) {
+        element_tangents_[e] = element_stiffness(shape_gradients(rest_.dm_inv[e]),
+                                                 rest_.volume_m3[e], snh_->projected_hessian(f));
+        tangent_deformations_[e] = f;
+      }
+      assembly_.add_element(e, element_tangents_[e], stiffness_scale);
     }
     assembly_.add_mass(mass_per_dof_, 1.0 + h_ * alpha);
   } else {
@@ -525,6 +542,9 @@ bool Body::reset_to_rest() {
   std::fill(rotations_.begin(), rotations_.end(), Eigen::Matrix3d::Identity());
   std::fill(stiffening_scales_.begin(), stiffening_scales_.end(), 1.0);
   std::fill(deformations_.begin(), deformations_.end(), Eigen::Matrix3d::Identity());
+  // Every tangent computed again, so the body steps exactly as a new one.
+  std::fill(tangent_deformations_.begin(), tangent_deformations_.end(),
+            Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   warp_.update_rotations(rest_, rotations_);
   assemble_system();
   return refactorise();

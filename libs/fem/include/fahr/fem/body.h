@@ -37,6 +37,7 @@
 #include "fahr/fem/compliance.h"
 #include "fahr/fem/contact_set.h"
 #include "fahr/fem/element_rest.h"
+#include "fahr/fem/hyperelastic_element.h"
 #include "fahr/fem/material.h"
 #include "fahr/fem/obstacle_support.h"
 #include "fahr/fem/projection.h"
@@ -251,6 +252,10 @@ class Body {
   std::optional<StableNeoHookean> snh_;
   std::vector<Eigen::Matrix3d> deformations_;
   std::vector<Eigen::Matrix3d> deformations_at_factor_;
+  // Each element's tangent (its projected K_t block, N/m) and the F it was
+  // computed at, kept between refreshes (SolverSettings::tangent_reuse_change).
+  std::vector<Matrix12d> element_tangents_;
+  std::vector<Eigen::Matrix3d> tangent_deformations_;
 
   SystemAssembly assembly_;
   CholmodSolver cholmod_;
