@@ -3,6 +3,8 @@
 // SuiteSparse's allocation hooks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "allocation_counter.h"
 #include "scenes.h"
 #include "suitesparse_allocations.h"
@@ -44,14 +46,20 @@ std::vector<Mode> modes() {
 TEST(Allocation, StepAllocatesNothing) {
   test::hook_suitesparse_allocations();
   const BodyMesh mesh = test::bar_mesh(2);
-  // Every mode with the linear material and with compression stiffening.
-  for (const double stiffening : {0.0, kTongueYeohC20OverC10})
+  // Every mode with the linear material, with compression stiffening, and
+  // with the Stable Neo-Hookean material (stiffening 2: its Yeoh term).
+  for (const double stiffening : {0.0, kTongueYeohC20OverC10, 2.0})
     for (const Mode& mode : modes()) {
       BodySettings settings;
       settings.solver = mode.solver;
-      settings.material.yeoh_c20_over_c10 = stiffening;
-      // The modes that must not refactorise keep a changed scale from doing so.
-      if (!mode.refactorises) settings.solver.refactor_stiffening_change = 0.0;
+      settings.material.yeoh_c20_over_c10 = std::min(stiffening, kTongueYeohC20OverC10);
+      if (stiffening > 1.0) settings.material.model = MaterialModel::kStableNeoHookean;
+      // The modes that must not refactorise keep a changed scale or F from
+      // doing so.
+      if (!mode.refactorises) {
+        settings.solver.refactor_stiffening_change = 0.0;
+        settings.solver.refactor_deformation_change = 0.0;
+      }
       settings.sleep.enabled = false;
       auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
       ASSERT_NE(body, nullptr);

@@ -2,82 +2,15 @@
 // gravity with its lowest 10 mm fixed.
 #include <gtest/gtest.h>
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <functional>
-#include <sstream>
 
 #include "scenes.h"
+#include "tetgen.h"
 
 namespace fahr::fem {
 namespace {
-
-// Minimal TetGen reader for this test only (geometry's loaders come later):
-// .node "count dim attrs markers" then "index x y z ..."; .ele "count 4 attrs"
-// then "index n0 n1 n2 n3". '#' starts a comment.
-bool read_tetgen(const std::string& stem, BodyMesh& mesh, std::string& error) {
-  std::ifstream node_file(stem + ".node");
-  std::ifstream ele_file(stem + ".ele");
-  if (!node_file || !ele_file) {
-    error = "cannot open " + stem + ".node/.ele";
-    return false;
-  }
-  auto next_line = [](std::ifstream& in, std::istringstream& line) {
-    std::string text;
-    while (std::getline(in, text)) {
-      const auto hash = text.find('#');
-      if (hash != std::string::npos) text.resize(hash);
-      if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-      line.clear();
-      line.str(text);
-      return true;
-    }
-    return false;
-  };
-  std::istringstream line;
-  std::size_t count = 0;
-  int dim = 0;
-  if (!next_line(node_file, line) || !(line >> count >> dim) || dim != 3) {
-    error = stem + ".node: bad header";
-    return false;
-  }
-  std::size_t base = 0;
-  for (std::size_t i = 0; i < count; ++i) {
-    std::size_t index = 0;
-    Eigen::Vector3d p;
-    if (!next_line(node_file, line) || !(line >> index >> p.x() >> p.y() >> p.z())) {
-      error = stem + ".node: bad node line " + std::to_string(i + 2);
-      return false;
-    }
-    if (i == 0) base = index;  // TetGen files count from 0 or 1
-    mesh.nodes_m.push_back(p);
-  }
-  std::size_t per = 0;
-  if (!next_line(ele_file, line) || !(line >> count >> per) || per != 4) {
-    error = stem + ".ele: bad header";
-    return false;
-  }
-  for (std::size_t e = 0; e < count; ++e) {
-    std::size_t index = 0;
-    std::array<std::size_t, 4> n{};
-    if (!next_line(ele_file, line) || !(line >> index >> n[0] >> n[1] >> n[2] >> n[3])) {
-      error = stem + ".ele: bad element line " + std::to_string(e + 2);
-      return false;
-    }
-    Tet tet{};
-    for (std::size_t a = 0; a < 4; ++a) tet[a] = static_cast<std::uint32_t>(n[a] - base);
-    // TetGen orders nodes with negative orientation in our convention for
-    // some files: fix the sign so that the rest volume is positive.
-    Eigen::Matrix3d dm;
-    dm << mesh.nodes_m[tet[1]] - mesh.nodes_m[tet[0]], mesh.nodes_m[tet[2]] - mesh.nodes_m[tet[0]],
-        mesh.nodes_m[tet[3]] - mesh.nodes_m[tet[0]];
-    if (dm.determinant() < 0.0) std::swap(tet[2], tet[3]);
-    mesh.tets.push_back(tet);
-  }
-  return true;
-}
 
 std::string tongue_stem() {
   return std::string(FAHR_TONGUE_DIR) + "/tongue.1";
@@ -97,7 +30,7 @@ TEST(Tongue, StepsStablyUnderGravity) {
       << ".node: ../shared/meshes/artisynth-tongue must be beside the checkout";
   BodyMesh mesh;
   std::string error;
-  ASSERT_TRUE(read_tetgen(stem, mesh, error)) << error;
+  ASSERT_TRUE(test::read_tetgen(stem, mesh, error)) << error;
   ASSERT_EQ(mesh.tets.size(), 11098u);
   const auto fixed = tongue_base(mesh);
   BodySettings settings;  // neonatal tongue material, +y up, gravity -y
@@ -143,7 +76,7 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
       << ".node: ../shared/meshes/artisynth-tongue must be beside the checkout";
   BodyMesh mesh;
   std::string error;
-  ASSERT_TRUE(read_tetgen(stem, mesh, error)) << error;
+  ASSERT_TRUE(test::read_tetgen(stem, mesh, error)) << error;
   BodySettings settings;
   settings.time_step = std::chrono::milliseconds(10);
   settings.solver.refactor_period = 0;  // refactorise on 0.1 rad of rotation
@@ -177,6 +110,7 @@ TEST(Tongue, PressedByALaryngoscopeAndReleased) {
       return (p - mesh.nodes_m[centres[s]]).norm() < 0.006;
     });
     std::vector<double> w;
+    w.reserve(near.size());
     double mass = 0.0;
     for (const std::uint32_t n : near) mass += body.mass_kg()[n];
     for (const std::uint32_t n : near) w.push_back(body.mass_kg()[n] / mass);

@@ -104,6 +104,9 @@ TEST(SceneErrors, UnknownEnumerationValuesListTheValidOnes) {
   expect_contains(error_of(replaced("backend: simulated", "backend: phantom")),
                   {"device.backend: 'phantom' is not one of: simulated, replay, remote, "
                    "openhaptics"});
+  expect_contains(error_of(with_material("      model: neo_hookean\n")),
+                  {"test.yaml:9:14: bodies[0].material.model: 'neo_hookean' is not one of: "
+                   "corotational, stable_neo_hookean"});
   expect_contains(error_of(std::string(kMinimalScene) + "solver:\n  compliance_columns: rows\n"),
                   {"solver.compliance_columns: 'rows' is not one of: blocks, normals"});
   expect_contains(error_of(std::string(kMinimalScene) + "contact:\n  held_proxy: back_off\n"),

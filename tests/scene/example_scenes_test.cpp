@@ -39,7 +39,8 @@ void expect_neonatal_contents(const Scene& scene) {
   EXPECT_EQ(tongue.deformable->material.youngs_modulus_pa, 10000.0);
   EXPECT_EQ(tongue.deformable->material.poisson_ratio, 0.45);
   EXPECT_EQ(tongue.deformable->material.density_kg_per_m3, 1040.0);
-  EXPECT_EQ(tongue.deformable->material.yeoh_c20_over_c10, 0.0);
+  EXPECT_EQ(tongue.deformable->material.yeoh_c20_over_c10, 0.47);
+  EXPECT_EQ(tongue.deformable->material.model, MaterialModel::kStableNeoHookean);
   ASSERT_TRUE(scene.device.has_value());
   EXPECT_EQ(scene.bodies[scene.device->tool_body].name, "miller1");
   EXPECT_EQ(scene.tool_index(), scene.device->tool_body);

@@ -94,8 +94,8 @@ void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Ma
                               const LameParameters& lame, std::span<const double> mass_per_dof_kg,
                               double mass_scale, double stiffness_scale,
                               std::span<const double> element_scales) {
+  zero();
   double* values = a_.valuePtr();
-  std::memset(values, 0, sizeof(double) * static_cast<std::size_t>(a_.nonZeros()));
   for (std::size_t e = 0; e < rest.size(); ++e) {
     // Rotated gradients r_a = R g_a give R K_ab R^T =
     // V (lambda r_a r_b^T + mu r_b r_a^T + mu (g_a . g_b) I).
@@ -121,6 +121,30 @@ void SystemAssembly::assemble(const ElementRest& rest, std::span<const Eigen::Ma
       }
     }
   }
+  add_mass(mass_per_dof_kg, mass_scale);
+}
+
+void SystemAssembly::zero() {
+  std::memset(a_.valuePtr(), 0, sizeof(double) * static_cast<std::size_t>(a_.nonZeros()));
+}
+
+void SystemAssembly::add_element(std::size_t element, const Matrix12d& k, double scale) {
+  double* values = a_.valuePtr();
+  const std::uint32_t* starts = &block_column_start_[48 * element];
+  for (Eigen::Index a = 0; a < 4; ++a) {
+    for (Eigen::Index b = 0; b < 4; ++b) {
+      for (Eigen::Index c = 0; c < 3; ++c) {
+        // Column c of block (a, b): rows 3a..3a+2 of K's column 3b + c.
+        double* column = values + starts[12 * a + 3 * b + c];
+        const double* source = k.data() + 12 * (3 * b + c) + 3 * a;
+        for (int d = 0; d < 3; ++d) column[d] += scale * source[d];
+      }
+    }
+  }
+}
+
+void SystemAssembly::add_mass(std::span<const double> mass_per_dof_kg, double mass_scale) {
+  double* values = a_.valuePtr();
   const std::size_t dofs = diagonal_index_.size();
   for (std::size_t k = 0; k < dofs; ++k) {
     values[diagonal_index_[k]] += mass_scale * mass_per_dof_kg[k];

@@ -1,11 +1,14 @@
 // The per-step pipeline of one body: forces, system, solve, projection, sleep.
 #include "fahr/fem/body.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "fahr/fem/compression_stiffening.h"
 #include "fahr/fem/corotation.h"
+#include "fahr/fem/hyperelastic_element.h"
 #include "fahr/fem/lumped_mass.h"
 #include "fahr/geometry/tet_deformation.h"
 
@@ -24,6 +27,12 @@ std::string validate(const SolverSettings& solver) {
     return "solver settings: cg_refresh_iterations must be >= 0";
   if (!(solver.refactor_stiffening_change >= 0.0)) {
     return "solver settings: refactor_stiffening_change must be >= 0";
+  }
+  if (!(solver.refactor_deformation_change >= 0.0)) {
+    return "solver settings: refactor_deformation_change must be >= 0";
+  }
+  if (!(solver.tangent_reuse_change >= 0.0)) {
+    return "solver settings: tangent_reuse_change must be >= 0";
   }
   return {};
 }
@@ -110,7 +119,17 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
   factor_held_.assign(n, 0);
   rotations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
   rotations_at_factor_ = rotations_;
-  stiffening_ = settings_.material.yeoh_c20_over_c10 > 0.0;
+  if (settings_.material.model == MaterialModel::kStableNeoHookean) {
+    // The Yeoh ratio is the energy's term here, not a secant scale.
+    snh_.emplace(settings_.material);
+    deformations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
+    deformations_at_factor_ = deformations_;
+    // No element has a tangent yet: NaN never compares within reach.
+    tangent_deformations_.assign(
+        rest_.size(), Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+    element_tangents_.assign(rest_.size(), Matrix12d::Zero());
+  }
+  stiffening_ = !snh_ && settings_.material.yeoh_c20_over_c10 > 0.0;
   if (stiffening_) {
     stiffening_scales_.assign(rest_.size(), 1.0);
     stiffening_scales_at_factor_ = stiffening_scales_;
@@ -130,8 +149,31 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
 void Body::assemble_system() {
   const double alpha = settings_.material.rayleigh_mass_per_s;
   const double beta = settings_.material.rayleigh_stiffness_s;
-  assembly_.assemble(rest_, rotations_, lame_, mass_per_dof_, 1.0 + h_ * alpha, h_ * beta + h_ * h_,
-                     stiffening_scales_);
+  if (snh_) {
+    // The tangent at the start of the step: each element's Hessian at its
+    // F, projected to positive semi-definite (its analytic eigensystem), so
+    // A is positive definite however compressed or inverted the element.
+    // An element whose F has moved less than tangent_reuse_change since its
+    // tangent was computed keeps that tangent (a lag far below the refresh
+    // trigger's); the others are computed again.
+    assembly_.zero();
+    const double stiffness_scale = h_ * beta + h_ * h_;
+    const double reuse = settings_.solver.tangent_reuse_change;
+    const double reuse_squared = reuse * reuse;
+    for (std::size_t e = 0; e < rest_.size(); ++e) {
+      const Eigen::Matrix3d& f = deformations_[e];
+      if (!((f - tangent_deformations_[e]).squaredNorm() <= reuse_squared) || !(reuse > 0.0)) {
+        element_tangents_[e] = element_stiffness(shape_gradients(rest_.dm_inv[e]),
+                                                 rest_.volume_m3[e], snh_->projected_hessian(f));
+        tangent_deformations_[e] = f;
+      }
+      assembly_.add_element(e, element_tangents_[e], stiffness_scale);
+    }
+    assembly_.add_mass(mass_per_dof_, 1.0 + h_ * alpha);
+  } else {
+    assembly_.assemble(rest_, rotations_, lame_, mass_per_dof_, 1.0 + h_ * alpha,
+                       h_ * beta + h_ * h_, stiffening_scales_);
+  }
   for (std::size_t i = 0; i < support_count_; ++i) {
     assembly_.add_normal_stiffness(supports_[i].node, supports_[i].normal, support_ratio_);
   }
@@ -165,6 +207,7 @@ std::string Body::set_solver(const SolverSettings& solver) {
   if (reanalyse && !cholmod_.analyze(assembly_.matrix(), solver.cholmod))
     return "CHOLMOD symbolic analysis failed";
   warp_.update_rotations(rest_, rotations_);
+  if (snh_) update_deformations();
   assemble_system();
   if (!refactorise()) return "the system matrix is not positive definite";
   return {};
@@ -183,6 +226,7 @@ bool Body::refactorise() {
   std::copy(rotations_.begin(), rotations_.end(), rotations_at_factor_.begin());
   std::copy(stiffening_scales_.begin(), stiffening_scales_.end(),
             stiffening_scales_at_factor_.begin());
+  std::copy(deformations_.begin(), deformations_.end(), deformations_at_factor_.begin());
   warp_.mark_factorised();
   return cholmod_.factorize();
 }
@@ -226,6 +270,52 @@ int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_en
     }
   }
   return inverted;
+}
+
+int Body::update_hyperelastic_forces(bool accumulate_energy, double* elastic_energy_j) {
+  int inverted = 0;
+  const double* x = x_.data();
+  double* f = force_.data();
+  for (std::size_t e = 0; e < rest_.size(); ++e) {
+    const Tet& tet = rest_.tets[e];
+    const Eigen::Matrix3d deformation = geometry::deformation_gradient(x, tet, rest_.dm_inv[e]);
+    deformations_[e] = deformation;
+    inverted += deformation.determinant() > 0.0 ? 0 : 1;
+    // f = -V P Dm^-T for nodes 1..3 (node 0 takes minus their sum): the
+    // exact -d(V Psi)/dx, hyperelastic_element.h's nodal_forces without the
+    // 9x12 matrix.
+    const double volume = rest_.volume_m3[e];
+    const Eigen::Matrix3d h =
+        -volume * snh_->first_piola(deformation) * rest_.dm_inv[e].transpose();
+    Eigen::Map<Eigen::Vector3d>(f + 3 * std::size_t{tet[0]}) -= h.col(0) + h.col(1) + h.col(2);
+    for (Eigen::Index a = 0; a < 3; ++a) {
+      Eigen::Map<Eigen::Vector3d>(f + 3 * std::size_t{tet[static_cast<std::size_t>(a + 1)]}) +=
+          h.col(a);
+    }
+    if (accumulate_energy) *elastic_energy_j += volume * snh_->energy_density(deformation);
+  }
+  return inverted;
+}
+
+void Body::update_deformations() {
+  for (std::size_t e = 0; e < rest_.size(); ++e) {
+    deformations_[e] = geometry::deformation_gradient(x_.data(), rest_.tets[e], rest_.dm_inv[e]);
+  }
+}
+
+int Body::update_elastic_forces(bool accumulate_energy, double* elastic_energy_j) {
+  return snh_ ? update_hyperelastic_forces(accumulate_energy, elastic_energy_j)
+              : update_rotations_and_forces(accumulate_energy, elastic_energy_j);
+}
+
+bool Body::deformed_since_factor() const {
+  const double change = settings_.solver.refactor_deformation_change;
+  if (!snh_ || !(change > 0.0)) return false;
+  const double limit = change * change;
+  for (std::size_t e = 0; e < deformations_.size(); ++e) {
+    if ((deformations_[e] - deformations_at_factor_[e]).squaredNorm() > limit) return true;
+  }
+  return false;
 }
 
 // The support springs changed A: the direct solve refactorises when the
@@ -303,7 +393,7 @@ void Body::finish_step(StepReport& report) {
 
 void Body::compute_forces(StepReport& report) {
   force_ = gravity_force_ + external_force_;
-  report.inverted_elements = update_rotations_and_forces(false, nullptr);
+  report.inverted_elements = update_elastic_forces(false, nullptr);
   double residual_squared = 0.0;
   for (Eigen::Index k = 0; k < force_.size(); ++k) {
     if (fixed_dof_[static_cast<std::size_t>(k)] == 0) residual_squared += force_[k] * force_[k];
@@ -319,7 +409,8 @@ void Body::prepare_system(StepReport& report) {
       (solver.refactor_period > 0 && steps_since_factor_ + 1 >= solver.refactor_period) ||
       (factor_needed && refresh_due_) ||
       (factor_needed && solver.refactor_period != 1 &&
-       (support_changed_factor_due(cg) || rotated_since_factor() || stiffened_since_factor()));
+       (support_changed_factor_due(cg) || rotated_since_factor() || stiffened_since_factor() ||
+        deformed_since_factor()));
   if (factor_needed) warp_.update_rotations(rest_, rotations_);
   // CG multiplies with the current A; the direct solve only needs A when it
   // refactorises.
@@ -468,6 +559,10 @@ bool Body::reset_to_rest() {
   support_count_ = 0;
   std::fill(rotations_.begin(), rotations_.end(), Eigen::Matrix3d::Identity());
   std::fill(stiffening_scales_.begin(), stiffening_scales_.end(), 1.0);
+  std::fill(deformations_.begin(), deformations_.end(), Eigen::Matrix3d::Identity());
+  // Every tangent computed again, so the body steps exactly as a new one.
+  std::fill(tangent_deformations_.begin(), tangent_deformations_.end(),
+            Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   warp_.update_rotations(rest_, rotations_);
   assemble_system();
   return refactorise();
@@ -475,14 +570,14 @@ bool Body::reset_to_rest() {
 
 void Body::elastic_forces(std::span<double> out_n) {
   force_.setZero();
-  update_rotations_and_forces(false, nullptr);
+  update_elastic_forces(false, nullptr);
   std::copy(force_.data(), force_.data() + force_.size(), out_n.begin());
 }
 
 Energy Body::energy() {
   Energy energy;
   force_.setZero();
-  update_rotations_and_forces(true, &energy.elastic_j);
+  update_elastic_forces(true, &energy.elastic_j);
   energy.kinetic_j = kinetic_energy();
   energy.gravity_potential_j = -gravity_force_.dot(x_);
   return energy;

@@ -30,6 +30,11 @@ Matrix12d element_stiffness(const Matrix9x12d& df_dx, double volume_m3, const Ma
   for (Eigen::Index a = 0; a < 4; ++a) {
     for (Eigen::Index j = 0; j < 3; ++j) g(j, a) = df_dx(3 * j, 3 * a);
   }
+  return element_stiffness(g, volume_m3, h);
+}
+
+Matrix12d element_stiffness(const Eigen::Matrix<double, 3, 4>& g, double volume_m3,
+                            const Matrix9d& h) {
   // hg[a][k] = sum_j g_a[j] H_jk.
   Eigen::Matrix3d hg[4][3];
   for (Eigen::Index a = 0; a < 4; ++a) {

@@ -71,6 +71,10 @@ const char* validate(const Material& material) {
   if (!(material.yeoh_c20_over_c10 >= 0.0 && material.yeoh_c20_over_c10 <= kMaxYeohC20OverC10)) {
     return "material.yeoh_c20_over_c10 must be in [0, 100]";
   }
+  if (material.model != MaterialModel::kCorotational &&
+      material.model != MaterialModel::kStableNeoHookean) {
+    return "material.model must be corotational or stable_neo_hookean";
+  }
   return "";
 }
 

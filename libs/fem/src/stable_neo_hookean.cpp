@@ -2,10 +2,12 @@
 // analytic eigensystem (formulas and sources in stable_neo_hookean.h).
 #include "fahr/fem/stable_neo_hookean.h"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <cassert>
 #include <cmath>
+
+#include "fahr/fem/svd3.h"
 
 namespace fahr::fem {
 namespace {
@@ -55,30 +57,6 @@ Eigen::Matrix3d cofactor(const Eigen::Matrix3d& f) {
   c.col(1) = f.col(2).cross(f.col(0));
   c.col(2) = f.col(0).cross(f.col(1));
   return c;
-}
-
-struct RotationVariantSvd {
-  Eigen::Matrix3d u;
-  Eigen::Matrix3d v;
-  Eigen::Vector3d s;
-};
-
-RotationVariantSvd rotation_variant_svd(const Eigen::Matrix3d& f) {
-  // U and V proper rotations, the sign of J carried by the smallest singular
-  // value (Eigen sorts them in decreasing order): Irving, Teran and Fedkiw's
-  // sign fix, as in corotation.cpp.
-  const Eigen::JacobiSVD<Eigen::Matrix3d, Eigen::NoQRPreconditioner> svd(
-      f, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  RotationVariantSvd out{svd.matrixU(), svd.matrixV(), svd.singularValues()};
-  if (out.u.determinant() < 0.0) {
-    out.u.col(2) = -out.u.col(2);
-    out.s(2) = -out.s(2);
-  }
-  if (out.v.determinant() < 0.0) {
-    out.v.col(2) = -out.v.col(2);
-    out.s(2) = -out.s(2);
-  }
-  return out;
 }
 
 // Twists and flips in the plane (a, b) of each singular pair, k the third
@@ -175,14 +153,15 @@ Eigen::Matrix3d StableNeoHookean::scaling_hessian(const Eigen::Vector3d& s) cons
 }
 
 HessianEigensystem StableNeoHookean::hessian_eigensystem(const Eigen::Matrix3d& f) const {
-  const RotationVariantSvd svd = rotation_variant_svd(f);
+  const Svd3 svd = rotation_variant_svd(f);
   const Partials partial = partials(svd.s.squaredNorm(), svd.s.prod());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> scaling(scaling_hessian(svd.s));
+  Eigen::Vector3d scaling_values;
+  Eigen::Matrix3d scaling_vectors;
+  symmetric_eigen3(scaling_hessian(svd.s), scaling_values, scaling_vectors);
   HessianEigensystem out;
   for (int m = 0; m < 3; ++m) {
-    out.values(m) = scaling.eigenvalues()(m);
-    out.vectors.col(m) =
-        vec(svd.u * scaling.eigenvectors().col(m).asDiagonal() * svd.v.transpose());
+    out.values(m) = scaling_values(m);
+    out.vectors.col(m) = vec(svd.u * scaling_vectors.col(m).asDiagonal() * svd.v.transpose());
   }
   const double half_sqrt2 = std::sqrt(0.5);
   for (int p = 0; p < 3; ++p) {
@@ -203,7 +182,7 @@ Matrix9d StableNeoHookean::projected_hessian(const Eigen::Matrix3d& f) const {
   // modes that are negative are formed, and usually few are (twists of a
   // compressed element; scaling modes only in strong compression).
   Matrix9d h = hessian(f);
-  const RotationVariantSvd svd = rotation_variant_svd(f);
+  const Svd3 svd = rotation_variant_svd(f);
   const Partials partial = partials(svd.s.squaredNorm(), svd.s.prod());
   const double half_sqrt2 = std::sqrt(0.5);
   for (int p = 0; p < 3; ++p) {
@@ -223,12 +202,13 @@ Matrix9d StableNeoHookean::projected_hessian(const Eigen::Matrix3d& f) const {
   const bool definite =
       a(0, 0) > 0.0 && a(0, 0) * a(1, 1) - a(0, 1) * a(0, 1) > 0.0 && a.determinant() > 0.0;
   if (!definite) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> scaling(a);
+    Eigen::Vector3d values;
+    Eigen::Matrix3d vectors;
+    symmetric_eigen3(a, values, vectors);
     for (int m = 0; m < 3; ++m) {
-      const double value = scaling.eigenvalues()(m);
+      const double value = values(m);
       if (value >= 0.0) continue;
-      const Vector9d q =
-          vec(svd.u * scaling.eigenvectors().col(m).asDiagonal() * svd.v.transpose());
+      const Vector9d q = vec(svd.u * vectors.col(m).asDiagonal() * svd.v.transpose());
       h.noalias() -= value * q * q.transpose();
     }
   }

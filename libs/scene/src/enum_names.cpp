@@ -11,6 +11,9 @@ std::string_view to_string(BodyRole role) {
 std::string_view to_string(LengthUnit unit) {
   return name_of(detail::kLengthUnitNames, unit);
 }
+std::string_view to_string(MaterialModel model) {
+  return name_of(detail::kMaterialModelNames, model);
+}
 std::string_view to_string(RunMode mode) {
   return name_of(detail::kRunModeNames, mode);
 }

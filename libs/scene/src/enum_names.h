@@ -28,6 +28,9 @@ inline constexpr std::pair<std::string_view, BodyRole> kBodyRoleNames[] = {
     {"obstacle", BodyRole::kObstacle}};
 inline constexpr std::pair<std::string_view, LengthUnit> kLengthUnitNames[] = {
     {"m", LengthUnit::kMetre}, {"cm", LengthUnit::kCentimetre}, {"mm", LengthUnit::kMillimetre}};
+inline constexpr std::pair<std::string_view, MaterialModel> kMaterialModelNames[] = {
+    {"corotational", MaterialModel::kCorotational},
+    {"stable_neo_hookean", MaterialModel::kStableNeoHookean}};
 inline constexpr std::pair<std::string_view, RunMode> kRunModeNames[] = {
     {"realtime", RunMode::kRealtime}, {"lockstep", RunMode::kLockstep}};
 inline constexpr std::pair<std::string_view, DdsVendor> kDdsVendorNames[] = {

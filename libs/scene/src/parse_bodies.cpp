@@ -83,9 +83,10 @@ void parse_unit(const MapReader& map, Body& body) {
 
 Material parse_material(const MapReader& body_map) {
   Material m;
-  const MapReader map(body_map.log(), body_map.value("material"), body_map.child_path("material"),
-                      {"youngs_modulus_pa", "poisson_ratio", "density_kg_per_m3",
-                       "rayleigh_mass_per_s", "rayleigh_stiffness_s", "yeoh_c20_over_c10"});
+  const MapReader map(
+      body_map.log(), body_map.value("material"), body_map.child_path("material"),
+      {"youngs_modulus_pa", "poisson_ratio", "density_kg_per_m3", "rayleigh_mass_per_s",
+       "rayleigh_stiffness_s", "yeoh_c20_over_c10", "model"});
   map.read("youngs_modulus_pa", open_closed(0.0, 1.0e12), m.youngs_modulus_pa);
   // nu = 0.5 is incompressible (the stiffness matrix is singular), nu = -1
   // has no shear stiffness: both ends excluded.
@@ -95,6 +96,7 @@ Material parse_material(const MapReader& body_map) {
   map.read("rayleigh_stiffness_s", closed(0.0, 10.0), m.rayleigh_stiffness_s);
   // The FEM's own bound (libs/fem material.h, kMaxYeohC20OverC10).
   map.read("yeoh_c20_over_c10", closed(0.0, 100.0), m.yeoh_c20_over_c10);
+  map.read_enum("model", kMaterialModelNames, m.model);
   return m;
 }
 

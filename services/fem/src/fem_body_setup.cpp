@@ -39,8 +39,15 @@ std::vector<std::uint32_t> fixed_nodes(const scene::Body& body, const geometry::
 fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& body) {
   fem::BodySettings s;
   const auto& m = body.deformable->material;
-  s.material = {m.youngs_modulus_pa,   m.poisson_ratio,        m.density_kg_per_m3,
-                m.rayleigh_mass_per_s, m.rayleigh_stiffness_s, m.yeoh_c20_over_c10};
+  s.material = {m.youngs_modulus_pa,
+                m.poisson_ratio,
+                m.density_kg_per_m3,
+                m.rayleigh_mass_per_s,
+                m.rayleigh_stiffness_s,
+                m.yeoh_c20_over_c10,
+                m.model == scene::MaterialModel::kStableNeoHookean
+                    ? fem::MaterialModel::kStableNeoHookean
+                    : fem::MaterialModel::kCorotational};
   s.time_step = std::chrono::duration<double>(1.0 / scene.rates.fem_hz);
   s.gravity_m_per_s2 = scene.gravity_mps2;
   s.solver.kind = scene.solver.linear_solver == scene::LinearSolver::kCholmod
@@ -65,6 +72,7 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
     s.solver.preconditioner = fem::CgPreconditioner::kLaggedCholesky;
     s.solver.refactor_rotation_rad = 0.0;
     s.solver.refactor_stiffening_change = 0.0;
+    s.solver.refactor_deformation_change = 0.0;
     s.solver.cg_refresh_iterations = 12;
   }
   s.solver.cg_relative_tolerance = scene.solver.cg_tolerance;

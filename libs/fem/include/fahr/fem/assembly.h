@@ -1,5 +1,7 @@
-// The system matrix A = mass_scale M + stiffness_scale K(R) on a sparsity
-// pattern fixed at set-up, written in place through an element-to-non-zero map.
+// The system matrix A = mass_scale M + stiffness_scale K on a sparsity
+// pattern fixed at set-up, written in place through an element-to-non-zero
+// map: K the corotated linear stiffness R K0 R^T, or any per-element 12x12
+// (the hyperelastic tangent).
 #pragma once
 
 #include <Eigen/Core>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include "fahr/fem/element_rest.h"
+#include "fahr/fem/hyperelastic_element.h"
 #include "fahr/fem/material.h"
 
 namespace fahr::fem {
@@ -33,6 +36,16 @@ class SystemAssembly {
                 const LameParameters& lame, std::span<const double> mass_per_dof_kg,
                 double mass_scale, double stiffness_scale,
                 std::span<const double> element_scales = {});
+
+  // The same A from element matrices: zero(), add_element() for each
+  // element, then add_mass() once. k_e is element e's 12x12 stiffness in
+  // hyperelastic_element.h's DOF order (symmetric: each block is read as
+  // stored), added as scale k_e. No allocation.
+  void zero();
+  void add_element(std::size_t element, const Matrix12d& k, double scale);
+  // Adds mass_scale diag(m) and decouples the fixed DOFs (their rows and
+  // columns zero, the diagonal mass_scale m): the end of an assembly.
+  void add_mass(std::span<const double> mass_per_dof_kg, double mass_scale);
 
   // Adds k n n^T to the diagonal block of `node`, with k = ratio times the
   // mean of the block's three diagonal entries as they are now (so the

@@ -1,18 +1,24 @@
-// One deformable body: corotational linear FEM on tetrahedra, one linearised
-// implicit Euler step per call, then the Algorithm 1 projection of a
-// ContactSet, and contact compliance on request.
+// One deformable body: tetrahedral FEM (corotational linear, or Stable
+// Neo-Hookean hyperelastic: Material::model), one linearised implicit Euler
+// step per call, then the Algorithm 1 projection of a ContactSet, and
+// contact compliance on request.
 //
-// The step (with v the velocity, f the corotated elastic force plus gravity
-// and external forces, all at the start of the step):
-//   M (v' - v) = h (f - D v' - K h v'),   D = alpha M + beta K,  K = R K0 R^T
+// The step (with v the velocity, f the elastic force plus gravity and
+// external forces, all at the start of the step, and K the stiffness there):
+//   M (v' - v) = h (f - D v' - K h v'),   D = alpha M + beta K
 //   =>  A v' = M v + h f,   A = (1 + h alpha) M + (h beta + h^2) K
 //   x' = x + h v'
 // which is one Newton step of backward Euler with f linearised about x
-// (Baraff and Witkin 1998; Mueller and Gross 2004 for the corotation). With
-// compression stiffening each element's K0 is scaled by its s_e of the start
-// of the step, in f and in A alike (compression_stiffening.h). The
-// right-hand side needs no K, so a lagged A only changes the dynamics, never
-// the static equilibrium. Fixed DOFs are decoupled rows with v' = 0.
+// (Baraff and Witkin 1998). Corotational: f is the corotated linear force
+// and K = R K0 R^T (Mueller and Gross 2004); with compression stiffening each
+// element's K0 is scaled by its s_e of the start of the step, in f and in A
+// alike (compression_stiffening.h). Stable Neo-Hookean: f is the exact
+// hyperelastic force -dE/dx (stable_neo_hookean.h) and K the tangent with
+// each element's Hessian projected to positive semi-definite, so A stays
+// positive definite through compression and inversion. The right-hand side
+// needs no K, so a lagged A only changes the dynamics, never the static
+// equilibrium; A is refactorised when it has really changed (solver_settings.h).
+// Fixed DOFs are decoupled rows with v' = 0.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +26,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -30,12 +37,14 @@
 #include "fahr/fem/compliance.h"
 #include "fahr/fem/contact_set.h"
 #include "fahr/fem/element_rest.h"
+#include "fahr/fem/hyperelastic_element.h"
 #include "fahr/fem/material.h"
 #include "fahr/fem/obstacle_support.h"
 #include "fahr/fem/projection.h"
 #include "fahr/fem/sleep.h"
 #include "fahr/fem/solver_settings.h"
 #include "fahr/fem/sphere_links.h"
+#include "fahr/fem/stable_neo_hookean.h"
 #include "fahr/fem/warped_factor.h"
 
 namespace fahr::fem {
@@ -75,9 +84,11 @@ struct StepReport {
 
 struct Energy {
   double kinetic_j = 0.0;
-  // Corotational strain energy, J; with compression stiffening each
-  // element's s_e times its linear energy (the scaled force derives from no
-  // energy, so this is the secant estimate).
+  // Elastic energy, J. Stable Neo-Hookean: sum of V Psi(F), the energy the
+  // force derives from. Corotational: the linear strain energy in each
+  // rotated frame; with compression stiffening each element's s_e times it
+  // (the scaled force derives from no energy, so this is the secant
+  // estimate).
   double elastic_j = 0.0;
   double gravity_potential_j = 0.0;  // -m g . x summed, J (relative to origin)
   double total_j() const { return kinetic_j + elastic_j + gravity_potential_j; }
@@ -143,7 +154,8 @@ class Body {
   // keep their meaning. Not for a per-step path: the factorisation mallocs.
   bool reset_to_rest();
 
-  // Corotational elastic force of the current positions, 3 per node, N.
+  // Elastic force of the current positions (the material model's), 3 per
+  // node, N.
   void elastic_forces(std::span<double> out_n);
   Energy energy();
 
@@ -174,6 +186,7 @@ class Body {
   double time_step_s() const { return h_; }
   double total_mass_kg() const { return total_mass_kg_; }
   const BodySettings& settings() const { return settings_; }
+  bool hyperelastic() const { return snh_.has_value(); }
   const SparseMatrix& system_matrix() const { return assembly_.matrix(); }
   double factor_nonzeros() const { return cholmod_.factor_nonzeros(); }
   // Numeric factorisations so far, set-up included.
@@ -185,6 +198,13 @@ class Body {
                          std::span<const Tet> tets, std::span<const std::uint32_t> fixed_nodes);
   // Rotations, elastic forces into force_ (accumulated), inverted count.
   int update_rotations_and_forces(bool accumulate_energy, double* elastic_energy_j);
+  // The same for the hyperelastic material: deformation gradients, exact
+  // forces into force_ (accumulated), inverted count (det F <= 0).
+  int update_hyperelastic_forces(bool accumulate_energy, double* elastic_energy_j);
+  // Deformation gradients of the current positions, nothing else.
+  void update_deformations();
+  // Elastic forces (and energy) of the current positions, either model.
+  int update_elastic_forces(bool accumulate_energy, double* elastic_energy_j);
   // The stages of step().
   void compute_forces(StepReport& report);
   void prepare_system(StepReport& report);
@@ -200,6 +220,8 @@ class Body {
   bool rotated_since_factor() const;
   // True if an element's stiffening scale changed by more than the setting.
   bool stiffened_since_factor() const;
+  // True if an element's F changed by more than the setting (hyperelastic).
+  bool deformed_since_factor() const;
   bool support_changed_factor_due(bool cg) const;
   bool accept_contacts(const ContactSet* contacts, const SphereLinks* links, StepReport& report);
   double kinetic_energy() const;
@@ -223,6 +245,17 @@ class Body {
   bool stiffening_ = false;
   std::vector<double> stiffening_scales_;
   std::vector<double> stiffening_scales_at_factor_;
+
+  // Stable Neo-Hookean (Material::model): the material, and per element
+  // F at the start of the step (the force's and the tangent's) and at the
+  // last factorisation. Empty for the corotational model.
+  std::optional<StableNeoHookean> snh_;
+  std::vector<Eigen::Matrix3d> deformations_;
+  std::vector<Eigen::Matrix3d> deformations_at_factor_;
+  // Each element's tangent (its projected K_t block, N/m) and the F it was
+  // computed at, kept between refreshes (SolverSettings::tangent_reuse_change).
+  std::vector<Matrix12d> element_tangents_;
+  std::vector<Eigen::Matrix3d> tangent_deformations_;
 
   SystemAssembly assembly_;
   CholmodSolver cholmod_;

@@ -34,5 +34,10 @@ Vector12d nodal_forces(const Matrix9x12d& df_dx, double volume_m3, const Eigen::
 // positive semi-definite when H is (a projected Hessian). `df_dx` must be
 // deformation_gradient_jacobian()'s: its block structure is used.
 Matrix12d element_stiffness(const Matrix9x12d& df_dx, double volume_m3, const Matrix9d& h);
+// The same K from the element's shape gradients (shape_gradients(dm_inv),
+// element_rest.h: column a is g_a), which is all of dF/dx: what a body
+// assembling every element uses, without forming the 9x12 matrix.
+Matrix12d element_stiffness(const Eigen::Matrix<double, 3, 4>& g, double volume_m3,
+                            const Matrix9d& h);
 
 }  // namespace fahr::fem

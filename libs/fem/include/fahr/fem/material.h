@@ -1,21 +1,35 @@
-// Linear elastic material in SI units and Rayleigh damping coefficients.
+// Elastic material in SI units, its model, and Rayleigh damping coefficients.
 #pragma once
 
 namespace fahr::fem {
 
-// Isotropic linear elasticity (used in the rotated frame of each element) and
-// Rayleigh damping D = alpha M + beta K.
+// How a body's elements turn deformation into force (docs/design/fem-step-and-solvers.md).
+enum class MaterialModel {
+  // Isotropic linear elasticity in each element's rotated frame
+  // (corotation.h); with yeoh_c20_over_c10 > 0 scaled per element by the
+  // compression-stiffening secant (compression_stiffening.h).
+  kCorotational,
+  // Stable Neo-Hookean (Smith, de Goes and Kim 2018) with the tongue's Yeoh
+  // term (stable_neo_hookean.h): an energy defined through inversion, its
+  // exact force every step and its projected tangent in A.
+  kStableNeoHookean,
+};
+
+// Isotropic elasticity (E and nu set the small-strain moduli of either
+// model) and Rayleigh damping D = alpha M + beta K.
 struct Material {
   double youngs_modulus_pa = 7740.0;   // E, Pa, > 0
   double poisson_ratio = 0.45;         // nu, dimensionless, in [0, 0.5)
   double density_kg_per_m3 = 1040.0;   // rho, kg/m^3, > 0
   double rayleigh_mass_per_s = 1.0;    // alpha, 1/s, >= 0
   double rayleigh_stiffness_s = 0.01;  // beta, s, >= 0
-  // Compression stiffening (compression_stiffening.h): the Yeoh ratio
-  // C20/C10, dimensionless, [0, kMaxYeohC20OverC10]; 0: off, the linear
-  // corotational material exactly as without it. The tongue's is
-  // kTongueYeohC20OverC10.
+  // Compression stiffening, the Yeoh ratio C20/C10, dimensionless,
+  // [0, kMaxYeohC20OverC10]; the tongue's is kTongueYeohC20OverC10.
+  // Corotational: the per-element secant scale (compression_stiffening.h),
+  // 0 the linear material exactly as without it. Stable Neo-Hookean: the
+  // Yeoh term of the energy (stable_neo_hookean.h), 0 none.
   double yeoh_c20_over_c10 = 0.0;
+  MaterialModel model = MaterialModel::kCorotational;
 };
 
 // Gerard et al.'s Yeoh fit of human tongue tissue, C20/C10 = 0.47 (see

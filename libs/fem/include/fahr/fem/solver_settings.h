@@ -36,6 +36,27 @@ struct SolverSettings {
   // the rotation trigger. Applies where the rotation trigger does (a factor
   // in use and refactor_period != 1).
   double refactor_stiffening_change = 0.1;
+  // With the Stable Neo-Hookean material (whose tangent depends on the
+  // whole F, not on a rotation): also refactorise when some element's
+  // deformation gradient has changed by more than this (Frobenius norm,
+  // dimensionless) since the last factorisation (0 disables). 0.1 is a turn
+  // of 0.07 rad (a turn of 0.1 rad changes F by 2 sqrt 2 sin(0.05) = 0.141)
+  // or a 10 % change of stretch; the SNH tangent is smooth in F, so its
+  // blocks are then off by about that fraction, more where the Yeoh term
+  // stiffens a compressed element, whose strain the criterion sees: a
+  // compressing tongue does not run long on a tangent much softer than the
+  // truth. A choice: in the 20 s overshoot run 0.1 refactorised 3,431 times
+  // (the corotational tongue 2,604) and let 1 node back through a bone;
+  // 0.14 refactorised 2,187 times and let 90 back (fahr_stack_sim_run
+  // --script overshoot). Applies where the rotation trigger does.
+  double refactor_deformation_change = 0.1;
+  // With the Stable Neo-Hookean material, when A is assembled: an element
+  // whose F has changed by at most this (Frobenius norm) since its tangent
+  // was last computed keeps that tangent, so a refresh recomputes only the
+  // elements that moved (0: every element every time). 0.01 lags a block by
+  // about 1 %, a tenth of what the refresh trigger allows. The force is
+  // exact every step either way, so the equilibrium does not depend on it.
+  double tangent_reuse_change = 0.01;
   // Rotate a reused factorisation per node into the current frame (see
   // warped_factor.h). Off only to measure what it buys.
   bool warp_lagged_factor = false;

@@ -95,7 +95,7 @@ class StableNeoHookean {
   Eigen::Matrix3d first_piola(const Eigen::Matrix3d& f) const;
   // d2Psi/dvec(F)^2, Pa; indefinite in general (inverted, compressed).
   Matrix9d hessian(const Eigen::Matrix3d& f) const;
-  // The analytic eigensystem of hessian(f), from one 3x3 SVD and one 3x3
+  // The analytic eigensystem of hessian(f), from one 3x3 SVD (svd3.h) and one 3x3
   // symmetric eigen-solve.
   HessianEigensystem hessian_eigensystem(const Eigen::Matrix3d& f) const;
   // hessian(f) with its negative eigenvalues set to zero: hessian(f) minus

@@ -29,7 +29,13 @@ std::string_view to_string(LengthUnit unit);
 // Metres per file unit: the scale a mesh loader multiplies coordinates by.
 double metres_per_unit(LengthUnit unit);
 
-// Linear elastic, isotropic material in SI units, optionally stiffening
+// The FEM material model (libs/fem material.h): corotational linear
+// elasticity, or the Stable Neo-Hookean hyperelastic solid.
+enum class MaterialModel { kCorotational, kStableNeoHookean };
+
+std::string_view to_string(MaterialModel model);
+
+// Isotropic elastic material in SI units, its model, optionally stiffening
 // under large compression.
 struct Material {
   double youngs_modulus_pa = kDefaultYoungsModulusPa;        // Pa, (0, 1e12]
@@ -39,6 +45,8 @@ struct Material {
   double rayleigh_stiffness_s = kDefaultRayleighStiffnessS;  // s, [0, 10]
   // Yeoh C20/C10, dimensionless, [0, 100]; 0: no compression stiffening.
   double yeoh_c20_over_c10 = kDefaultYeohC20OverC10;
+  // corotational by default: a scene without the key behaves as before it.
+  MaterialModel model = MaterialModel::kCorotational;
 };
 
 // Nodes held at their rest position: the union of an index file and a box.
