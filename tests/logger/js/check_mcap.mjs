@@ -22,7 +22,7 @@ const problems = [];
 const json = (v) => JSON.stringify(v, (_k, x) => (typeof x === "bigint" ? Number(x) : x));
 
 // 1. Stream reader: every record in file order, chunk CRCs validated.
-const stream = new McapStreamReader({ decompressHandlers, validateCrcs: true });
+const stream = new McapStreamReader({ decompressHandlers, validateCrcs: true, includeChunks: true });
 stream.append(bytes);
 const schemas = new Map();
 const channels = new Map();
@@ -82,6 +82,8 @@ for await (const m of indexed.readMessages({ validateCrcs: true })) {
   if (!samples[channel.topic]) samples[channel.topic] = summarise(value);
 }
 
+if (decoded === 0) problems.push("no messages");
+
 // 4. Loss accounting: the recorder's figures (its fahr_recording_loss
 // metadata) against what is in the file and what each writer says it sent.
 const loss = metadata.find((m) => m.name === "fahr_recording_loss");
@@ -90,17 +92,28 @@ if (!loss) problems.push("no fahr_recording_loss metadata");
 else {
   for (const [k, v] of loss.metadata) {
     const [topic, writerId] = k.split(" ");
-    const [sent, recorded, gaps, drops] = v.split(" ").map(Number);
+    const [sent, recorded, gaps, drops, skipped, leading] = v.split(" ").map(Number);
     const w = writers.get(`${topic} ${writerId}`);
     const inFile = w ? w.seqs.length : 0;
     const status = lastStatus.get(Number(writerId));
     const metric = status?.metrics.find((x) => x.name === `sent ${topic}`);
     const reported = metric ? metric.value : undefined;
-    const row = { topic, writer_id: Number(writerId), sent, reported, recorded, in_file: inFile, gaps, drops };
+    const row = { topic, writer_id: Number(writerId), sent, reported, recorded, in_file: inFile, gaps, leading_gaps: leading, drops, skipped };
     accounting.push(row);
     if (inFile !== recorded) problems.push(`${k}: ${inFile} in the file, recorder says ${recorded}`);
-    if (recorded + gaps + drops !== sent) problems.push(`${k}: recorded + gaps + drops != sent`);
-    if (reported !== undefined && reported > sent) problems.push(`${k}: writer reports ${reported} sent, recorder ${sent}`);
+    if (recorded + gaps + drops + skipped !== sent) problems.push(`${k}: recorded + gaps + drops + skipped != sent`);
+    // The gaps again, from the sequence numbers in the file.
+    if (w && skipped === 0) {
+      const seen = new Set(w.seqs);
+      let missing = 0;
+      for (let s = 1; s <= sent; s++) if (!seen.has(s)) missing++;
+      if (missing !== gaps + drops) problems.push(`${k}: ${missing} sequence numbers missing from the file, recorder says ${gaps} gaps + ${drops} drops`);
+    }
+    // A status carries the counts from before it was written: its own topic
+    // and ServiceEvents (written right after it) are one behind.
+    const behind = topic === "fahr/ServiceStatus" || topic === "fahr/ServiceEvents" ? 1 : 0;
+    if (reported === undefined) problems.push(`${k}: the writer reported no sent count`);
+    else if (reported + behind !== sent) problems.push(`${k}: writer reports ${reported} sent, recorder counts ${sent}`);
     if (w && new Set(w.seqs).size !== w.seqs.length) problems.push(`${k}: duplicate sequence numbers`);
   }
 }
@@ -112,7 +125,7 @@ console.log(json({
   channels: Object.fromEntries(counts), metadata: metadata.map((m) => m.name),
   accounting, samples,
 }));
-process.exit(problems.length === 0 ? 0 : 1);
+process.exitCode = problems.length === 0 ? 0 : 1;
 
 function findDataEnd(b) {
   // Walk the records from the magic to the Data End record (opcode 0x0f).
