@@ -9,7 +9,7 @@
 #                           [--dds-gateway V] [--dds-fem V] [--dds-haptic V]
 #                           [--mode realtime|lockstep] [--haptic-collision aist|triangle]
 #                           [--cpus-fem LIST] [--cpus-haptic LIST]
-#                           [--record FILE.mcap] [--record-decimate TOPIC=N]
+#                           [--record FILE.mcap] [--record-decimate TOPIC=N] [--record-arg ARG]
 #
 # --record FILE.mcap: fahr_logger joins first and records every topic of the
 # run to FILE.mcap (FILE.mcap.part until it closes, after the services have
@@ -17,6 +17,7 @@
 # recorded, lost and dropped samples is printed at the end.
 # --record-decimate fahr/DeformationState=10 keeps one FEM state in ten
 # (the others are counted as skipped): the recording's size bound.
+# --record-arg ARG passes one more argument to fahr_logger (repeatable).
 # --haptic-collision triangle: the haptic service finds the blade's contacts
 # with the tongue by the triangle-level baseline instead of the AIST.
 # --cpus-fem / --cpus-haptic: run that service on these CPUs only (its
@@ -71,6 +72,7 @@ while [ $# -gt 0 ]; do
     --cpus-haptic) haptic_extra+=(--cpus "$2"); shift 2 ;;
     --record) record="$2"; shift 2 ;;
     --record-decimate) record_extra+=(--decimate "$2"); shift 2 ;;
+    --record-arg) record_extra+=("$2"); shift 2 ;;
     -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
