@@ -32,11 +32,21 @@ common::TransportConfig in_process(std::uint32_t domain, const char* name) {
   return config;
 }
 
-std::string temp_file(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("fahr_logger_test_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return (dir / name).string();
+fs::path temp_dir() {
+  return fs::temp_directory_path() / ("fahr_logger_test_" + std::to_string(getpid()));
 }
+
+std::string temp_file(const std::string& name) {
+  fs::create_directories(temp_dir());
+  return (temp_dir() / name).string();
+}
+
+// Removes the test's recordings when the binary ends.
+class TempFiles : public ::testing::Environment {
+ public:
+  void TearDown() override { fs::remove_all(temp_dir()); }
+};
+const auto* const kTempFiles = ::testing::AddGlobalTestEnvironment(new TempFiles);
 
 TEST(WireHeader, ReadsSequenceWriterAndKeyFromTheBytes) {
   msg::DevicePose pose;

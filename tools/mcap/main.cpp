@@ -47,10 +47,12 @@ int info(const std::string& path) {
   std::printf("channels:\n");
   for (const auto& [id, c] : r.channels) {
     const auto n = r.channel_messages.count(id) != 0 ? r.channel_messages.at(id) : 0;
+    const auto bytes = r.channel_bytes.count(id) != 0 ? r.channel_bytes.at(id) : 0;
     std::string key;
     if (auto it = c.metadata.find("key"); it != c.metadata.end()) key = " [" + it->second + "]";
-    std::printf("  %3u %-28s%-12s %10llu msgs  (%s)\n", id, c.topic.c_str(), key.c_str(),
-                static_cast<unsigned long long>(n), c.message_encoding.c_str());
+    std::printf("  %3u %-24s%-22s %8llu msgs %9.2f MiB  (%s)\n", id, c.topic.c_str(), key.c_str(),
+                static_cast<unsigned long long>(n), static_cast<double>(bytes) / (1 << 20),
+                c.message_encoding.c_str());
   }
   for (const auto& m : r.metadata) {
     std::printf("metadata %s:\n", m.name.c_str());

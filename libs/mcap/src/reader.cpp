@@ -95,6 +95,7 @@ bool read_chunk(std::span<const std::uint8_t> content, ReadReport& r,
       if (r.messages == 0) r.message_start_time = r.message_end_time = m.log_time;
       ++r.messages;
       ++r.channel_messages[m.channel_id];
+      r.channel_bytes[m.channel_id] += m.data.size();
       r.message_start_time = std::min(r.message_start_time, m.log_time);
       r.message_end_time = std::max(r.message_end_time, m.log_time);
       if (on_message) {

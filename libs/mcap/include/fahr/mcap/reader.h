@@ -25,6 +25,7 @@ struct ReadReport {
   std::vector<ChunkIndex> chunk_indexes;
   std::uint64_t messages = 0;
   std::map<std::uint16_t, std::uint64_t> channel_messages;
+  std::map<std::uint16_t, std::uint64_t> channel_bytes;  // message data, uncompressed
   std::uint64_t message_start_time = 0, message_end_time = 0;
   std::uint64_t chunks = 0;
   std::set<std::string> compressions;
