@@ -1,6 +1,9 @@
 // Raw subscriptions -> bounded queue -> MCAP writer thread.
 #include "fahr/logger_service/recorder.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 
@@ -179,18 +182,26 @@ void Recorder::on_sample(std::size_t topic, std::span<const std::uint8_t> cdr,
   queue_bytes_ += cdr.size();
   stats_.queue_peak_bytes = std::max(stats_.queue_peak_bytes, queue_bytes_);
   queue_.push_back(std::move(item));
+  // The writer wakes every 20 ms on its own; a wake-up per sample would be
+  // thousands of context switches a second on the services' cores. Only a
+  // filling queue calls it early.
+  const bool filling = queue_bytes_ > options_.queue_bytes / 4;
   lock.unlock();
-  queue_cv_.notify_one();
+  if (filling) queue_cv_.notify_one();
 }
 
 void Recorder::run_writer() {
+  if (options_.writer_nice != 0) {
+    // Linux: nice is per thread (PRIO_PROCESS with the thread's id).
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), options_.writer_nice);
+  }
   std::deque<Item> batch;
   std::vector<std::vector<std::uint8_t>> used;
   while (true) {
     {
       std::unique_lock lock(queue_mutex_);
-      queue_cv_.wait_for(lock, std::chrono::milliseconds(100),
-                         [this] { return !queue_.empty() || stopping_; });
+      queue_cv_.wait_for(lock, std::chrono::milliseconds(20),
+                         [this] { return queue_bytes_ > options_.queue_bytes / 4 || stopping_; });
       // Give the buffers written last round back for reuse (a few).
       for (auto& b : used) {
         if (spare_.size() < 1024) spare_.push_back(std::move(b));
@@ -238,6 +249,7 @@ void Recorder::write_item(Item& item) {
   {
     std::lock_guard lock(queue_mutex_);
     ++stats_.written;
+    stats_.bytes += item.bytes.size();
   }
   if (t.name == common::TopicTraits<msg::ServiceStatus>::kName) note_status(item);
 }
@@ -302,9 +314,7 @@ void Recorder::stop() {
 
 RecorderStats Recorder::stats() const {
   std::lock_guard lock(queue_mutex_);
-  RecorderStats s = stats_;
-  s.bytes = 0;
-  return s;
+  return stats_;
 }
 
 std::vector<std::string> Recorder::files() const {

@@ -34,6 +34,10 @@ struct RecorderOptions {
   // Keep one sample in N of a topic (by sequence number); the others are
   // counted as skipped, not lost. Empty: keep everything.
   std::map<std::string, std::uint32_t> decimate;
+  // Nice value of the writer thread (compression and disk): above 0 it
+  // yields the CPU to the services' loops on a shared machine, its queue
+  // absorbing the delay.
+  int writer_nice = 10;
   // Test hook: the writer thread sleeps this long per message, so a test
   // can force the queue to overflow.
   std::chrono::microseconds writer_delay{0};
@@ -44,7 +48,7 @@ struct RecorderOptions {
 
 struct RecorderStats {
   std::uint64_t received = 0, written = 0, dropped = 0, skipped = 0;
-  std::uint64_t bytes = 0;  // written to the file(s)
+  std::uint64_t bytes = 0;  // message bytes written (before compression)
   std::size_t queue_peak_bytes = 0;
 };
 
