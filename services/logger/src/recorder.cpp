@@ -80,6 +80,8 @@ Recorder::Topic topic_of(const char* key_field) {
   t.writer_qos = QosProfile::for_role(common::TopicTraits<T>::kRole);
   t.qos = recorder_qos(common::TopicTraits<T>::kRole);
   t.role = role_text(common::TopicTraits<T>::kRole);
+  const TopicRole role = common::TopicTraits<T>::kRole;
+  t.always_queue = role != TopicRole::kServoStream && role != TopicRole::kStateStream;
   return t;
 }
 
@@ -158,7 +160,7 @@ void Recorder::on_sample(std::size_t topic, std::span<const std::uint8_t> cdr,
     accounting_.on_skipped(t.name, header->writer_id);
     return;
   }
-  if (stopping_ || queue_bytes_ + cdr.size() > options_.queue_bytes) {
+  if (stopping_ || (!t.always_queue && queue_bytes_ + cdr.size() > options_.queue_bytes)) {
     ++stats_.dropped;
     lock.unlock();
     accounting_.on_drop(t.name, header->writer_id);

@@ -29,7 +29,9 @@ namespace fahr::logger_service {
 struct RecorderOptions {
   std::string path;  // NAME.mcap (written as NAME.mcap.part until closed)
   mcap::WriterOptions mcap;
-  // Bytes the queue may hold before samples are dropped (and counted).
+  // Bytes the queue may hold before samples of the streams (DevicePose,
+  // ForceCommand, ContactSet, DeformationState) are dropped and counted;
+  // reports, the scene and lockstep samples are always queued.
   std::size_t queue_bytes = 256u << 20;
   // Keep one sample in N of a topic (by sequence number); the others are
   // counted as skipped, not lost. Empty: keep everything.
@@ -79,6 +81,9 @@ class Recorder {
     common::QosProfile writer_qos;  // what fahr's writers offer (topics.h role)
     common::QosProfile qos;         // the recorder's reader QoS
     std::string role;
+    // Never dropped for a full queue: low-rate topics the books and a
+    // replay depend on (reports, the scene, lockstep).
+    bool always_queue = false;
     std::uint32_t decimate = 1;
     std::uint16_t schema_id = 0;
   };
