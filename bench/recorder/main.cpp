@@ -254,6 +254,7 @@ void print_phase(const char* phase, std::vector<Span> spans) {
   }
   auto pct = [&](auto member, double q) {
     std::vector<std::int64_t> v;
+    v.reserve(spans.size());
     for (const auto& s : spans) v.push_back(s.*member);
     std::sort(v.begin(), v.end());
     return static_cast<double>(v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))]) *

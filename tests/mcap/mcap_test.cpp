@@ -37,8 +37,9 @@ const auto* const kTempFiles = ::testing::AddGlobalTestEnvironment(new TempFiles
 
 // Payload of message i: its size varies so chunks hold uneven counts.
 std::vector<std::uint8_t> payload(std::uint32_t i) {
-  std::vector<std::uint8_t> p(20 + (i * 37) % 300);
-  for (std::size_t k = 0; k < p.size(); ++k) p[k] = static_cast<std::uint8_t>(i * 7 + k);
+  std::vector<std::uint8_t> p(20 + (std::size_t{i} * 37) % 300);
+  for (std::size_t k = 0; k < p.size(); ++k)
+    p[k] = static_cast<std::uint8_t>(std::size_t{i} * 7 + k);
   return p;
 }
 
@@ -65,7 +66,7 @@ class RoundTrip : public ::testing::TestWithParam<std::string> {};
 TEST_P(RoundTrip, EveryMessageComesBackWithItsTimesAndCrcsHold) {
   WriterOptions options;
   options.compression = GetParam();
-  options.chunk_size = 16 * 1024;  // many chunks
+  options.chunk_size = 16 * 1024ULL;  // many chunks
   options.sync_chunks = false;
   const std::string path =
       temp_path("roundtrip_" + (GetParam().empty() ? "none" : GetParam()) + ".mcap");
@@ -142,8 +143,8 @@ TEST(Mcap, AFlippedByteFailsItsCrc) {
 
 TEST(Mcap, SplitsBySizeAndEveryPartStandsAlone) {
   WriterOptions options;
-  options.chunk_size = 8 * 1024;
-  options.split_bytes = 64 * 1024;
+  options.chunk_size = 8 * 1024ULL;
+  options.split_bytes = 64 * 1024ULL;
   options.sync_chunks = false;
   const std::string path = temp_path("split.mcap");
   std::vector<std::string> files;
@@ -180,7 +181,7 @@ TEST(Mcap, RecoverAfterSigkillKeepsEveryCompleteChunk) {
   if (child == 0) {
     close(ready[0]);
     WriterOptions options;
-    options.chunk_size = 32 * 1024;
+    options.chunk_size = 32 * 1024ULL;
     options.compression = "zstd";
     Writer w(options);
     w.open(path);
@@ -220,7 +221,7 @@ TEST(Mcap, RecoverAfterSigkillKeepsEveryCompleteChunk) {
 // A file cut at any byte recovers to a valid file holding a prefix.
 TEST(Mcap, RecoverFromAnyTruncation) {
   WriterOptions options;
-  options.chunk_size = 4 * 1024;
+  options.chunk_size = 4 * 1024ULL;
   options.sync_chunks = false;
   const std::string path = temp_path("cut.mcap");
   {
