@@ -87,6 +87,19 @@ case "$mode" in
       echo "record_run_test: run_local failed:" >&2; tail -n 40 "$out/run.log" >&2; exit 1; }
     grep -A16 "^run_local: recording" "$out/run.log" || true
     check "$out/run.mcap"
+    # The trace of the same file: valid JSON that Perfetto reads, a track
+    # of tick slices per service, and pose -> tick -> command -> servo flows.
+    "$build/tools/trace/fahr_trace" "$out/run.mcap" -o "$out/trace.json" | head -n 5
+    node -e '
+      const d = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8"));
+      const ev = d.traceEvents, count = {};
+      for (const e of ev) count[e.ph] = (count[e.ph] ?? 0) + 1;
+      const tickPids = new Set(ev.filter((e) => e.ph === "X" && e.name === "tick").map((e) => e.pid));
+      const names = ev.filter((e) => e.ph === "M" && e.name === "process_name").map((e) => e.args.name);
+      console.log(`record_run_test: trace.json: ${ev.length} events ${JSON.stringify(count)}, tick tracks: ${names.join(", ")}`);
+      const ok = tickPids.size >= 3 && count.s > 0 && count.f > 0 && count.C > 0;
+      if (!ok) console.error("record_run_test: the trace lacks tick tracks, flows or counters");
+      process.exitCode = ok ? 0 : 1;' "$out/trace.json"
     if [ "$mode" = loss ]; then
       # The injection must have shown: transport gaps and recorder drops.
       node -e '
