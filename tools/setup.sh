@@ -23,6 +23,8 @@ packages=(
   iproute2 nftables
   # MCAP recordings: chunk compression (zstd, lz4) and CRC-32 (zlib)
   libzstd-dev liblz4-dev zlib1g-dev
+  # the recorder's HTML report is checked by rendering it headless
+  chromium
 )
 # The recorder tests read recordings back with Foxglove's npm packages:
 # Debian's node and npm, unless a node is already installed (another

@@ -4,7 +4,10 @@
 # committed package-lock.json into the build tree): every chunk, data and
 # summary CRC, every message decoded with the file's own omgidl schemas, and
 # per writer recorded + gaps + drops + skipped = sent, with sent equal to the
-# writer's own count from its last ServiceStatus.
+# writer's own count from its last ServiceStatus. The normal and loss runs
+# also check fahr_trace's JSON (tick tracks, flows, counters) and render
+# fahr_report's page in headless Chromium to a PNG (no script error, six
+# plots of at least 100 points; FAHR_KEEP_REPORT=DIR keeps page and PNG).
 #
 #   record_run_test.sh BUILD_DIR install
 #   record_run_test.sh BUILD_DIR VENDOR SECONDS [normal|loss|kill]
@@ -100,6 +103,25 @@ case "$mode" in
       const ok = tickPids.size >= 3 && count.s > 0 && count.f > 0 && count.C > 0;
       if (!ok) console.error("record_run_test: the trace lacks tick tracks, flows or counters");
       process.exitCode = ok ? 0 : 1;' "$out/trace.json"
+    # The report of the same file, rendered by headless Chromium to a PNG:
+    # no script error, every plot drawn with at least 100 points.
+    "$build/tools/report/fahr_report" "$out/run.mcap" -o "$out/report.html"
+    if command -v chromium >/dev/null 2>&1; then
+      chrome=(chromium --headless --no-sandbox --disable-gpu --hide-scrollbars)
+      "${chrome[@]}" --window-size=1150,2800 --screenshot="$out/report.png" "file://$out/report.html" \
+        >/dev/null 2>&1 || true
+      check_div=$("${chrome[@]}" --dump-dom "file://$out/report.html" 2>/dev/null | grep -o '<div id="fahr-check"[^>]*>' || true)
+      echo "record_run_test: report rendered: $check_div, PNG $(stat -c %s "$out/report.png" 2>/dev/null || echo 0) bytes"
+      node -e '
+        const m = /data-errors="(\d+)" data-plots="(\d+)" data-min-points="(\d+)"/.exec(process.argv[1] || "");
+        const ok = m && m[1] === "0" && Number(m[2]) === 6 && Number(m[3]) >= 100;
+        if (!ok) console.error("record_run_test: the report has script errors or a plot with fewer than 100 points");
+        process.exitCode = ok ? 0 : 1;' "$check_div"
+      [ -s "$out/report.png" ] || { echo "record_run_test: no PNG from headless Chromium" >&2; exit 1; }
+      if [ -n "${FAHR_KEEP_REPORT:-}" ]; then cp "$out/report.png" "$out/report.html" "$FAHR_KEEP_REPORT/"; fi
+    else
+      echo "record_run_test: SKIPPED the report's rendering: chromium is not installed (tools/setup.sh installs it)"
+    fi
     if [ "$mode" = loss ]; then
       # The injection must have shown: transport gaps and recorder drops.
       node -e '
