@@ -10,6 +10,7 @@
 #                           [--mode realtime|lockstep] [--haptic-collision aist|triangle]
 #                           [--cpus-fem LIST] [--cpus-haptic LIST]
 #                           [--record FILE.mcap] [--record-decimate TOPIC=N] [--record-arg ARG]
+#                           [--replay FILE.mcap]
 #
 # --record FILE.mcap: fahr_logger joins first and records every topic of the
 # run to FILE.mcap (FILE.mcap.part until it closes, after the services have
@@ -18,6 +19,9 @@
 # --record-decimate fahr/DeformationState=10 keeps one FEM state in ten
 # (the others are counted as skipped): the recording's size bound.
 # --record-arg ARG passes one more argument to fahr_logger (repeatable).
+# --replay FILE.mcap (lockstep only): fahr_replay stands in for the gateway
+# and feeds the recorded run's DevicePoses, step by step; the haptic and FEM
+# hashes then equal the recorded run's.
 # --haptic-collision triangle: the haptic service finds the blade's contacts
 # with the tongue by the triangle-level baseline instead of the AIST.
 # --cpus-fem / --cpus-haptic: run that service on these CPUs only (its
@@ -55,6 +59,7 @@ fem_extra=()
 haptic_extra=()
 record=""
 record_extra=()
+replay=""
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -73,6 +78,7 @@ while [ $# -gt 0 ]; do
     --record) record="$2"; shift 2 ;;
     --record-decimate) record_extra+=(--decimate "$2"); shift 2 ;;
     --record-arg) record_extra+=("$2"); shift 2 ;;
+    --replay) replay="$2"; shift 2 ;;
     -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
@@ -101,6 +107,11 @@ logger="$build/services/logger/fahr_logger"
 needed=("$gateway" "$fem" "$haptic" "$summary")
 [ "$mode" = lockstep ] && needed+=("$clock")
 [ -n "$record" ] && needed+=("$logger")
+replayer="$build/tools/replay/fahr_replay"
+if [ -n "$replay" ]; then
+  [ "$mode" = lockstep ] || { echo "run_local: --replay needs --mode lockstep" >&2; exit 2; }
+  needed+=("$replayer")
+fi
 for exe in "${needed[@]}"; do
   if [ ! -x "$exe" ]; then
     echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock fahr_logger" >&2
@@ -164,6 +175,7 @@ echo "run_local: gateway $dds_gateway, fem $dds_fem, haptic $dds_haptic, domain 
 logger_pid=""
 if [ -n "$record" ]; then
   mkdir -p "$(dirname "$record")"
+  [ "$mode" = lockstep ] && record_extra+=(--lockstep)
   "$logger" -o "$record" "${common[@]}" --scene "$scene" "${record_extra[@]}" >"$logs/logger.log" 2>&1 &
   logger_pid=$!; pids+=("$logger_pid")
   wait_for_line "$logs/logger.log" "recording to" "$logger_pid" 30
@@ -191,8 +203,12 @@ wait_for_line "$logs/fem.log" "^fahr_fem_service: " "$fem_pid" 60
 wait_for_line "$logs/haptic.log" "ready" "$haptic_pid" 60
 
 if [ "$mode" = lockstep ]; then
-  stdbuf -oL "$gateway" "${gateway_flags[@]}" --mode lockstep --force-input-period 1 --backend simulated \
-    --script "$script" --duration-s 0 >"$logs/gateway.log" 2>&1 &
+  if [ -n "$replay" ]; then
+    "$replayer" "$replay" --mode lockstep "${gateway_flags[@]}" >"$logs/gateway.log" 2>&1 &
+  else
+    stdbuf -oL "$gateway" "${gateway_flags[@]}" --mode lockstep --force-input-period 1 --backend simulated \
+      --script "$script" --duration-s 0 >"$logs/gateway.log" 2>&1 &
+  fi
   gateway_pid=$!; pids+=("$gateway_pid")
   steps=$(awk "BEGIN { printf \"%d\", $duration_s * 1000 }")
   status=0

@@ -62,6 +62,7 @@ int run(int argc, char** argv) {
   std::vector<std::string> decimate;
   long writer_delay_us = 0;
   int writer_nice = 10;
+  bool lockstep = false;
   app.add_option("-o,--out", options.path, "the recording (default fahr_<date>_<time>.mcap)");
   app.add_option("--dds", dds,
                  "DDS vendor: fastdds or cyclonedds (default $FAHR_DDS, else fastdds)");
@@ -86,6 +87,9 @@ int run(int argc, char** argv) {
   app.add_option("--writer-nice", writer_nice,
                  "nice value of the writer thread (compression, disk): >0 yields to the services")
       ->check(CLI::Range(-20, 19));
+  app.add_flag("--lockstep", lockstep,
+               "a lockstep run: read the streams reliably (the services write them reliable and "
+               "transient local)");
   app.add_option("--scene", scene, "scene file: its text goes into the recording's metadata");
   app.add_option("--writer-delay-us", writer_delay_us,
                  "testing: the writer thread sleeps this long per message (forces queue drops)");
@@ -100,6 +104,7 @@ int run(int argc, char** argv) {
   options.queue_bytes = static_cast<std::size_t>(queue_mib) << 20;
   options.writer_delay = std::chrono::microseconds(writer_delay_us);
   options.writer_nice = writer_nice;
+  options.lockstep = lockstep;
   for (const auto& d : decimate) {
     const auto eq = d.find('=');
     if (eq == std::string::npos) {

@@ -10,7 +10,7 @@
 # plots of at least 100 points; FAHR_KEEP_REPORT=DIR keeps page and PNG).
 #
 #   record_run_test.sh BUILD_DIR install
-#   record_run_test.sh BUILD_DIR VENDOR SECONDS [normal|loss|kill]
+#   record_run_test.sh BUILD_DIR VENDOR SECONDS [normal|loss|kill|replay]
 #
 # install: `npm ci` of the reader's packages into BUILD_DIR/tests/logger/js
 # (outside any namespace: it needs the npm registry); CTest runs it first.
@@ -22,6 +22,10 @@
 # kill:   fahr_logger with the gateway alone, SIGKILLed after SECONDS; then
 #         fahr_mcap recover rebuilds the .part, which must hold every
 #         DevicePose older than one chunk plus 1 s at the kill.
+# replay: a lockstep run of SECONDS of simulated time recorded (and read
+#         back), then run again with fahr_replay feeding the recorded
+#         DevicePoses in place of the gateway: the haptic and FEM output
+#         hashes (and the poses') must equal the recorded run's.
 # Runs inside a loopback-only network namespace (tests/run_in_netns.sh).
 # Exit 77 (skipped) only if node or npm is absent.
 set -euo pipefail
@@ -170,6 +174,21 @@ case "$mode" in
       console.log(`record_run_test: recovered ${n} DevicePoses, the newest ${behind.toFixed(2)} s before the kill`);
       process.exitCode = n > 0 && behind <= 2.0 ? 0 : 1;' "$out/killed.mcap" "$kill_ns")
     ;;
-  *) echo "record_run_test: mode must be normal, loss or kill" >&2; exit 2 ;;
+  replay)
+    bash "$repo/deployment/run_local.sh" "$build" --dds "$vendor" --mode lockstep \
+      --duration-s "$seconds" --record "$out/lockstep.mcap" >"$out/recorded.log" 2>&1 || {
+      echo "record_run_test: the recorded lockstep run failed:" >&2; tail -n 40 "$out/recorded.log" >&2; exit 1; }
+    check "$out/lockstep.mcap"
+    FAHR_RUN_LOG_DIR="$out/logs-replay" bash "$repo/deployment/run_local.sh" "$build" --dds "$vendor" \
+      --mode lockstep --duration-s "$seconds" --replay "$out/lockstep.mcap" >"$out/replayed.log" 2>&1 || {
+      echo "record_run_test: the replayed lockstep run failed:" >&2; tail -n 40 "$out/replayed.log" >&2; exit 1; }
+    grep "^lockstep_clock: hash" "$out/recorded.log" | sed 's/^/  recorded: /'
+    grep "^lockstep_clock: hash" "$out/replayed.log" | sed 's/^/  replayed: /'
+    recorded=$(grep "^lockstep_clock: hash" "$out/recorded.log")
+    replayed=$(grep "^lockstep_clock: hash" "$out/replayed.log")
+    [ "$(echo "$recorded" | wc -l)" = 3 ] && [ "$recorded" = "$replayed" ] || {
+      echo "record_run_test: the replayed run's hashes differ from the recorded run's" >&2; exit 1; }
+    ;;
+  *) echo "record_run_test: mode must be normal, loss, kill or replay" >&2; exit 2 ;;
 esac
 echo "record_run_test: passed ($mode, $vendor)"

@@ -100,6 +100,14 @@ Recorder::Recorder(common::Participant& participant, RecorderOptions options)
   writer_.open(options_.path);
   for (std::size_t i = 0; i < topics_.size(); ++i) {
     auto& t = topics_[i];
+    if (options_.lockstep && !t.always_queue) {
+      t.writer_qos.reliability = common::Reliability::kReliable;
+      t.writer_qos.durability = common::Durability::kTransientLocal;
+      t.writer_qos.history_depth = 8;
+      t.qos.reliability = common::Reliability::kReliable;
+      t.qos.durability = common::Durability::kTransientLocal;
+      t.qos.history_depth = 64;
+    }
     if (auto it = options_.decimate.find(t.name); it != options_.decimate.end()) {
       t.decimate = std::max<std::uint32_t>(1, it->second);
     }

@@ -112,8 +112,11 @@ else {
     // A status carries the counts from before it was written: its own topic
     // and ServiceEvents (written right after it) are one behind.
     const behind = topic === "fahr/ServiceStatus" || topic === "fahr/ServiceEvents" ? 1 : 0;
-    if (reported === undefined) problems.push(`${k}: the writer reported no sent count`);
-    else if (reported + behind !== sent) problems.push(`${k}: writer reports ${reported} sent, recorder counts ${sent}`);
+    // A participant without a status reporter (the lockstep clock, a
+    // replay) reports no count; one with a reporter must.
+    if (reported === undefined && status) problems.push(`${k}: the writer reported no sent count`);
+    else if (reported === undefined) row.reported = "no ServiceStatus";
+    else if (reported !== undefined && reported + behind !== sent) problems.push(`${k}: writer reports ${reported} sent, recorder counts ${sent}`);
     if (w && new Set(w.seqs).size !== w.seqs.length) problems.push(`${k}: duplicate sequence numbers`);
   }
 }

@@ -36,6 +36,10 @@ struct RecorderOptions {
   // Keep one sample in N of a topic (by sequence number); the others are
   // counted as skipped, not lost. Empty: keep everything.
   std::map<std::string, std::uint32_t> decimate;
+  // Lockstep run: the services write the four streams reliable and
+  // transient local (common::lockstep_output_qos); the recorder then reads
+  // them reliably too, so nothing is lost and a replay has every step.
+  bool lockstep = false;
   // Nice value of the writer thread (compression and disk): above 0 it
   // yields the CPU to the services' loops on a shared machine, its queue
   // absorbing the delay.
