@@ -9,7 +9,19 @@
 #                           [--dds-gateway V] [--dds-fem V] [--dds-haptic V]
 #                           [--mode realtime|lockstep] [--haptic-collision aist|triangle]
 #                           [--cpus-fem LIST] [--cpus-haptic LIST]
+#                           [--record FILE.mcap] [--record-decimate TOPIC=N] [--record-arg ARG]
+#                           [--replay FILE.mcap]
 #
+# --record FILE.mcap: fahr_logger joins first and records every topic of the
+# run to FILE.mcap (FILE.mcap.part until it closes, after the services have
+# stopped and sent their last reports); its per-writer table of sent,
+# recorded, lost and dropped samples is printed at the end.
+# --record-decimate fahr/DeformationState=10 keeps one FEM state in ten
+# (the others are counted as skipped): the recording's size bound.
+# --record-arg ARG passes one more argument to fahr_logger (repeatable).
+# --replay FILE.mcap (lockstep only): fahr_replay stands in for the gateway
+# and feeds the recorded run's DevicePoses, step by step; the haptic and FEM
+# hashes then equal the recorded run's.
 # --haptic-collision triangle: the haptic service finds the blade's contacts
 # with the tongue by the triangle-level baseline instead of the AIST.
 # --cpus-fem / --cpus-haptic: run that service on these CPUs only (its
@@ -45,6 +57,9 @@ mode=realtime
 haptic_collision=aist
 fem_extra=()
 haptic_extra=()
+record=""
+record_extra=()
+replay=""
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -60,7 +75,11 @@ while [ $# -gt 0 ]; do
     --haptic-collision) haptic_collision="$2"; shift 2 ;;
     --cpus-fem) fem_extra+=(--cpus "$2"); shift 2 ;;
     --cpus-haptic) haptic_extra+=(--cpus "$2"); shift 2 ;;
-    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
+    --record) record="$2"; shift 2 ;;
+    --record-decimate) record_extra+=(--decimate "$2"); shift 2 ;;
+    --record-arg) record_extra+=("$2"); shift 2 ;;
+    --replay) replay="$2"; shift 2 ;;
+    -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
@@ -84,11 +103,18 @@ fem="$build/services/fem/fahr_fem_service"
 haptic="$build/services/haptic/fahr_haptic_service"
 summary="$build/tools/run_summary/fahr_run_summary"
 clock="$build/services/lockstep_clock/fahr_lockstep_clock"
+logger="$build/services/logger/fahr_logger"
 needed=("$gateway" "$fem" "$haptic" "$summary")
 [ "$mode" = lockstep ] && needed+=("$clock")
+[ -n "$record" ] && needed+=("$logger")
+replayer="$build/tools/replay/fahr_replay"
+if [ -n "$replay" ]; then
+  [ "$mode" = lockstep ] || { echo "run_local: --replay needs --mode lockstep" >&2; exit 2; }
+  needed+=("$replayer")
+fi
 for exe in "${needed[@]}"; do
   if [ ! -x "$exe" ]; then
-    echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock" >&2
+    echo "run_local: $exe is missing; build it: cmake --build $build --target fahr_device_gateway fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock fahr_logger" >&2
     exit 2
   fi
 done
@@ -145,6 +171,25 @@ wait_for_line() {
 }
 
 echo "run_local: gateway $dds_gateway, fem $dds_fem, haptic $dds_haptic, domain $domain, ${duration_s} s of the '$script' script, $mode, logs in $logs"
+# The recorder joins first, so it matches every writer before its first sample.
+logger_pid=""
+if [ -n "$record" ]; then
+  mkdir -p "$(dirname "$record")"
+  [ "$mode" = lockstep ] && record_extra+=(--lockstep)
+  "$logger" -o "$record" "${common[@]}" --scene "$scene" "${record_extra[@]}" >"$logs/logger.log" 2>&1 &
+  logger_pid=$!; pids+=("$logger_pid")
+  wait_for_line "$logs/logger.log" "recording to" "$logger_pid" 30
+fi
+# Stops the recorder after the services, so their last reports are in the
+# file, and prints its table and the file's name.
+finish_recording() {
+  [ -n "$logger_pid" ] || return 0
+  sleep 0.5
+  stop "$logger_pid"
+  wait "$logger_pid" 2>/dev/null || { echo "run_local: the logger failed:" >&2; tail -n 20 "$logs/logger.log" >&2; return 1; }
+  echo "run_local: recording (per writer: sent = recorded + gaps + drops + skipped; (before): gaps before the recorder matched the writer):"
+  grep "^fahr_logger: " "$logs/logger.log" | grep -v "recording to" | sed 's/^fahr_logger: /  /'
+}
 stdbuf -oL "$fem" --scene "$scene" "${fem_flags[@]}" "${fem_extra[@]}" --mode "$mode" --duration-s 0 >"$logs/fem.log" 2>&1 &
 fem_pid=$!; pids+=("$fem_pid")
 "$haptic" --scene "$scene" "${haptic_flags[@]}" "${haptic_extra[@]}" --mode "$mode" --collision "$haptic_collision" --duration-s 0 \
@@ -158,8 +203,12 @@ wait_for_line "$logs/fem.log" "^fahr_fem_service: " "$fem_pid" 60
 wait_for_line "$logs/haptic.log" "ready" "$haptic_pid" 60
 
 if [ "$mode" = lockstep ]; then
-  stdbuf -oL "$gateway" "${gateway_flags[@]}" --mode lockstep --force-input-period 1 --backend simulated \
-    --script "$script" --duration-s 0 >"$logs/gateway.log" 2>&1 &
+  if [ -n "$replay" ]; then
+    "$replayer" "$replay" --mode lockstep "${gateway_flags[@]}" >"$logs/gateway.log" 2>&1 &
+  else
+    stdbuf -oL "$gateway" "${gateway_flags[@]}" --mode lockstep --force-input-period 1 --backend simulated \
+      --script "$script" --duration-s 0 >"$logs/gateway.log" 2>&1 &
+  fi
   gateway_pid=$!; pids+=("$gateway_pid")
   steps=$(awk "BEGIN { printf \"%d\", $duration_s * 1000 }")
   status=0
@@ -171,6 +220,7 @@ if [ "$mode" = lockstep ]; then
     stop "${!pid_var}"
     wait "${!pid_var}" 2>/dev/null || true
   done
+  finish_recording || status=1
   pids=()
   echo "run_local: service logs:"
   for name in gateway fem haptic; do tail -n 3 "$logs/$name.log" | sed "s/^/  [$name] /"; done
@@ -202,6 +252,7 @@ for name in haptic fem; do
   stop "$pid"
   wait "$pid" 2>/dev/null || true
 done
+finish_recording || status=1
 pids=()
 
 cat "$logs/summary.md"

@@ -7,6 +7,11 @@
 # then a summary (rates, forces against the device's limit, lost track).
 # FAHR_DEMO_SECONDS changes the length; FAHR_DEMO_TRANSPORT=1 adds the
 # transport's round-trip benchmark afterwards (about a minute).
+# The run is recorded (fahr_logger, MCAP; Foxglove and Lichtblick open it)
+# to FAHR_DEMO_RECORD (default build/recordings/demo_<date>_<time>.mcap;
+# FAHR_DEMO_RECORD=0 records nothing), keeping one ContactSet and one FEM
+# state in ten (the rest counted as skipped) so the file stays near 0.5 MB
+# per second of run instead of 2 MB; the path is printed at the end.
 # As root it runs inside a loopback-only network namespace; otherwise it
 # keeps both vendors on loopback through the profiles in deployment/dds.
 set -euo pipefail
@@ -15,10 +20,16 @@ build="${FAHR_BUILD_DIR:-$root/build}"
 
 bash "$root/tools/setup.sh"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
-cmake --build "$build" -j2 --target fahr_device_gateway fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock
+cmake --build "$build" -j2 --target fahr_device_gateway fahr_fem_service fahr_haptic_service fahr_run_summary fahr_lockstep_clock fahr_logger fahr_mcap_tool
 
 echo "fahr demo: simulated neonatal intubation, gateway + FEM + haptic over DDS"
-bash "$root/deployment/run_local.sh" "$build" --duration-s "${FAHR_DEMO_SECONDS:-20}"
+record=("--record" "${FAHR_DEMO_RECORD:-$build/recordings/demo_$(date +%Y%m%d_%H%M%S).mcap}"
+        --record-decimate fahr/DeformationState=10 --record-decimate fahr/ContactSet=10)
+[ "${FAHR_DEMO_RECORD:-}" = 0 ] && record=()
+bash "$root/deployment/run_local.sh" "$build" --duration-s "${FAHR_DEMO_SECONDS:-20}" "${record[@]}"
+if [ ${#record[@]} -gt 0 ]; then
+  echo "fahr demo: recording ${record[1]} (inspect: $build/tools/mcap/fahr_mcap info ${record[1]}; open it in Foxglove or Lichtblick)"
+fi
 
 if [ "${FAHR_DEMO_TRANSPORT:-0}" = 1 ]; then
   cmake --build "$build" -j2 --target fahr_transport_latency

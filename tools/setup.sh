@@ -21,7 +21,17 @@ packages=(
   clang-format clang-tidy
   # network namespaces for multi-process tests
   iproute2 nftables
+  # MCAP recordings: chunk compression (zstd, lz4) and CRC-32 (zlib)
+  libzstd-dev liblz4-dev zlib1g-dev
+  # the recorder's HTML report is checked by rendering it headless
+  chromium
 )
+# The recorder tests read recordings back with Foxglove's npm packages:
+# Debian's node and npm, unless a node is already installed (another
+# distribution of node ships its own npm, which Debian's npm conflicts with).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

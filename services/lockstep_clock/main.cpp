@@ -23,7 +23,9 @@
 #include "fahr/common/participant.h"
 #include "fahr/common/transport_config.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   using namespace fahr;
   CLI::App app{"fahr lockstep coordinator"};
   std::string participants_csv, dds, domain, profile;
@@ -79,6 +81,18 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fahr_lockstep_clock: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {  // anything else: a message rather than terminate()
+    std::fprintf(stderr, "fahr_lockstep_clock: %s\n", e.what());
+    return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // The option set-up may throw too (CLI11, allocation): a message, not terminate().
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
     std::fprintf(stderr, "fahr_lockstep_clock: %s\n", e.what());
     return 1;
   }

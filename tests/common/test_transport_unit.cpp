@@ -190,14 +190,24 @@ TEST(ServiceReporter, ReportsTickStatisticsLatePeriodsAndQosEvents) {
   EXPECT_EQ(s.period().p50_ns(), 1'000'000);
   EXPECT_EQ(s.period().max_ns(), 3'000'000);
   EXPECT_EQ(s.tick_cpu().p50_ns(), 150'000);
-  ASSERT_EQ(s.metrics().size(), 1U);
-  EXPECT_EQ(s.metrics()[0].value(), 1.25);
+  // Each of the participant's writers' sent counts first (a status counts
+  // the reports before it), then the service's own figures.
+  ASSERT_EQ(s.metrics().size(), 3U);
+  EXPECT_EQ(s.metrics()[0].name().to_string(), "sent fahr/ServiceStatus");
+  EXPECT_EQ(s.metrics()[0].value(), 0.0);
+  EXPECT_EQ(s.metrics()[1].name().to_string(), "sent fahr/ServiceEvents");
+  EXPECT_EQ(s.metrics()[2].name().to_string(), "latency_p99_ms");
+  EXPECT_EQ(s.metrics()[2].value(), 1.25);
   ASSERT_TRUE(events.fetch_newest());
   EXPECT_EQ(events.newest().tick_spans().size(), 101U);
   bool saw_match = false;
   for (const auto& e : events.newest().qos_events())
     saw_match |= e.kind() == msg::QOS_PUBLICATION_MATCHED;
   EXPECT_TRUE(saw_match) << "the reporter's own publications matched the test's readers";
+  reporter.report();
+  ASSERT_TRUE(status.fetch_newest());
+  EXPECT_EQ(status.newest().metrics()[0].value(), 1.0);
+  EXPECT_EQ(status.newest().metrics()[1].value(), 1.0);
 }
 
 TEST(BackgroundPublisher, WritesTheNewestAndAccountsForEverySample) {

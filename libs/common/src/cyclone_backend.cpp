@@ -176,6 +176,9 @@ class CycloneWriter final : public WriterBackend {
   }
   void assert_liveliness() override { dds_assert_liveliness(writer_); }
   int matched_readers() const override { return ctx_.matched.load(); }
+  bool wait_for_acks(std::chrono::nanoseconds timeout) override {
+    return dds_wait_for_acks(writer_, timeout.count()) == DDS_RETCODE_OK;
+  }
 
  private:
   EndpointContext ctx_;
@@ -187,12 +190,15 @@ class CycloneWriter final : public WriterBackend {
 
 class CycloneReader final : public ReaderBackend {
  public:
+  // With `raw_sink` set the reader hands over Cyclone's serialized bytes
+  // (encapsulation header included) instead of typed samples.
   CycloneReader(dds_entity_t subscriber, dds_entity_t topic, const std::string& topic_name,
                 const TypeSupport& type, const QosProfile& profile, SampleSink* sink,
-                EventLog& events)
+                EventLog& events, RawSampleSink* raw_sink = nullptr)
       : type_(type),
         fast_type_(static_cast<TopicDataType*>(type.make_fast_type())),
         sink_(sink),
+        raw_sink_(raw_sink),
         scratch_(type.new_sample()) {
     ctx_.topic = topic_name;
     ctx_.events = &events;
@@ -236,6 +242,12 @@ class CycloneReader final : public ReaderBackend {
     const std::uint32_t size = ddsi_serdata_size(&serdata);
     ddsrt_iovec_t ref{};
     ddsi_serdata* held = ddsi_serdata_to_ser_ref(&serdata, 0, size, &ref);
+    if (raw_sink_ != nullptr) {
+      raw_sink_->deliver_raw(static_cast<const std::uint8_t*>(ref.iov_base), ref.iov_len,
+                             source_time_ns);
+      ddsi_serdata_to_ser_unref(held, &ref);
+      return;
+    }
     // Borrow Cyclone's bytes for the fastcdr decoder without copying them.
     SerializedPayload_t payload;
     payload.data = static_cast<eprosima::fastrtps::rtps::octet*>(ref.iov_base);
@@ -251,6 +263,7 @@ class CycloneReader final : public ReaderBackend {
   const TypeSupport& type_;
   std::unique_ptr<TopicDataType> fast_type_;
   SampleSink* sink_;
+  RawSampleSink* raw_sink_;
   void* scratch_;
   dds_entity_t reader_ = 0;
 };
@@ -294,6 +307,15 @@ class CycloneParticipant final : public ParticipantBackend {
     return std::make_unique<CycloneReader>(subscriber_, topic, spec.topic_name, *spec.type,
                                            spec.qos, sink, events_);
   }
+
+  std::unique_ptr<ReaderBackend> create_raw_reader(const EndpointSpec& spec,
+                                                   RawSampleSink* sink) override {
+    std::lock_guard lock(mutex_);
+    const dds_entity_t topic = topic_for(spec);
+    return std::make_unique<CycloneReader>(subscriber_, topic, spec.topic_name, *spec.type,
+                                           spec.qos, nullptr, events_, sink);
+  }
+  bool raw_bytes_as_received() const override { return true; }
 
  private:
   void create_domain(const TransportConfig& config) {

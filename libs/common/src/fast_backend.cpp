@@ -1,5 +1,6 @@
 // Fast DDS 2.9 backend: the fastddsgen TopicDataTypes go straight to the
 // vendor; listeners turn its statuses into TransportEvents.
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -15,7 +16,9 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <map>
 #include <mutex>
+#include <set>
 #include <stdexcept>
+#include <vector>
 
 #include "backends.h"
 #include "fahr/common/clock.h"
@@ -26,6 +29,7 @@ namespace {
 
 namespace dds = eprosima::fastdds::dds;
 using eprosima::fastrtps::Duration_t;
+using eprosima::fastrtps::rtps::SerializedPayload_t;
 
 // Samples larger than this get a dynamically sized history instead of one
 // preallocated at the type's bound (a DeformationState's bound is 1.7 MB).
@@ -87,6 +91,61 @@ TransportEvent make_event(EventKind kind, std::string_view topic, std::uint32_t 
                     static_cast<std::int32_t>(change));
 }
 
+// A sample as its serialized bytes (raw readers).
+struct RawSample {
+  std::vector<std::uint8_t> bytes;
+};
+
+// The TopicDataType of raw readers: the same type name, size bound and key
+// as the generated type, but "deserializing" keeps the payload's bytes as
+// they arrived (encapsulation header included).
+class RawTopicType final : public dds::TopicDataType {
+ public:
+  explicit RawTopicType(const TypeSupport& type)
+      : inner_(static_cast<dds::TopicDataType*>(type.make_fast_type())) {
+    setName(type.type_name);
+    m_typeSize = inner_->m_typeSize;
+    m_isGetKeyDefined = inner_->m_isGetKeyDefined;
+  }
+  bool serialize(void* data, SerializedPayload_t* payload) override {
+    const auto& raw = static_cast<RawSample*>(data)->bytes;
+    if (payload->max_size < raw.size()) return false;
+    std::copy(raw.begin(), raw.end(), payload->data);
+    payload->length = static_cast<std::uint32_t>(raw.size());
+    payload->encapsulation = raw.size() > 1 && raw[1] == 0 ? CDR_BE : CDR_LE;
+    return true;
+  }
+  bool deserialize(SerializedPayload_t* payload, void* data) override {
+    static_cast<RawSample*>(data)->bytes.assign(payload->data, payload->data + payload->length);
+    return true;
+  }
+  std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override {
+    return
+        [data] { return static_cast<std::uint32_t>(static_cast<RawSample*>(data)->bytes.size()); };
+  }
+  void* createData() override { return new RawSample(); }
+  void deleteData(void* data) override { delete static_cast<RawSample*>(data); }
+  // Every keyed fahr type has one `@key unsigned long` right after its
+  // 36-byte SampleHeader; its instance handle is that key big-endian,
+  // zero-padded to 16 bytes, exactly what the generated getKey produces.
+  bool getKey(void* data, eprosima::fastrtps::rtps::InstanceHandle_t* handle,
+              bool /*force_md5*/) override {
+    if (!m_isGetKeyDefined) return false;
+    const auto& raw = static_cast<RawSample*>(data)->bytes;
+    constexpr std::size_t kKeyAt = 4 + 36;
+    if (raw.size() < kKeyAt + 4) return false;
+    const bool little = raw[1] != 0;
+    for (int i = 0; i < 16; ++i) handle->value[i] = 0;
+    for (int i = 0; i < 4; ++i) {
+      handle->value[i] = little ? raw[kKeyAt + 3 - i] : raw[kKeyAt + i];
+    }
+    return true;
+  }
+
+ private:
+  std::unique_ptr<dds::TopicDataType> inner_;
+};
+
 class FastWriter final : public WriterBackend, private dds::DataWriterListener {
  public:
   FastWriter(dds::Publisher& publisher, dds::Topic& topic, const QosProfile& profile,
@@ -111,6 +170,9 @@ class FastWriter final : public WriterBackend, private dds::DataWriterListener {
   }
   void assert_liveliness() override { writer_->assert_liveliness(); }
   int matched_readers() const override { return matched_.load(); }
+  bool wait_for_acks(std::chrono::nanoseconds timeout) override {
+    return writer_->wait_for_acknowledgments(to_duration(timeout)) == ReturnCode_t::RETCODE_OK;
+  }
 
  private:
   void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& s) override {
@@ -144,14 +206,18 @@ class FastWriter final : public WriterBackend, private dds::DataWriterListener {
 
 class FastReader final : public ReaderBackend, private dds::DataReaderListener {
  public:
+  // With `raw_sink` set (and `topic` of a RawTopicType) the reader hands
+  // over bytes instead of typed samples.
   FastReader(dds::Subscriber& subscriber, dds::Topic& topic, const TypeSupport& type,
-             const QosProfile& profile, std::uint32_t max_bytes, SampleSink* sink, EventLog& events)
+             const QosProfile& profile, std::uint32_t max_bytes, SampleSink* sink, EventLog& events,
+             RawSampleSink* raw_sink = nullptr)
       : subscriber_(subscriber),
         topic_name_(topic.get_name()),
         type_(type),
         sink_(sink),
+        raw_sink_(raw_sink),
         events_(events),
-        scratch_(type.new_sample()) {
+        scratch_(raw_sink != nullptr ? new RawSample() : type.new_sample()) {
     dds::DataReaderQos qos = subscriber.get_default_datareader_qos();
     apply_profile(profile, max_bytes, qos);
     reader_ = subscriber.create_datareader(&topic, qos, this, dds::StatusMask::all());
@@ -160,7 +226,11 @@ class FastReader final : public ReaderBackend, private dds::DataReaderListener {
   ~FastReader() override {
     reader_->set_listener(nullptr);
     subscriber_.delete_datareader(reader_);
-    type_.delete_sample(scratch_);
+    if (raw_sink_ != nullptr) {
+      delete static_cast<RawSample*>(scratch_);
+    } else {
+      type_.delete_sample(scratch_);
+    }
   }
   int matched_writers() const override { return matched_.load(); }
 
@@ -168,7 +238,13 @@ class FastReader final : public ReaderBackend, private dds::DataReaderListener {
   void on_data_available(dds::DataReader* reader) override {
     dds::SampleInfo info;
     while (reader->take_next_sample(scratch_, &info) == ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data) sink_->deliver(scratch_, info.source_timestamp.to_ns());
+      if (!info.valid_data) continue;
+      if (raw_sink_ != nullptr) {
+        const auto& raw = static_cast<RawSample*>(scratch_)->bytes;
+        raw_sink_->deliver_raw(raw.data(), raw.size(), info.source_timestamp.to_ns());
+      } else {
+        sink_->deliver(scratch_, info.source_timestamp.to_ns());
+      }
     }
   }
   void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& s) override {
@@ -208,6 +284,7 @@ class FastReader final : public ReaderBackend, private dds::DataReaderListener {
   std::string topic_name_;
   const TypeSupport& type_;
   SampleSink* sink_;
+  RawSampleSink* raw_sink_;
   EventLog& events_;
   void* scratch_;
   dds::DataReader* reader_ = nullptr;
@@ -267,12 +344,26 @@ class FastParticipant final : public ParticipantBackend {
                                         events_);
   }
 
+  std::unique_ptr<ReaderBackend> create_raw_reader(const EndpointSpec& spec,
+                                                   RawSampleSink* sink) override {
+    auto [topic, max_bytes] = topic_for(spec, true);
+    return std::make_unique<FastReader>(*subscriber_, *topic, *spec.type, spec.qos, max_bytes,
+                                        nullptr, events_, sink);
+  }
+  bool raw_bytes_as_received() const override { return true; }
+
  private:
-  std::pair<dds::Topic*, std::uint32_t> topic_for(const EndpointSpec& spec) {
+  std::pair<dds::Topic*, std::uint32_t> topic_for(const EndpointSpec& spec, bool raw = false) {
     std::lock_guard lock(mutex_);
     auto type_it = types_.find(spec.type->type_name);
+    if (type_it != types_.end() && raw_types_.count(spec.type->type_name) != (raw ? 1U : 0U)) {
+      throw std::runtime_error(std::string("Fast DDS participant: type ") + spec.type->type_name +
+                               " is carried both typed and raw");
+    }
     if (type_it == types_.end()) {
-      dds::TypeSupport support(static_cast<dds::TopicDataType*>(spec.type->make_fast_type()));
+      if (raw) raw_types_.insert(spec.type->type_name);
+      dds::TypeSupport support(raw ? static_cast<dds::TopicDataType*>(new RawTopicType(*spec.type))
+                                   : static_cast<dds::TopicDataType*>(spec.type->make_fast_type()));
       if (support.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
         throw std::runtime_error(std::string("Fast DDS refused type ") + spec.type->type_name);
       }
@@ -294,6 +385,7 @@ class FastParticipant final : public ParticipantBackend {
   dds::Subscriber* subscriber_ = nullptr;
   std::mutex mutex_;
   std::map<std::string, dds::TypeSupport> types_;
+  std::set<std::string> raw_types_;
   std::map<std::string, dds::Topic*> topics_;
 };
 

@@ -42,6 +42,22 @@ Participant::Participant(const TransportConfig& config)
 
 Participant::~Participant() = default;
 
+std::atomic<std::uint64_t>& Participant::sent_counter(std::string_view topic) {
+  std::lock_guard lock(sent_mutex_);
+  for (auto& [name, count] : sent_) {
+    if (name == topic) return count;
+  }
+  auto& entry = sent_.emplace_back(std::piecewise_construct, std::forward_as_tuple(topic),
+                                   std::forward_as_tuple(0));
+  return entry.second;
+}
+
+void Participant::for_each_sent(
+    const std::function<void(std::string_view topic, std::uint64_t sent)>& fn) {
+  std::lock_guard lock(sent_mutex_);
+  for (const auto& [name, count] : sent_) fn(name, count.load(std::memory_order_relaxed));
+}
+
 }  // namespace fahr::common
 
 #if defined(FAHR_SANITIZE_BUILD)

@@ -66,6 +66,10 @@ ServiceReporter::~ServiceReporter() {
   }
   stop_cv_.notify_all();
   thread_.join();
+  // The last reports must reach a recorder before the writers go: a
+  // reliable sample still unacknowledged at deletion is lost.
+  status_.wait_for_acks(std::chrono::milliseconds(500));
+  events_.wait_for_acks(std::chrono::milliseconds(500));
 }
 
 void ServiceReporter::run() {
@@ -128,9 +132,14 @@ void ServiceReporter::report() {
   status.late_periods(late_periods_);
   status.period(duration_stats(periods_));
   status.tick_cpu(duration_stats(cpus_));
-  if (metrics_) {
+  {
+    // Each writer's sent count first ("sent <topic>"), so the bound never
+    // cuts them; then the service's own figures.
     std::vector<std::pair<std::string, double>> figures;
-    metrics_(figures);
+    participant_.for_each_sent([&](std::string_view topic, std::uint64_t sent) {
+      figures.emplace_back("sent " + std::string(topic), static_cast<double>(sent));
+    });
+    if (metrics_) metrics_(figures);
     for (const auto& [name, value] : figures) {
       if (status.metrics().size() >= kMaxMetrics) break;
       msg::Metric metric;

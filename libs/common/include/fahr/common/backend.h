@@ -2,6 +2,8 @@
 // Services never see this; Publisher<T> and Subscriber<T> sit on top of it.
 #pragma once
 
+#include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -36,6 +38,15 @@ class SampleSink {
   virtual void deliver(const void* sample, std::int64_t source_time_ns) = 0;
 };
 
+// Receives a sample's serialized bytes (XCDR1, with the 4-byte encapsulation
+// header) on a vendor thread; `data` is only valid during the call.
+class RawSampleSink {
+ public:
+  virtual ~RawSampleSink() = default;
+  virtual void deliver_raw(const std::uint8_t* data, std::size_t size,
+                           std::int64_t source_time_ns) = 0;
+};
+
 class WriterBackend {
  public:
   virtual ~WriterBackend() = default;
@@ -43,6 +54,9 @@ class WriterBackend {
   virtual bool write(const void* sample, std::int64_t source_time_ns) = 0;
   virtual void assert_liveliness() = 0;
   virtual int matched_readers() const = 0;
+  // Reliable writers: blocks until every matched reader acknowledged every
+  // sample, or the timeout passes; true if they did.
+  virtual bool wait_for_acks(std::chrono::nanoseconds /*timeout*/) { return true; }
 };
 
 class ReaderBackend {
@@ -64,6 +78,14 @@ class ParticipantBackend {
   // `sink` must outlive the returned reader.
   virtual std::unique_ptr<ReaderBackend> create_reader(const EndpointSpec& spec,
                                                        SampleSink* sink) = 0;
+  // A reader of serialized samples (for recorders). This default takes
+  // typed samples and serializes them again with the fastddsgen type; Fast
+  // DDS and Cyclone override it to hand over the bytes as they arrived. A
+  // participant carries a type either typed or raw, not both.
+  virtual std::unique_ptr<ReaderBackend> create_raw_reader(const EndpointSpec& spec,
+                                                           RawSampleSink* sink);
+  // True if create_raw_reader hands over the bytes as they arrived.
+  virtual bool raw_bytes_as_received() const { return false; }
 };
 
 template <class T>

@@ -2,8 +2,15 @@
 // service in an in-process run). Owns the vendor backend and the events.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <deque>
+#include <functional>
 #include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <utility>
 
 #include "fahr/common/backend.h"
 #include "fahr/common/transport_config.h"
@@ -27,11 +34,21 @@ class Participant {
   EventLog& events() { return *events_; }
   detail::ParticipantBackend& backend() { return *backend_; }
 
+  // Samples this participant's writer of `topic` has sent: its last
+  // sequence number (Publisher keeps it). The status reporter publishes
+  // each as the metric "sent <topic>", so a recorder can check that
+  // recorded + lost = sent for every writer. The reference stays valid for
+  // the participant's life, after the publisher is gone.
+  std::atomic<std::uint64_t>& sent_counter(std::string_view topic);
+  void for_each_sent(const std::function<void(std::string_view topic, std::uint64_t sent)>& fn);
+
  private:
   TransportConfig config_;
   std::uint32_t writer_id_;
   std::unique_ptr<EventLog> events_;
   std::unique_ptr<detail::ParticipantBackend> backend_;
+  std::mutex sent_mutex_;
+  std::deque<std::pair<std::string, std::atomic<std::uint64_t>>> sent_;
 };
 
 }  // namespace fahr::common

@@ -3,6 +3,8 @@
 // itself, so a 1 kHz loop may call it.
 #pragma once
 
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -20,7 +22,7 @@ class Publisher {
   explicit Publisher(Participant& participant,
                      QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole),
                      std::string_view topic_name = TopicTraits<T>::kName)
-      : writer_id_(participant.writer_id()) {
+      : writer_id_(participant.writer_id()), sent_(&participant.sent_counter(topic_name)) {
     detail::EndpointSpec spec{&detail::type_support<T>(), std::string(topic_name), qos};
     writer_ = participant.backend().create_writer(spec);
   }
@@ -30,6 +32,7 @@ class Publisher {
   bool write(T& sample) {
     auto& header = sample.header();
     header.seq(++seq_);
+    sent_->store(seq_, std::memory_order_relaxed);
     header.writer_id(writer_id_);
     const std::int64_t now_ns = wall_now_ns();
     header.source_time_ns(now_ns);
@@ -37,12 +40,16 @@ class Publisher {
   }
 
   void assert_liveliness() { writer_->assert_liveliness(); }
+  // Reliable topics: waits until every matched reader has every sample
+  // (before a shutdown, so the last reports reach a recorder); true if so.
+  bool wait_for_acks(std::chrono::nanoseconds timeout) { return writer_->wait_for_acks(timeout); }
   int matched_readers() const { return writer_->matched_readers(); }
   std::uint64_t last_seq() const { return seq_; }
 
  private:
   std::uint32_t writer_id_;
   std::uint64_t seq_ = 0;
+  std::atomic<std::uint64_t>* sent_;
   std::unique_ptr<detail::WriterBackend> writer_;
 };
 

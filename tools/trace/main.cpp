@@ -1,0 +1,370 @@
+// fahr_trace: turns a fahr recording (fahr_logger's MCAP) into Chrome trace
+// JSON that Perfetto and chrome://tracing open, and prints the whole run's
+// latency figures (every tick, not a report window).
+//
+//   fahr_trace FILE.mcap [-o trace.json]
+//
+// Tracks: one process per service (from ServiceEvents), a "tick" thread of
+// slices from its tick spans (wall start and duration; args: CPU time),
+// a "samples" thread with one short slice per DevicePose (gateway) and
+// ForceCommand (haptic) at its source time. Flows follow each answered
+// DevicePose: its slice -> the haptic tick that wrote the ForceCommand ->
+// the ForceCommand -> the first gateway servo tick that started after the
+// command reached the recorder (the recorder's receive time stands in for
+// the gateway's, which is not recorded). Counters: motion-to-force latency,
+// each topic's receive minus source time, the services' measured rates and
+// late periods.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "device_posePubSubTypes.h"
+#include "fahr/mcap/reader.h"
+#include "force_commandPubSubTypes.h"
+#include "service_statusPubSubTypes.h"
+
+namespace fahr {
+namespace {
+
+using eprosima::fastrtps::rtps::SerializedPayload_t;
+
+template <class T, class PubSub>
+bool decode(const mcap::MessageView& m, T& out) {
+  PubSub type;
+  SerializedPayload_t payload;
+  payload.data = const_cast<std::uint8_t*>(m.data.data());
+  payload.length = static_cast<std::uint32_t>(m.data.size());
+  payload.max_size = payload.length;
+  const bool ok = type.deserialize(&payload, &out);
+  payload.data = nullptr;  // borrowed
+  return ok;
+}
+
+struct Tick {
+  std::int64_t start_ns, duration_ns, cpu_ns;
+  std::uint64_t tick;
+};
+
+struct Service {
+  std::string name;
+  int pid = 0;
+  std::vector<Tick> ticks;  // sorted by start
+};
+
+struct Pose {
+  std::int64_t source_ns = 0;
+};
+
+struct Command {
+  std::uint64_t pose_seq = 0;
+  std::int64_t source_ns = 0, log_ns = 0;
+  std::uint32_t writer_id = 0;
+};
+
+struct Percentiles {
+  std::size_t n = 0;
+  double p50 = 0, p99 = 0, p999 = 0, max = 0, mean = 0, stddev = 0;
+};
+
+Percentiles percentiles(std::vector<double> v) {
+  Percentiles p;
+  if (v.empty()) return p;
+  std::sort(v.begin(), v.end());
+  auto at = [&](double q) {
+    return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+  };
+  p.n = v.size();
+  p.p50 = at(0.5);
+  p.p99 = at(0.99);
+  p.p999 = at(0.999);
+  p.max = v.back();
+  double sum = 0, sq = 0;
+  for (double x : v) sum += x;
+  p.mean = sum / static_cast<double>(v.size());
+  for (double x : v) sq += (x - p.mean) * (x - p.mean);
+  p.stddev = std::sqrt(sq / static_cast<double>(v.size()));
+  return p;
+}
+
+// Chrome trace JSON, written as it goes (one event per line).
+class TraceWriter {
+ public:
+  explicit TraceWriter(const std::string& path) : out_(path) {
+    out_ << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
+  }
+  ~TraceWriter() { out_ << "\n]}\n"; }
+  bool ok() const { return static_cast<bool>(out_); }
+  void raw(const std::string& event) {
+    if (count_++ > 0) out_ << ",\n";
+    out_ << event;
+  }
+  // Microseconds relative to the first event, with ns resolution.
+  std::string ts(std::int64_t ns) const {
+    char text[40];
+    std::snprintf(text, sizeof(text), "%.3f", static_cast<double>(ns - origin_ns) * 1e-3);
+    return text;
+  }
+  std::int64_t origin_ns = 0;
+  std::size_t count() const { return count_; }
+
+ private:
+  std::ofstream out_;
+  std::size_t count_ = 0;
+};
+
+std::string quoted(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"fahr_trace: a recording as a Chrome trace, and its latency figures"};
+  std::string path, output;
+  app.add_option("file", path, "fahr recording (MCAP)")->required();
+  app.add_option("-o,--output", output, "trace JSON (default: FILE with .trace.json)");
+  CLI11_PARSE(app, argc, argv);
+  if (output.empty()) output = path + ".trace.json";
+  const bool tty = isatty(STDERR_FILENO) != 0;
+
+  // One pass over the file: what the trace and the figures need.
+  std::map<std::uint32_t, Service> services;  // by writer_id
+  std::map<std::uint64_t, Pose> poses;        // by seq (one gateway)
+  std::uint32_t gateway_id = 0;
+  std::vector<Command> commands;
+  std::map<std::string, std::vector<double>> topic_latency_ms;
+  std::map<std::uint32_t, std::vector<std::pair<std::int64_t, double>>> late_periods;
+  std::map<std::uint32_t, std::vector<std::pair<std::int64_t, double>>> rates;
+  std::vector<std::int64_t> pose_times;
+  std::uint64_t seen = 0;
+  msg::ServiceEvents events;
+  msg::ServiceStatus status;
+  msg::DevicePose pose;
+  msg::ForceCommand command;
+  const auto report = mcap::read_file(path, [&](const mcap::Channel& c,
+                                                const mcap::MessageView& m) {
+    if (tty && ++seen % 20000 == 0) {
+      std::fprintf(stderr, "\rfahr_trace: %llu messages read",
+                   static_cast<unsigned long long>(seen));
+    }
+    topic_latency_ms[c.topic].push_back(
+        (static_cast<double>(m.log_time) - static_cast<double>(m.publish_time)) * 1e-6);
+    if (c.topic == "fahr/ServiceEvents") {
+      if (!decode<msg::ServiceEvents, msg::ServiceEventsPubSubType>(m, events)) return;
+      auto& s = services[events.header().writer_id()];
+      s.name = events.service_name().to_string();
+      for (const auto& span : events.tick_spans()) {
+        s.ticks.push_back({span.start_ns(), span.duration_ns(), span.cpu_ns(), span.tick()});
+      }
+    } else if (c.topic == "fahr/ServiceStatus") {
+      if (!decode<msg::ServiceStatus, msg::ServiceStatusPubSubType>(m, status)) return;
+      const auto id = status.header().writer_id();
+      rates[id].emplace_back(static_cast<std::int64_t>(m.publish_time), status.measured_rate_hz());
+      late_periods[id].emplace_back(static_cast<std::int64_t>(m.publish_time),
+                                    static_cast<double>(status.late_periods()));
+    } else if (c.topic == "fahr/DevicePose") {
+      if (!decode<msg::DevicePose, msg::DevicePosePubSubType>(m, pose)) return;
+      gateway_id = pose.header().writer_id();
+      poses[pose.header().seq()] = {pose.header().source_time_ns()};
+      pose_times.push_back(pose.header().source_time_ns());
+    } else if (c.topic == "fahr/ForceCommand") {
+      if (!decode<msg::ForceCommand, msg::ForceCommandPubSubType>(m, command)) return;
+      commands.push_back({command.answered_pose_seq(), command.header().source_time_ns(),
+                          static_cast<std::int64_t>(m.log_time), command.header().writer_id()});
+    }
+  });
+  if (tty)
+    std::fprintf(stderr, "\rfahr_trace: %llu messages read\n",
+                 static_cast<unsigned long long>(report.messages));
+  if (report.messages == 0) {
+    std::fprintf(stderr, "fahr_trace: %s: no messages (%s)\n", path.c_str(), report.error.c_str());
+    return 1;
+  }
+  if (!report.valid()) {
+    std::fprintf(stderr, "fahr_trace: warning: %s is not a valid file (%s); using what was read\n",
+                 path.c_str(), report.error.c_str());
+  }
+  int next_pid = 1;
+  std::int64_t origin = INT64_MAX;
+  for (auto& [id, s] : services) {
+    s.pid = next_pid++;
+    std::sort(s.ticks.begin(), s.ticks.end(),
+              [](const Tick& a, const Tick& b) { return a.start_ns < b.start_ns; });
+    if (!s.ticks.empty()) origin = std::min(origin, s.ticks.front().start_ns);
+  }
+  if (!pose_times.empty()) origin = std::min(origin, pose_times.front());
+  if (origin == INT64_MAX) origin = 0;
+
+  TraceWriter trace(output);
+  if (!trace.ok()) {
+    std::fprintf(stderr, "fahr_trace: cannot write %s\n", output.c_str());
+    return 1;
+  }
+  trace.origin_ns = origin;
+  auto pid_of = [&](std::uint32_t writer) {
+    auto it = services.find(writer);
+    return it == services.end() ? 0 : it->second.pid;
+  };
+  // Tracks.
+  for (const auto& [id, s] : services) {
+    trace.raw("{\"ph\":\"M\",\"name\":\"process_name\",\"pid\":" + std::to_string(s.pid) +
+              ",\"args\":{\"name\":" + quoted(s.name + " (" + std::to_string(id) + ")") + "}}");
+    trace.raw("{\"ph\":\"M\",\"name\":\"thread_name\",\"pid\":" + std::to_string(s.pid) +
+              ",\"tid\":1,\"args\":{\"name\":\"tick\"}}");
+    trace.raw("{\"ph\":\"M\",\"name\":\"thread_name\",\"pid\":" + std::to_string(s.pid) +
+              ",\"tid\":2,\"args\":{\"name\":\"samples\"}}");
+    for (const auto& t : s.ticks) {
+      trace.raw("{\"ph\":\"X\",\"name\":\"tick\",\"pid\":" + std::to_string(s.pid) +
+                ",\"tid\":1,\"ts\":" + trace.ts(t.start_ns) +
+                ",\"dur\":" + std::to_string(static_cast<double>(t.duration_ns) * 1e-3) +
+                ",\"args\":{\"tick\":" + std::to_string(t.tick) +
+                ",\"cpu_us\":" + std::to_string(static_cast<double>(t.cpu_ns) * 1e-3) + "}}");
+    }
+  }
+  // The tick of a service that contains a time (or 0 if none).
+  auto tick_at = [&](std::uint32_t writer, std::int64_t ns) -> const Tick* {
+    auto it = services.find(writer);
+    if (it == services.end()) return nullptr;
+    const auto& ticks = it->second.ticks;
+    auto after = std::upper_bound(ticks.begin(), ticks.end(), ns,
+                                  [](std::int64_t v, const Tick& t) { return v < t.start_ns; });
+    if (after == ticks.begin()) return nullptr;
+    const Tick& t = *(after - 1);
+    return ns <= t.start_ns + t.duration_ns ? &t : nullptr;
+  };
+  auto tick_after = [&](std::uint32_t writer, std::int64_t ns) -> const Tick* {
+    auto it = services.find(writer);
+    if (it == services.end()) return nullptr;
+    const auto& ticks = it->second.ticks;
+    auto after = std::upper_bound(ticks.begin(), ticks.end(), ns,
+                                  [](std::int64_t v, const Tick& t) { return v < t.start_ns; });
+    return after == ticks.end() ? nullptr : &*after;
+  };
+  // Samples, flows and motion-to-force latency.
+  const int gateway_pid = pid_of(gateway_id);
+  std::vector<double> motion_to_force_ms, motion_to_render_ms;
+  std::size_t flows = 0;
+  for (const auto& c : commands) {
+    auto p = poses.find(c.pose_seq);
+    if (p == poses.end()) continue;
+    const double latency_ms = static_cast<double>(c.source_ns - p->second.source_ns) * 1e-6;
+    motion_to_force_ms.push_back(latency_ms);
+    const int haptic_pid = pid_of(c.writer_id);
+    if (gateway_pid == 0 || haptic_pid == 0) continue;
+    const std::string id = std::to_string(c.pose_seq);
+    trace.raw("{\"ph\":\"X\",\"name\":\"DevicePose " + id +
+              "\",\"pid\":" + std::to_string(gateway_pid) +
+              ",\"tid\":2,\"ts\":" + trace.ts(p->second.source_ns) + ",\"dur\":1}");
+    trace.raw("{\"ph\":\"s\",\"name\":\"pose\",\"cat\":\"flow\",\"id\":" + id +
+              ",\"pid\":" + std::to_string(gateway_pid) +
+              ",\"tid\":2,\"ts\":" + trace.ts(p->second.source_ns) + "}");
+    if (const Tick* t = tick_at(c.writer_id, c.source_ns)) {
+      trace.raw("{\"ph\":\"t\",\"name\":\"pose\",\"cat\":\"flow\",\"id\":" + id +
+                ",\"pid\":" + std::to_string(haptic_pid) +
+                ",\"tid\":1,\"ts\":" + trace.ts(std::max(t->start_ns, p->second.source_ns)) + "}");
+    }
+    trace.raw("{\"ph\":\"X\",\"name\":\"ForceCommand " + id + "\",\"pid\":" +
+              std::to_string(haptic_pid) + ",\"tid\":2,\"ts\":" + trace.ts(c.source_ns) +
+              ",\"dur\":1,\"args\":{\"motion_to_force_ms\":" + std::to_string(latency_ms) + "}}");
+    trace.raw("{\"ph\":\"t\",\"name\":\"pose\",\"cat\":\"flow\",\"id\":" + id + ",\"pid\":" +
+              std::to_string(haptic_pid) + ",\"tid\":2,\"ts\":" + trace.ts(c.source_ns) + "}");
+    if (const Tick* servo = tick_after(gateway_id, std::max(c.log_ns, c.source_ns))) {
+      trace.raw("{\"ph\":\"f\",\"bp\":\"e\",\"name\":\"pose\",\"cat\":\"flow\",\"id\":" + id +
+                ",\"pid\":" + std::to_string(gateway_pid) +
+                ",\"tid\":1,\"ts\":" + trace.ts(servo->start_ns) + "}");
+      ++flows;
+      motion_to_render_ms.push_back(static_cast<double>(servo->start_ns - p->second.source_ns) *
+                                    1e-6);
+    }
+    trace.raw("{\"ph\":\"C\",\"name\":\"motion_to_force_ms\",\"pid\":" +
+              std::to_string(haptic_pid) + ",\"ts\":" + trace.ts(c.source_ns) +
+              ",\"args\":{\"ms\":" + std::to_string(latency_ms) + "}}");
+  }
+  for (const auto& [id, series] : rates) {
+    const int pid = pid_of(id);
+    if (pid == 0) continue;
+    for (const auto& [ns, hz] : series) {
+      trace.raw("{\"ph\":\"C\",\"name\":\"measured_rate_hz\",\"pid\":" + std::to_string(pid) +
+                ",\"ts\":" + trace.ts(ns) + ",\"args\":{\"hz\":" + std::to_string(hz) + "}}");
+    }
+    for (const auto& [ns, late] : late_periods[id]) {
+      trace.raw("{\"ph\":\"C\",\"name\":\"late_periods\",\"pid\":" + std::to_string(pid) +
+                ",\"ts\":" + trace.ts(ns) + ",\"args\":{\"total\":" + std::to_string(late) + "}}");
+    }
+  }
+
+  // The whole run's figures.
+  std::printf("fahr_trace: %s -> %s (%zu events, %zu flows)\n", path.c_str(), output.c_str(),
+              trace.count(), flows);
+  const auto m2f = percentiles(motion_to_force_ms);
+  const auto m2r = percentiles(motion_to_render_ms);
+  std::printf("\nmotion-to-force latency over every answered DevicePose:\n");
+  std::printf(
+      "  pose written -> ForceCommand written:      n %zu  p50 %.3f ms  p99 %.3f ms  "
+      "p99.9 %.3f ms  max %.3f ms\n",
+      m2f.n, m2f.p50, m2f.p99, m2f.p999, m2f.max);
+  std::printf(
+      "  pose written -> servo tick rendering it:  n %zu  p50 %.3f ms  p99 %.3f ms  "
+      "p99.9 %.3f ms  max %.3f ms (approx.)\n",
+      m2r.n, m2r.p50, m2r.p99, m2r.p999, m2r.max);
+  std::printf("\nper topic: recorder receive time - writer source time (same host: one clock)\n");
+  std::printf("  %-24s %9s %9s %9s %9s %9s\n", "topic", "n", "p50 ms", "p99 ms", "p99.9 ms",
+              "max ms");
+  for (const auto& [topic, v] : topic_latency_ms) {
+    const auto p = percentiles(v);
+    std::printf("  %-24s %9zu %9.3f %9.3f %9.3f %9.3f\n", topic.c_str(), p.n, p.p50, p.p99, p.p999,
+                p.max);
+  }
+  if (pose_times.size() > 2) {
+    std::vector<double> periods;
+    for (std::size_t i = 1; i < pose_times.size(); ++i) {
+      periods.push_back(static_cast<double>(pose_times[i] - pose_times[i - 1]) * 1e-6);
+    }
+    const auto p = percentiles(periods);
+    std::printf(
+        "\nDevicePose period (jitter): mean %.3f ms, std %.3f ms, p99 %.3f ms, max %.3f ms\n",
+        p.mean, p.stddev, p.p99, p.max);
+  }
+  std::printf(
+      "\nper service: ticks recorded, late periods (its own count), tick wall / CPU p99.9\n");
+  for (const auto& [id, s] : services) {
+    std::vector<double> wall, cpu;
+    for (const auto& t : s.ticks) {
+      wall.push_back(static_cast<double>(t.duration_ns) * 1e-3);
+      cpu.push_back(static_cast<double>(t.cpu_ns) * 1e-3);
+    }
+    const double late = late_periods[id].empty() ? 0 : late_periods[id].back().second;
+    std::printf("  %-16s ticks %8zu  late periods %6.0f  wall p99.9 %8.1f us  CPU p99.9 %8.1f us\n",
+                s.name.c_str(), s.ticks.size(), late, percentiles(wall).p999,
+                percentiles(cpu).p999);
+  }
+  for (const auto& m : report.metadata) {
+    if (m.name != "fahr_recording_loss") continue;
+    std::printf("\nloss per writer (sent recorded gaps drops skipped gaps-before-match):\n");
+    for (const auto& [k, v] : m.values) std::printf("  %-36s %s\n", k.c_str(), v.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace fahr
+
+int main(int argc, char** argv) {
+  try {
+    return fahr::run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fahr_trace: %s\n", e.what());
+    return 1;
+  }
+}
