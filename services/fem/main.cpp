@@ -52,11 +52,8 @@ int run(int argc, char** argv) {
            ? std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period())
            : 250ms},
       recorder, [&](auto& metrics) { fem_step.metrics(metrics); },
-      [&](auto& errors) {
-        // Refused ContactSets: said here, off the step, once per change.
-        if (std::string error = fem_step.layout_check().take_error(); !error.empty())
-          errors.push_back(std::move(error));
-      });
+      // Refused ContactSets, failed solves, resets: said here, off the step.
+      [&](auto& errors) { fem_step.take_errors(errors); });
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // launchers wait for the start line
   print_start_line(participant, setup, *scene, lockstep);
 

@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "contact_set.h"
 #include "fahr/fem_service/fem_body_setup.h"
@@ -140,6 +142,47 @@ TEST(LayoutRefusal, AnotherLayoutIsRefusedWithBothFingerprintsAndItsOwnIsApplied
   const std::string third = step.layout_check().take_error();
   EXPECT_NE(third.find(hex(theirs + 1)), std::string::npos) << third;
   EXPECT_EQ(step.layout_check().refused(), 6u);
+}
+
+// A set with a non-finite number anywhere the FEM would read it is refused
+// whole and counted; one error sentence per report says so; a finite set
+// after it is applied.
+TEST(NonFiniteRefusal, ASetWithANonFiniteNumberIsNeverUsed) {
+  StillTongue tongue;
+  FemBodySetup& setup = tongue.setup;
+  ServiceStep step(setup);
+  const std::uint64_t ours = setup.layout_fingerprint;
+  const std::uint32_t sphere = top_sphere(setup);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<msg::ContactSet> bad(6, pressing_set(setup, sphere, ours));
+  bad[0].contacts()[0].normal().x(nan);
+  bad[1].contacts()[0].point_m().z(inf);
+  bad[2].contacts()[0].force_n(nan);
+  bad[3].contacts()[0].penetration_m(-inf);
+  bad[4].contacts()[0].hold_centre_m().y(nan);
+  bad[5].world_from_tool().orientation().w(nan);
+  std::uint64_t seq = 1;
+  for (const msg::ContactSet& set : bad) {
+    step.take(set, seq++);
+    step.step();
+    EXPECT_FALSE(step.last_report().contacts_applied) << "set " << seq - 1;
+    EXPECT_EQ(step.state().applied_contact_seq(), 0u);
+  }
+  EXPECT_LT(largest_motion_m(setup), 1e-9) << "a refused set moved the body";
+  EXPECT_EQ(step.non_finite_sets(), bad.size());
+  std::vector<std::string> errors;
+  step.take_errors(errors);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("non-finite"), std::string::npos) << errors[0];
+  errors.clear();
+  step.take_errors(errors);
+  EXPECT_TRUE(errors.empty()) << "said twice";
+
+  step.take(pressing_set(setup, sphere, ours), seq);
+  step.step();
+  EXPECT_TRUE(step.last_report().contacts_applied);
+  EXPECT_EQ(step.non_finite_sets(), bad.size());
 }
 
 TEST(LayoutRefusal, TheErrorIsOneSentenceNamingBothInHex) {

@@ -236,6 +236,22 @@ TEST(TissueDigest, RefusesStatesThatDoNotFit) {
   EXPECT_TRUE(digest.digest(state, snapshot));
   state.positions_m()[7] = std::numeric_limits<float>::quiet_NaN();
   EXPECT_FALSE(digest.digest(state, snapshot));
+  state.positions_m()[7] = static_cast<float>(setup.mesh.rest_positions()[2].y());
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  // A non-finite W, W normal or free centre: the state is refused whole.
+  state.compliance_sphere_ids().assign({3, 4});
+  state.compliance_mpn().assign(36, 0.01f);
+  ASSERT_TRUE(digest.digest(state, snapshot));
+  state.compliance_mpn()[17] = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(digest.digest(state, snapshot));
+  state.compliance_mpn()[17] = 0.01f;
+  state.compliance_free_centres_m().assign(6, 0.0f);
+  state.compliance_free_centres_m()[4] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(digest.digest(state, snapshot));
+  state.compliance_free_centres_m().clear();
+  state.compliance_normals().assign(6, std::numeric_limits<float>::quiet_NaN());
+  state.compliance_mpn().assign(12, 0.01f);
+  EXPECT_FALSE(digest.digest(state, snapshot));
 }
 
 // A DeformationState with the body at rest and no compliance yet.

@@ -2,6 +2,7 @@
 #include "fahr/fem_service/contact_conversion.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "fahr/common/wire_eigen.h"
 
@@ -28,6 +29,20 @@ void to_fem(const msg::ContactSet& wire, fem::ContactSet& out) {
     c.penetration_m = w.penetration_m();
     c.force_n = w.force_n();
   }
+}
+
+bool all_finite(const msg::ContactSet& wire) {
+  for (const auto& w : wire.contacts()) {
+    if (!to_eigen(w.point_m()).allFinite() || !to_eigen(w.normal()).allFinite() ||
+        !to_eigen(w.hold_centre_m()).allFinite() || !std::isfinite(w.penetration_m()) ||
+        !std::isfinite(w.force_n())) {
+      return false;
+    }
+  }
+  const auto& pose = wire.world_from_tool();
+  const auto& q = pose.orientation();
+  return to_eigen(pose.position_m()).allFinite() && std::isfinite(q.w()) && std::isfinite(q.x()) &&
+         std::isfinite(q.y()) && std::isfinite(q.z());
 }
 
 void fill_state(const fem::Body& body, std::uint32_t body_id, msg::DeformationState& out) {

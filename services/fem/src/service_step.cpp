@@ -3,6 +3,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cstdio>
 
 #include "fahr/fem_service/contact_conversion.h"
 
@@ -45,6 +46,12 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
 }
 
 void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
+  if (!all_finite(wire)) {
+    // Never used, nor the set before it (which it supersedes).
+    non_finite_sets_.fetch_add(1, std::memory_order_relaxed);
+    have_contacts_ = false;
+    return;
+  }
   if (!layout_check_.accept(wire.layout_fingerprint())) {
     // Its sphere ids name other spheres: nothing of it is applied, nor the
     // set before it (which it supersedes).
@@ -65,7 +72,11 @@ void ServiceStep::step() {
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
   inverted_max_ = std::max<std::uint64_t>(
       inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
-  if (last_report_.diverged_reset) ++divergence_resets_;
+  if (last_report_.diverged_reset) {
+    ++divergence_resets_;
+    resets_.fetch_add(1, std::memory_order_relaxed);
+  }
+  if (last_report_.solve_failed) failed_solves_.fetch_add(1, std::memory_order_relaxed);
   if (last_report_.refactorised) ++refactorisations_;
   anatomy_returned_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_returned);
   anatomy_beyond_steps_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_beyond);
@@ -97,9 +108,36 @@ void ServiceStep::fill_compliance() {
   }
 }
 
+void ServiceStep::take_errors(std::vector<std::string>& errors) {
+  if (std::string error = layout_check_.take_error(); !error.empty())
+    errors.push_back(std::move(error));
+  const auto say = [&](const std::atomic<std::uint64_t>& count, std::uint64_t& said,
+                       const char* what) {
+    const std::uint64_t now = count.load(std::memory_order_relaxed);
+    if (now == said) return;
+    char text[200];
+    std::snprintf(text, sizeof(text), "%s (%llu since the last report, %llu since start)", what,
+                  static_cast<unsigned long long>(now - said),
+                  static_cast<unsigned long long>(now));
+    said = now;
+    errors.emplace_back(text);
+  };
+  say(non_finite_sets_, non_finite_said_,
+      "ContactSet refused: a non-finite number in a contact or the tool's pose; its contacts "
+      "are not applied");
+  say(failed_solves_, failed_said_,
+      "FEM linear solve failed or gave a non-finite velocity: the step kept the positions with "
+      "zero velocity");
+  say(resets_, resets_said_,
+      "FEM body diverged (a node non-finite or farther from rest than twice the body's size) "
+      "and was reset to rest");
+}
+
 void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) const {
   out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets_));
   out.emplace_back("layout_refused_sets", static_cast<double>(layout_check_.refused()));
+  out.emplace_back("non_finite_contact_sets", static_cast<double>(non_finite_sets()));
+  out.emplace_back("failed_solves", static_cast<double>(failed_solves()));
   out.emplace_back("compliance_reuses", static_cast<double>(contact_step_.compliance_reuses()));
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));
   out.emplace_back("divergence_resets", static_cast<double>(divergence_resets_));

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace fahr::haptic_service {
 namespace {
@@ -88,6 +89,15 @@ bool TissueDigest::digest(const msg::DeformationState& state, TissueSnapshot& ou
   const auto start = std::chrono::steady_clock::now();
   const auto& x = state.positions_m();
   if (x.size() != positions_m_.size()) return false;
+  // A non-finite compliance or free centre is never used: the whole state
+  // is refused (counted as a bad state), as for a non-finite position.
+  const auto finite = [](const auto& values) {
+    return std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); });
+  };
+  if (!finite(state.compliance_mpn()) || !finite(state.compliance_normals()) ||
+      !finite(state.compliance_free_centres_m())) {
+    return false;
+  }
   for (std::size_t i = 0; i < x.size(); ++i) positions_m_[i] = static_cast<double>(x[i]);
   if (!out.spheres.update(setup_.layout, positions_m_)) return false;  // a NaN from the FEM
   out.tree.refit(out.spheres);

@@ -14,6 +14,11 @@ namespace fahr::fem_service {
 
 void to_fem(const msg::ContactSet& wire, fem::ContactSet& out);
 
+// True if every number of the set the FEM would use is finite: each
+// contact's point, normal, hold centre, penetration and force, and the
+// tool's pose. A set that is not is refused whole (ServiceStep::take).
+bool all_finite(const msg::ContactSet& wire);
+
 void fill_state(const fem::Body& body, std::uint32_t body_id, msg::DeformationState& out);
 
 }  // namespace fahr::fem_service

@@ -8,6 +8,7 @@
 // containers have reached their largest size.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -31,6 +32,8 @@ class ServiceStep {
   // next one (a set older than the body's max_contact_age_steps is ignored).
   // A set of another sphere layout than the body's (layout_check.h) is
   // refused: the steps until the next set apply no contacts.
+  // A set with a non-finite number (all_finite) is refused and counted the
+  // same way: nothing of it is used.
   void take(const msg::ContactSet& wire, std::uint64_t seq);
 
   // One FEM step and the DeformationState that reports it (the header is
@@ -58,6 +61,16 @@ class ServiceStep {
   std::uint64_t anatomy_returned() const { return anatomy_returned_; }
   std::uint64_t anatomy_beyond_steps() const { return anatomy_beyond_steps_; }
 
+  // ContactSets refused for a non-finite number, and steps whose linear
+  // solve failed or gave a non-finite velocity (the body then kept its
+  // positions with zero velocity, fem::StepReport::solve_failed).
+  std::uint64_t non_finite_sets() const { return non_finite_sets_.load(std::memory_order_relaxed); }
+  std::uint64_t failed_solves() const { return failed_solves_.load(std::memory_order_relaxed); }
+  // What went wrong since the last call, one sentence per kind (a layout
+  // refused, sets with non-finite numbers, failed solves, resets after
+  // divergence), for the service's ServiceEvents; called off the step.
+  void take_errors(std::vector<std::string>& errors);
+
   // The service's own ServiceStatus metrics.
   void metrics(std::vector<std::pair<std::string, double>>& out) const;
 
@@ -75,6 +88,13 @@ class ServiceStep {
   std::uint64_t inverted_max_ = 0;
   std::uint64_t divergence_resets_ = 0;
   std::uint64_t refactorisations_ = 0;
+  std::atomic<std::uint64_t> non_finite_sets_{0};
+  std::atomic<std::uint64_t> failed_solves_{0};
+  std::atomic<std::uint64_t> resets_{0};
+  // What take_errors() has said so far (its caller's thread only).
+  std::uint64_t non_finite_said_ = 0;
+  std::uint64_t failed_said_ = 0;
+  std::uint64_t resets_said_ = 0;
   std::uint64_t anatomy_returned_ = 0;
   std::uint64_t anatomy_beyond_steps_ = 0;
   double anatomy_depth_max_m_ = 0.0;
