@@ -177,6 +177,61 @@ TEST(HapticLoop, EmbeddedStartStaysBounded) {
   EXPECT_LT(largest_jump, 10e-3);
 }
 
+// Presses the blade into the resting tongue for 400 ticks with W of 0.02
+// m/N (FEM states every 5 ticks, reset epoch 0), then goes on for 300 ticks
+// on states of `epoch` with a ten times stiffer tongue. Returns the largest
+// change of the commanded force over one tick in that second part, N.
+double largest_step_after_change(std::uint32_t epoch, std::uint64_t* resets = nullptr) {
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest(setup);
+  TissueSnapshot snapshot = digest.make_snapshot();
+  HapticLoop loop(setup);
+  msg::ForceCommand command;
+  msg::ContactSet contacts;
+  contacts.contacts().reserve(msg::MAX_CONTACTS);
+  const Eigen::Vector3d deep(kPressTipM.x() - 0.001, kPressTipM.y() - 0.004, 0.0);
+  std::uint64_t tick = 0;
+  for (; tick < 400; ++tick) {
+    if (tick % 5 == 0 && tick > 0) {
+      EXPECT_TRUE(digest.digest(rest_with_compliance(setup, contacts, tick / 5), snapshot));
+    }
+    const double s = std::min(1.0, static_cast<double>(tick) / 200.0);
+    loop.tick(device_pose(tick, kPressTipM + s * (deep - kPressTipM), kPressPitchDeg), snapshot,
+              command, contacts);
+  }
+  Eigen::Vector3d previous = to_eigen(command.force_n());
+  EXPECT_GT(previous.norm(), 0.3) << "the press made no force to change";
+  double largest = 0.0;
+  for (; tick < 700; ++tick) {
+    if (tick % 5 == 0) {
+      msg::DeformationState state = rest_with_compliance(setup, contacts, tick / 5, 0.002f);
+      state.reset_epoch(epoch);
+      EXPECT_TRUE(digest.digest(state, snapshot));
+    }
+    loop.tick(device_pose(tick, deep, kPressPitchDeg), snapshot, command, contacts);
+    const Eigen::Vector3d force = to_eigen(command.force_n());
+    largest = std::max(largest, (force - previous).norm());
+    previous = force;
+  }
+  if (resets != nullptr) *resets = loop.metrics().tissue_resets.load();
+  return largest;
+}
+
+// A tongue that jumped (a new reset epoch) is not rendered as it jumped:
+// the force changes by at most 0.1 N a tick until it matches what the new
+// state gives. The same stiffer tongue without a new epoch is the control:
+// its force does step by more, so the bound is the slew's doing.
+TEST(HapticLoop, ANewResetEpochSlewsTheForce) {
+  std::uint64_t resets = 0;
+  const double with_epoch = largest_step_after_change(1, &resets);
+  const double control = largest_step_after_change(0);
+  std::printf("largest force change a tick: %.3f N after a reset epoch, %.3f N without\n",
+              with_epoch, control);
+  EXPECT_EQ(resets, 1u);
+  EXPECT_GT(control, kResetSlewN) << "the stiffer tongue made no step to bound";
+  EXPECT_LE(with_epoch, kResetSlewN + 1e-9);
+}
+
 #ifndef FAHR_SANITIZE_BUILD
 TEST(HapticLoop, TickAndDigestAllocateNothing) {
   const HapticSetup& setup = neonatal_scene().setup;

@@ -83,6 +83,7 @@ void ServiceStep::step() {
   anatomy_depth_max_m_ = std::max(anatomy_depth_max_m_, last_report_.projection.obstacle_deepest_m);
   fill_state(*setup_.body, setup_.scene_body->id, state_);
   state_.stale_contact_sets(static_cast<std::uint32_t>(stale_sets_));
+  state_.reset_epoch(static_cast<std::uint32_t>(divergence_resets_));
   state_.applied_contact_seq(usable ? applied_contact_seq_ : 0);
   fill_compliance();
 }

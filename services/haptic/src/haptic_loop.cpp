@@ -316,6 +316,15 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
     response_.reset(device.position_m, device.orientation);
     started_ = true;
   }
+  if (tissue.from_fem && tissue.reset_epoch != reset_epoch_) {
+    // The tongue jumped back to rest: what the proxy held and the contacts
+    // it had mean nothing now. The proxy goes to the hand, and the force
+    // slews from what was rendered to what the new tongue gives.
+    reset_epoch_ = tissue.reset_epoch;
+    response_.reset(device.position_m, device.orientation);
+    slewing_ = true;
+    relaxed_add<std::uint64_t>(metrics_.tissue_resets, 1);
+  }
   if (tissue.from_fem && tissue.fem_step != last_fem_step_) {
     last_fem_step_ = tissue.fem_step;
     relaxed_add<std::uint64_t>(metrics_.snapshots, 1);
@@ -364,6 +373,8 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   phases_.response_us = Micro(response_end - response_start).count();
 
   fill_command(out, pose.device_id(), command);
+  if (slewing_) slew_force(command);
+  rendered_n_ = common::to_eigen(command.force_n());
   command.header().sim_step(pose.servo_tick());
   command.header().sim_time_ns(pose.header().sim_time_ns());
   contacts.body_id(setup_.deformable->id);
@@ -440,6 +451,21 @@ const contact::ForceOutput& HapticLoop::penalty_tick(const contact::DeviceSample
   return out;
 }
 
+// After a tissue reset the command's force moves at most kResetSlewN a
+// tick toward the response's, with no local stiffness (the gateway would add
+// K (x - x_k) on top), until it has caught up.
+void HapticLoop::slew_force(msg::ForceCommand& command) {
+  const Eigen::Vector3d wanted = common::to_eigen(command.force_n());
+  const Eigen::Vector3d change = wanted - rendered_n_;
+  if (change.norm() <= kResetSlewN) {
+    slewing_ = false;
+    return;
+  }
+  common::put(Eigen::Vector3d(rendered_n_ + change * (kResetSlewN / change.norm())),
+              command.force_n());
+  common::put(Eigen::Matrix3d(Eigen::Matrix3d::Zero()), command.stiffness_npm());
+}
+
 void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out) {
   const auto get = [](const auto& a) {
     return static_cast<double>(a.load(std::memory_order_relaxed));
@@ -454,6 +480,7 @@ void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out
   out.emplace_back("tissue_rows_total", get(metrics_.tissue_rows_total));
   out.emplace_back("rows_without_compliance", get(metrics_.rows_without_compliance));
   out.emplace_back("lost_track_ticks", get(metrics_.lost_track_ticks));
+  out.emplace_back("tissue_resets", get(metrics_.tissue_resets));
   out.emplace_back("lost_track_episodes", get(metrics_.lost_track_episodes));
   out.emplace_back("tissue_reaction_n", get(metrics_.reaction_n));
   out.emplace_back("anatomy_reaction_n", get(metrics_.obstacle_reaction_n));

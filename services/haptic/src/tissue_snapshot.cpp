@@ -104,6 +104,7 @@ bool TissueDigest::digest(const msg::DeformationState& state, TissueSnapshot& ou
   if (out.triangles) out.triangles->update(positions_m_);
   out.from_fem = true;
   out.fem_step = state.step();
+  out.reset_epoch = state.reset_epoch();
   query_obstacles(out);
   index_compliance(state, out);
   out.digest_us =

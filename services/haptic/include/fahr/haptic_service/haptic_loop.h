@@ -43,6 +43,7 @@ struct LoopMetrics {
   std::atomic<std::uint64_t> tissue_rows_total{0};   // tissue rows solved, all ticks
   std::atomic<std::uint64_t> rows_without_compliance{0};  // of those, rows without W, total
   std::atomic<std::uint64_t> lost_track_ticks{0};
+  std::atomic<std::uint64_t> tissue_resets{0};  // new DeformationState reset epochs seen
   std::atomic<std::uint64_t> lost_track_episodes{0};
   std::atomic<double> reaction_n{0.0};  // last tissue reaction, N
   std::atomic<double> obstacle_reaction_n{
@@ -73,6 +74,9 @@ inline constexpr std::size_t kMaxAnatomyRows = 16;
 // of the ContactSet. The FEM's block holds the rows and these
 // (msg::MAX_COMPLIANCE_SPHERES).
 inline constexpr std::size_t kComplianceRequests = 16;
+// Largest change of the commanded force a tick after the tongue was reset
+// (DeformationState::reset_epoch), N.
+inline constexpr double kResetSlewN = 0.1;
 
 class HapticLoop {
  public:
@@ -96,6 +100,7 @@ class HapticLoop {
   void select_rows(const TissueSnapshot& tissue);
   void collect_triangle_rows(const TissueSnapshot& tissue);
   void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
+  void slew_force(msg::ForceCommand& command);
   const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device,
                                            const TissueSnapshot& tissue);
 
@@ -136,6 +141,9 @@ class HapticLoop {
   std::size_t row_count_ = 0;
 
   std::uint64_t last_fem_step_ = 0;
+  std::uint32_t reset_epoch_ = 0;
+  bool slewing_ = false;  // after a reset, until the force caught up
+  Eigen::Vector3d rendered_n_ = Eigen::Vector3d::Zero();  // the last command's force
   bool started_ = false;
   bool was_lost_ = false;
   std::uint64_t last_servo_tick_ = 0;

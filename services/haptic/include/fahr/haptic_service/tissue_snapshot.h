@@ -30,6 +30,7 @@ struct TissueSnapshot {
   // false: the rest state the loop starts from, before any DeformationState.
   bool from_fem = false;
   std::uint64_t fem_step = 0;
+  std::uint32_t reset_epoch = 0;  // DeformationState::reset_epoch
   collision::SphereState spheres;
   collision::SphereTree tree;
 
