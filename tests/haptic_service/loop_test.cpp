@@ -177,28 +177,52 @@ TEST(HapticLoop, EmbeddedStartStaysBounded) {
   EXPECT_LT(largest_jump, 10e-3);
 }
 
+// The haptic loop on the neonatal scene with what a tick needs, and the
+// press both tests below start with: the blade into the resting tongue over
+// 200 ticks and held for 200 more, with W of 0.02 m/N for what the ticks
+// ask for (a FEM state every 5 ticks, reset epoch 0). Fills every buffer.
+struct PressRig {
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest{setup};
+  TissueSnapshot snapshot = digest.make_snapshot();
+  HapticLoop loop{setup};
+  msg::ForceCommand command;
+  msg::ContactSet contacts;
+  msg::DeformationState state;
+  const Eigen::Vector3d deep{kPressTipM.x() - 0.001, kPressTipM.y() - 0.004, 0.0};
+  std::uint64_t tick = 0;
+
+  PressRig() { contacts.contacts().reserve(msg::MAX_CONTACTS); }
+  // False if a state was refused.
+  bool press() {
+    for (; tick < 400; ++tick) {
+      if (tick % 5 == 0 && tick > 0) {
+        state = rest_with_compliance(setup, contacts, tick / 5);
+        if (!digest.digest(state, snapshot)) return false;
+      }
+      const double s = std::min(1.0, static_cast<double>(tick) / 200.0);
+      loop.tick(device_pose(tick, kPressTipM + s * (deep - kPressTipM), kPressPitchDeg), snapshot,
+                command, contacts);
+    }
+    return true;
+  }
+};
+
 // Presses the blade into the resting tongue for 400 ticks with W of 0.02
 // m/N (FEM states every 5 ticks, reset epoch 0), then goes on for 300 ticks
 // on states of `epoch` with a ten times stiffer tongue. Returns the largest
 // change of the commanded force over one tick in that second part, N.
 double largest_step_after_change(std::uint32_t epoch, std::uint64_t* resets = nullptr) {
-  const HapticSetup& setup = neonatal_scene().setup;
-  TissueDigest digest(setup);
-  TissueSnapshot snapshot = digest.make_snapshot();
-  HapticLoop loop(setup);
-  msg::ForceCommand command;
-  msg::ContactSet contacts;
-  contacts.contacts().reserve(msg::MAX_CONTACTS);
-  const Eigen::Vector3d deep(kPressTipM.x() - 0.001, kPressTipM.y() - 0.004, 0.0);
-  std::uint64_t tick = 0;
-  for (; tick < 400; ++tick) {
-    if (tick % 5 == 0 && tick > 0) {
-      EXPECT_TRUE(digest.digest(rest_with_compliance(setup, contacts, tick / 5), snapshot));
-    }
-    const double s = std::min(1.0, static_cast<double>(tick) / 200.0);
-    loop.tick(device_pose(tick, kPressTipM + s * (deep - kPressTipM), kPressPitchDeg), snapshot,
-              command, contacts);
-  }
+  PressRig rig;
+  EXPECT_TRUE(rig.press());
+  const HapticSetup& setup = rig.setup;
+  TissueDigest& digest = rig.digest;
+  TissueSnapshot& snapshot = rig.snapshot;
+  HapticLoop& loop = rig.loop;
+  msg::ForceCommand& command = rig.command;
+  msg::ContactSet& contacts = rig.contacts;
+  const Eigen::Vector3d deep = rig.deep;
+  std::uint64_t tick = rig.tick;
   Eigen::Vector3d previous = to_eigen(command.force_n());
   EXPECT_GT(previous.norm(), 0.3) << "the press made no force to change";
   double largest = 0.0;
@@ -234,31 +258,16 @@ TEST(HapticLoop, ANewResetEpochSlewsTheForce) {
 
 #ifndef FAHR_SANITIZE_BUILD
 TEST(HapticLoop, TickAndDigestAllocateNothing) {
-  const HapticSetup& setup = neonatal_scene().setup;
-  TissueDigest digest(setup);
-  TissueSnapshot snapshot = digest.make_snapshot();
-  msg::DeformationState state;
-  state.body_id(setup.deformable->id);
-  for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
-    for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
-  }
-  HapticLoop loop(setup);
-  msg::ForceCommand command;
-  msg::ContactSet contacts;
-  contacts.contacts().reserve(msg::MAX_CONTACTS);
-  const Eigen::Vector3d deep(kPressTipM.x() - 0.001, kPressTipM.y() - 0.004, 0.0);
-  // Warm-up: press into the tongue (and so fill every buffer once), with W
-  // for what the ticks ask for.
-  std::uint64_t tick = 0;
-  for (; tick < 400; ++tick) {
-    if (tick % 5 == 0 && tick > 0) {
-      state = rest_with_compliance(setup, contacts, tick / 5);
-      ASSERT_TRUE(digest.digest(state, snapshot));
-    }
-    const double s = std::min(1.0, static_cast<double>(tick) / 200.0);
-    loop.tick(device_pose(tick, kPressTipM + s * (deep - kPressTipM), kPressPitchDeg), snapshot,
-              command, contacts);
-  }
+  PressRig rig;
+  ASSERT_TRUE(rig.press());
+  TissueDigest& digest = rig.digest;
+  TissueSnapshot& snapshot = rig.snapshot;
+  HapticLoop& loop = rig.loop;
+  msg::ForceCommand& command = rig.command;
+  msg::ContactSet& contacts = rig.contacts;
+  msg::DeformationState& state = rig.state;
+  const Eigen::Vector3d deep = rig.deep;
+  std::uint64_t tick = rig.tick;
   ASSERT_GT(loop.metrics().tool_rows.load(), 0u) << "the blade does not touch the tongue";
   state.step(state.step() + 1);
   ASSERT_TRUE(digest.digest(state, snapshot));
