@@ -62,6 +62,15 @@ double anatomy_depth(const HapticSetup& setup, const Eigen::Vector3d& tip_m, dou
 
 using common::to_eigen;
 
+// A DeformationState with the body at rest and no compliance yet.
+msg::DeformationState rest_state(const HapticSetup& setup) {
+  msg::DeformationState state;
+  for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
+    for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
+  }
+  return state;
+}
+
 // The tongue at rest as the FEM would publish it once the ticks asked for
 // W: a diagonal 3x3 block of `w_mpn` for each sphere the ContactSet names
 // (rows and requests), as the FEM's block follows the ContactSet. No
@@ -69,12 +78,9 @@ using common::to_eigen;
 msg::DeformationState rest_with_compliance(const HapticSetup& setup,
                                            const msg::ContactSet& contacts, std::uint64_t step,
                                            float w_mpn = 0.02f) {
-  msg::DeformationState state;
+  msg::DeformationState state = rest_state(setup);
   state.body_id(setup.deformable->id);
   state.step(step);
-  for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
-    for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
-  }
   auto& ids = state.compliance_sphere_ids();
   for (const msg::Contact& c : contacts.contacts()) {
     if (ids.size() == msg::MAX_COMPLIANCE_SPHERES) break;
@@ -316,15 +322,6 @@ TEST(TissueDigest, RefusesStatesThatDoNotFit) {
   state.compliance_normals().assign(6, std::numeric_limits<float>::quiet_NaN());
   state.compliance_mpn().assign(12, 0.01f);
   EXPECT_FALSE(digest.digest(state, snapshot));
-}
-
-// A DeformationState with the body at rest and no compliance yet.
-msg::DeformationState rest_state(const HapticSetup& setup) {
-  msg::DeformationState state;
-  for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
-    for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
-  }
-  return state;
 }
 
 // The neonatal scene's digest, a fresh snapshot and a state at rest.

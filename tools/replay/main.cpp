@@ -30,6 +30,7 @@
 #include "contact_setPubSubTypes.h"
 #include "deformation_statePubSubTypes.h"
 #include "device_posePubSubTypes.h"
+#include "fahr/common/cdr_bytes.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/publisher.h"
@@ -42,18 +43,10 @@ namespace fahr {
 namespace {
 
 using namespace std::chrono_literals;
-using eprosima::fastrtps::rtps::SerializedPayload_t;
 
 template <class T, class PubSub>
 bool decode(const mcap::MessageView& m, T& out) {
-  PubSub type;
-  SerializedPayload_t payload;
-  payload.data = const_cast<std::uint8_t*>(m.data.data());
-  payload.length = static_cast<std::uint32_t>(m.data.size());
-  payload.max_size = payload.length;
-  const bool ok = type.deserialize(&payload, &out);
-  payload.data = nullptr;  // borrowed
-  return ok;
+  return common::decode_cdr<PubSub>(m.data, out);
 }
 
 // One recorded sample, ready to publish at its source time.

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "device_posePubSubTypes.h"
+#include "fahr/common/cdr_bytes.h"
 #include "fahr/mcap/reader.h"
 #include "force_commandPubSubTypes.h"
 #include "page.h"
@@ -27,18 +28,9 @@
 namespace fahr {
 namespace {
 
-using eprosima::fastrtps::rtps::SerializedPayload_t;
-
 template <class T, class PubSub>
 bool decode(const mcap::MessageView& m, T& out) {
-  PubSub type;
-  SerializedPayload_t payload;
-  payload.data = const_cast<std::uint8_t*>(m.data.data());
-  payload.length = static_cast<std::uint32_t>(m.data.size());
-  payload.max_size = payload.length;
-  const bool ok = type.deserialize(&payload, &out);
-  payload.data = nullptr;  // borrowed
-  return ok;
+  return common::decode_cdr<PubSub>(m.data, out);
 }
 
 struct Series {

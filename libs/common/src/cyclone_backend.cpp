@@ -22,6 +22,7 @@
 #include <stdexcept>
 
 #include "backends.h"
+#include "fahr/common/cdr_bytes.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/config_error.h"
 
@@ -248,13 +249,9 @@ class CycloneReader final : public ReaderBackend {
       ddsi_serdata_to_ser_unref(held, &ref);
       return;
     }
-    // Borrow Cyclone's bytes for the fastcdr decoder without copying them.
-    SerializedPayload_t payload;
-    payload.data = static_cast<eprosima::fastrtps::rtps::octet*>(ref.iov_base);
-    payload.length = static_cast<std::uint32_t>(ref.iov_len);
-    payload.max_size = payload.length;
-    const bool ok = fast_type_->deserialize(&payload, scratch_);
-    payload.data = nullptr;  // not ours to free
+    // Cyclone's bytes, borrowed by the fastcdr decoder.
+    const bool ok = decode_cdr(
+        *fast_type_, {static_cast<const std::uint8_t*>(ref.iov_base), ref.iov_len}, scratch_);
     ddsi_serdata_to_ser_unref(held, &ref);
     if (ok) sink_->deliver(scratch_, source_time_ns);
   }

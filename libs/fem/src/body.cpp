@@ -325,8 +325,8 @@ bool Body::deformed_since_factor() const {
 // (fem_tongue_press), so a lagged-factor CG refreshes too. A few nodes
 // joining or leaving the held set are a small low-rank change of A, and
 // nodes sitting on the bone with no force flicker in and out from step to
-// step: refreshing on every change refactorised in 55 % of the 20 s
-// intubation's steps, and each refresh solves W's columns again. So the
+// step: refreshing on every change refactorised in most pressed steps, and
+// each refresh solves W's columns again. So the
 // factor follows the held set once a quarter of it (and at least
 // kSupportChangesForRefresh nodes) changed.
 bool Body::support_changed_factor_due(bool cg) const {

@@ -381,15 +381,16 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   contacts.haptic_tick(tick_);
   contacts.fem_step(tissue.fem_step);
   contacts.layout_fingerprint(layout_fingerprint_);
+  const std::span<const fem::Contact> requests(requests_.data(), request_count_);
   if (setup_.penalty) {
     contacts.tool_frozen(false);
-    fill_contacts({penalty_contacts_.data(), penalty_count_}, tool_body_.id,
+    fill_contacts({penalty_contacts_.data(), penalty_count_}, requests, tool_body_.id,
                   tissue.tissue_obstacle_body_ids(), contacts);
   } else {
     contacts.tool_frozen(response_.tool_frozen());
-    fill_contacts(response_.contacts(), tool_body_.id, tissue.tissue_obstacle_body_ids(), contacts);
+    fill_contacts(response_.contacts(), requests, tool_body_.id, tissue.tissue_obstacle_body_ids(),
+                  contacts);
   }
-  append_contacts({requests_.data(), request_count_}, tool_body_.id, contacts);
   // Where the FEM finds the tool: the proxy after this tick (the penalty
   // baseline's tool is the device).
   common::put(setup_.penalty ? device.position_m : response_.proxy().position_m,

@@ -42,13 +42,14 @@ msg::ConstraintState wire_state(fem::ContactState s) {
 
 }  // namespace
 
-void fill_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_body_id,
-                   std::span<const std::uint32_t> obstacle_body_ids, msg::ContactSet& out) {
-  const std::size_t n = std::min<std::size_t>(contacts.size(), msg::MAX_CONTACTS);
+void fill_contacts(std::span<const fem::Contact> contacts, std::span<const fem::Contact> requests,
+                   std::uint32_t tool_body_id, std::span<const std::uint32_t> obstacle_body_ids,
+                   msg::ContactSet& out) {
+  const std::size_t n = std::min<std::size_t>(contacts.size() + requests.size(), msg::MAX_CONTACTS);
   out.contacts().resize(n);
   std::size_t obstacle = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const fem::Contact& c = contacts[i];
+    const fem::Contact& c = i < contacts.size() ? contacts[i] : requests[i - contacts.size()];
     msg::Contact& w = out.contacts()[i];
     w.sphere_id(c.sphere_id);
     if (c.kind == fem::ContactKind::kObstacle) {
@@ -59,26 +60,6 @@ void fill_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_bo
       w.kind(c.kind == fem::ContactKind::kForceOnly ? msg::CONTACT_FORCE_ONLY : msg::CONTACT_TOOL);
       w.other_body_id(tool_body_id);
     }
-    w.state(wire_state(c.state));
-    put(c.plane_point_m, w.point_m());
-    put(c.normal, w.normal());
-    put(c.hold_centre_m, w.hold_centre_m());
-    w.penetration_m(c.penetration_m);
-    w.force_n(c.force_n);
-  }
-}
-
-void append_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_body_id,
-                     msg::ContactSet& out) {
-  const std::size_t first = out.contacts().size();
-  const std::size_t n = std::min<std::size_t>(contacts.size(), msg::MAX_CONTACTS - first);
-  out.contacts().resize(first + n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const fem::Contact& c = contacts[i];
-    msg::Contact& w = out.contacts()[first + i];
-    w.sphere_id(c.sphere_id);
-    w.kind(msg::CONTACT_TOOL);
-    w.other_body_id(tool_body_id);
     w.state(wire_state(c.state));
     put(c.plane_point_m, w.point_m());
     put(c.normal, w.normal());

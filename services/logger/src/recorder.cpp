@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "fahr/common/cdr_bytes.h"
 #include "fahr/common/clock.h"
 #include "fahr/idl/schemas.h"
 #include "fahr/logger_service/wire_header.h"
@@ -267,14 +268,7 @@ void Recorder::write_item(Item& item) {
 // A service's status: who it is, and the count each of its writers sent.
 void Recorder::note_status(Item& item) {
   msg::ServiceStatus status;
-  msg::ServiceStatusPubSubType type;
-  eprosima::fastrtps::rtps::SerializedPayload_t payload;
-  payload.data = item.bytes.data();
-  payload.length = static_cast<std::uint32_t>(item.bytes.size());
-  payload.max_size = payload.length;
-  const bool ok = type.deserialize(&payload, &status);
-  payload.data = nullptr;  // not ours to free
-  if (!ok) return;
+  if (!common::decode_cdr<msg::ServiceStatusPubSubType>(item.bytes, status)) return;
   auto& info = services_[item.writer_id];
   info.name = status.service_name().to_string();
   info.host = status.host().to_string();

@@ -18,14 +18,13 @@ namespace fahr::haptic_service {
 void fill_command(const contact::ForceOutput& output, std::uint32_t device_id,
                   msg::ForceCommand& out);
 
-// Contacts in the response's order. Tool contacts name `tool_body_id`;
-// obstacle contacts take their body from `obstacle_body_ids`, in order (the
-// response copies the tissue-obstacle contacts after the tool's).
-void fill_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_body_id,
-                   std::span<const std::uint32_t> obstacle_body_ids, msg::ContactSet& out);
-// Appends tool contacts after what `out` holds (the tick's compliance
-// requests), up to msg::MAX_CONTACTS in all.
-void append_contacts(std::span<const fem::Contact> contacts, std::uint32_t tool_body_id,
-                     msg::ContactSet& out);
+// Contacts in the response's order, then `requests` (tool contacts: the
+// tick's compliance requests), up to msg::MAX_CONTACTS in all. Tool contacts
+// name `tool_body_id`; obstacle contacts take their body from
+// `obstacle_body_ids`, in order (the response copies the tissue-obstacle
+// contacts after the tool's).
+void fill_contacts(std::span<const fem::Contact> contacts, std::span<const fem::Contact> requests,
+                   std::uint32_t tool_body_id, std::span<const std::uint32_t> obstacle_body_ids,
+                   msg::ContactSet& out);
 
 }  // namespace fahr::haptic_service
