@@ -138,7 +138,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void on_tick(std::int64_t now_ns) {
     if (closed_ || !open_) return;
     if (now_ns < next_send_ns_) return;
-    next_send_ns_ = std::max(next_send_ns_ + period_ns_, now_ns - period_ns_);
+    // The next send a period on, never earlier than half a period from now:
+    // a client that was skipped does not get a burst to catch up.
+    next_send_ns_ = std::max(next_send_ns_ + period_ns_, now_ns + period_ns_ / 2);
     if (foxglove_) {
       send_foxglove_messages();
     } else {
