@@ -76,6 +76,7 @@ result.deformFramesPerSecond = ((s.deformFrames - f0) * 1000) / (Date.now() - t0
 // Let the run go on (the blade presses), then look again.
 let arrowSeen = s.arrowVisible;
 let ghostSeen = s.ghostVisible;
+let lostSeen = s.lostTrack;
 let peakForce = s.forceN;
 const end = Date.now() + seconds * 1000;
 while (Date.now() < end) {
@@ -83,6 +84,7 @@ while (Date.now() < end) {
   s = await stats();
   arrowSeen ||= s.arrowVisible;
   ghostSeen ||= s.ghostVisible;
+  lostSeen ||= s.lostTrack;
   peakForce = Math.max(peakForce, s.forceN);
   if (mode === "lost" && s.ghostVisible) {
     await page.screenshot({ path: join(out, "lost_track.png") });
@@ -103,6 +105,7 @@ result.vertexChecksumChange = Math.abs(s.positionsChecksum - firstChecksum);
 result.maxStrain = s.maxStrain;
 result.arrowSeen = arrowSeen;
 result.ghostSeen = ghostSeen;
+result.lostTrackSeen = lostSeen;
 result.peakForceN = peakForce;
 result.limitN = s.limitN;
 result.stateFrames = s.stateFrames;
@@ -118,7 +121,8 @@ if (mode !== "replay" || !s.replay?.paused) {
   if (!(result.meanPixelChange > 0.5)) problems.push(`the tongue's pixels hardly changed (${result.meanPixelChange.toFixed(2)})`);
 }
 if (!arrowSeen) problems.push("no force arrow");
-if (mode === "lost" && !ghostSeen) problems.push("no grey device blade while the device lost track");
+if (lostSeen && !ghostSeen) problems.push("no grey device blade while the device lost track");
+if (mode === "lost" && !lostSeen) problems.push("the device never lost track");
 if (consoleErrors.length > 0) problems.push(`console errors: ${consoleErrors.slice(0, 3).join(" | ")}`);
 result.problems = problems;
 console.log(JSON.stringify(result));
