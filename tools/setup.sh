@@ -23,8 +23,11 @@ packages=(
   iproute2 nftables
   # MCAP recordings: chunk compression (zstd, lz4) and CRC-32 (zlib)
   libzstd-dev liblz4-dev zlib1g-dev
-  # the recorder's HTML report is checked by rendering it headless
+  # the recorder's HTML report is checked by rendering it headless; the
+  # visualizer's page is tested in it (playwright-core drives Debian's build)
   chromium
+  # the visualizer's HTTP + WebSocket server (Boost.Beast) and its JSON
+  libboost-dev nlohmann-json3-dev
 )
 # The recorder tests read recordings back with Foxglove's npm packages:
 # Debian's node and npm, unless a node is already installed (another

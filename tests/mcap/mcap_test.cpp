@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fahr/mcap/indexed_reader.h"
 #include "fahr/mcap/reader.h"
 #include "fahr/mcap/writer.h"
 
@@ -243,6 +244,64 @@ TEST(Mcap, RecoverFromAnyTruncation) {
     previous = r.messages;
   }
   EXPECT_GT(previous, 300U);
+}
+
+TEST(Mcap, IndexedReaderSeeksByReadingOnlyTheChunksOfTheSpan) {
+  WriterOptions options;
+  options.compression = "zstd";
+  options.chunk_size = 16 * 1024ULL;
+  options.sync_chunks = false;
+  const std::string path = temp_path("indexed.mcap");
+  constexpr std::uint32_t kMessages = 5000;
+  {
+    Writer w(options);
+    w.open(path);
+    write_sample(w, kMessages);
+    w.close();
+  }
+  IndexedReader r(path);
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_EQ(r.message_count(), kMessages);
+  EXPECT_EQ(r.start_time(), 1'000'000'000ULL);
+  EXPECT_EQ(r.end_time(), 1'000'000'000ULL + (kMessages - 1) * 1'000'000ULL);
+  EXPECT_EQ(r.channels().size(), 2U);
+  EXPECT_EQ(r.schemas().size(), 1U);
+  ASSERT_GT(r.chunks().size(), 10U);
+  // 100 ms in the middle: messages 3000..3099, from one or two chunks.
+  const std::uint64_t begin = 1'000'000'000ULL + 3000ULL * 1'000'000ULL;
+  std::vector<std::uint32_t> seen;
+  ASSERT_TRUE(r.read(begin, begin + 100'000'000ULL, [&](const Channel& c, const MessageView& m) {
+    const auto p = payload(m.sequence);
+    ASSERT_EQ(m.data.size(), p.size());
+    EXPECT_TRUE(std::equal(p.begin(), p.end(), m.data.begin()));
+    EXPECT_EQ(c.topic, m.sequence % 3 == 0 ? "fahr/B" : "fahr/A");
+    seen.push_back(m.sequence);
+  }));
+  ASSERT_EQ(seen.size(), 100U);
+  for (std::uint32_t i = 0; i < 100; ++i) EXPECT_EQ(seen[i], 3000 + i);
+  EXPECT_LE(r.chunks_read(), 3U);
+  // The torn .part of a killed writer has no summary: refused, not guessed.
+  {
+    Writer w(options);
+    w.open(temp_path("torn.mcap"));
+    write_sample(w, 100);
+    w.flush();
+    IndexedReader torn(temp_path("torn.mcap") + ".part");
+    EXPECT_FALSE(torn.ok());
+  }
+}
+
+TEST(Mcap, IndexedReaderRefusesGarbage) {
+  const std::string path = temp_path("garbage.mcap");
+  {
+    std::ofstream f(path, std::ios::binary);
+    for (int i = 0; i < 1000; ++i) f.put(static_cast<char>(i * 31));
+  }
+  IndexedReader r(path);
+  EXPECT_FALSE(r.ok());
+  EXPECT_FALSE(r.read(0, ~0ULL, [](const Channel&, const MessageView&) {}));
+  IndexedReader missing(temp_path("missing.mcap"));
+  EXPECT_FALSE(missing.ok());
 }
 
 }  // namespace

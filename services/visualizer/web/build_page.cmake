@@ -1,0 +1,26 @@
+# Builds the page: copies the sources to WORK, `npm ci` there (only when the
+# lockfile changed), then esbuild bundles src/app.js into OUT/app.js and
+# copies index.html. Run by CMake (services/visualizer/CMakeLists.txt).
+file(MAKE_DIRECTORY ${WORK} ${OUT})
+file(COPY ${SRC}/package.json ${SRC}/package-lock.json ${SRC}/build.mjs ${SRC}/src DESTINATION ${WORK})
+set(stamp ${WORK}/node_modules/.fahr-lock)
+set(need_install TRUE)
+if(EXISTS ${stamp})
+  file(READ ${stamp} old)
+  file(READ ${SRC}/package-lock.json new)
+  if(old STREQUAL new)
+    set(need_install FALSE)
+  endif()
+endif()
+if(need_install)
+  execute_process(COMMAND ${NPM} ci --no-audit --no-fund --loglevel=error
+                  WORKING_DIRECTORY ${WORK} RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "npm ci for the visualizer's page failed (${rc})")
+  endif()
+  file(COPY_FILE ${SRC}/package-lock.json ${stamp})
+endif()
+execute_process(COMMAND ${NODE} build.mjs ${OUT} WORKING_DIRECTORY ${WORK} RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "esbuild of the visualizer's page failed (${rc})")
+endif()

@@ -1,0 +1,152 @@
+#!/usr/bin/env bash
+# fahr_visualizer against real runs, read by independent clients installed
+# with `npm ci` from the committed package-lock.json (tests/visualizer/js):
+#
+#   visualizer_run_test.sh BUILD_DIR install
+#   visualizer_run_test.sh BUILD_DIR foxglove|browser|replay|remote
+#
+# install:  npm ci of the clients into BUILD_DIR/tests/visualizer/js (outside
+#           any namespace: it needs the npm registry); CTest runs it first.
+# foxglove: a realtime run; a Foxglove WebSocket client (@foxglove/ws-protocol)
+#           decodes DevicePose, ForceCommand, ContactSet, DeformationState,
+#           SceneDescription and ServiceStatus with the advertised omgidl
+#           schemas, and its client publishing is refused.
+# browser:  a realtime run; Debian's chromium (playwright-core) opens the page:
+#           scene, tongue vertices updating at the display rate, force arrow,
+#           pixels in the tongue's bounds changing, no console error;
+#           screenshots (browser_check.mjs's "lost" mode also waits for the
+#           grey device blade; no scripted run loses track reliably yet).
+# replay:   a lockstep run recorded by fahr_logger, replayed by the visualizer
+#           (indexed seeks) in the page; a seek and a pause are exercised.
+# remote:   the gateway on --backend remote and the visualizer with
+#           --allow-remote-input: poses sent as the page's mouse device
+#           reach the gateway (its DevicePose follows them, clamped).
+# FAHR_KEEP_SCREENSHOTS=DIR keeps the PNGs. Runs inside a loopback-only
+# network namespace (tests/run_in_netns.sh). Exit 77 only if node, npm or
+# chromium is absent.
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/../.." && pwd)
+build=$(cd "$1" && pwd)
+mode=$2
+for tool in node npm chromium; do
+  if ! command -v "$tool" >/dev/null 2>&1; then
+    echo "SKIPPED: $tool is needed (tools/setup.sh installs it)"
+    exit 77
+  fi
+done
+js="$build/tests/visualizer/js"
+if [ "$mode" = install ]; then
+  mkdir -p "$js"
+  cp "$repo/tests/visualizer/js/package.json" "$repo/tests/visualizer/js/package-lock.json" "$js/"
+  if ! cmp -s "$js/package-lock.json" "$js/node_modules/.fahr-lock" 2>/dev/null; then
+    (cd "$js" && npm ci --no-audit --no-fund --loglevel=error)
+    cp "$js/package-lock.json" "$js/node_modules/.fahr-lock"
+  fi
+  echo "visualizer_run_test: clients installed in $js"
+  exit 0
+fi
+[ -d "$js/node_modules/playwright-core" ] || { echo "visualizer_run_test: run $0 $build install first" >&2; exit 1; }
+cp "$repo"/tests/visualizer/js/*.mjs "$js/"
+vis="$build/services/visualizer/fahr_visualizer"
+[ -f "$build/services/visualizer/web/app.js" ] || { echo "visualizer_run_test: the page is not built" >&2; exit 1; }
+
+out=$(mktemp -d /tmp/fahr-visualizer-test-XXXXXX)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  if [ -n "${FAHR_KEEP_SCREENSHOTS:-}" ]; then mkdir -p "$FAHR_KEEP_SCREENSHOTS"; cp "$out"/*.png "$out"/*.json "$FAHR_KEEP_SCREENSHOTS/" 2>/dev/null || true; fi
+  rm -rf "$out"
+}
+trap cleanup EXIT
+export FAHR_RUN_LOCAL_IN_NETNS=1
+export FAHR_RUN_LOG_DIR="$out/logs"
+port=8765
+url="http://127.0.0.1:$port/"
+
+start_visualizer() {
+  "$vis" --port "$port" "$@" >"$out/visualizer.log" 2>&1 &
+  pids+=($!)
+  for _ in $(seq 100); do grep -q "^fahr_visualizer: .* on http" "$out/visualizer.log" && return 0; sleep 0.1; done
+  echo "visualizer_run_test: the visualizer did not start:" >&2; cat "$out/visualizer.log" >&2; exit 1
+}
+stop_visualizer() {
+  kill -INT "${pids[0]}"; wait "${pids[0]}" || true
+  pids=("${pids[@]:1}")
+  tail -n 1 "$out/visualizer.log"
+}
+# A realtime run in the background: run_local.sh with SECONDS and SCRIPT.
+start_run() {
+  bash "$repo/deployment/run_local.sh" "$build" --dds cyclonedds --domain 42 --duration-s "$1" \
+    --script "$2" >"$out/run.log" 2>&1 &
+  pids+=($!)
+}
+
+case "$mode" in
+  foxglove)
+    start_visualizer --dds cyclonedds --domain 42
+    start_run 20 intubation
+    node "$js/foxglove_check.mjs" "ws://127.0.0.1:$port" 60 \
+      DevicePose,ForceCommand,ContactSet,DeformationState,SceneDescription,ServiceStatus | tee "$out/foxglove.json"
+    stop_visualizer
+    ;;
+  browser)
+    start_visualizer --dds cyclonedds --domain 42
+    start_run 25 intubation
+    node "$js/browser_check.mjs" "$url" "$out" 8 live | tee "$out/browser.json"
+    stop_visualizer
+    ;;
+  replay)
+    bash "$repo/deployment/run_local.sh" "$build" --dds cyclonedds --domain 42 --mode lockstep \
+      --duration-s 3 --record "$out/run.mcap" >"$out/run.log" 2>&1 || {
+      echo "visualizer_run_test: the recorded run failed:" >&2; tail -n 30 "$out/run.log" >&2; exit 1; }
+    start_visualizer --replay "$out/run.mcap" --speed 0.5
+    node "$js/browser_check.mjs" "$url" "$out" 3 replay | tee "$out/replay.json"
+    # Seek to the middle and pause: the position must follow.
+    (cd "$js" && node --input-type=module -e '
+      import WebSocket from "ws";
+      const ws = new WebSocket(process.argv[1]);
+      let last = null, sent = false;
+      ws.on("message", (d, binary) => {
+        if (binary) return;
+        const m = JSON.parse(d.toString());
+        if (m.op !== "replay") return;
+        last = m;
+        if (!sent) { sent = true; ws.send(JSON.stringify({ op: "replay", action: "seek", value: m.duration / 2 }));
+                     ws.send(JSON.stringify({ op: "replay", action: "pause" })); }
+      });
+      setTimeout(() => {
+        const ok = last && last.paused && Math.abs(last.t - last.duration / 2) < 0.1;
+        console.log(`visualizer_run_test: after seek + pause: t ${last?.t} of ${last?.duration} s, paused ${last?.paused}`);
+        process.exit(ok ? 0 : 1);
+      }, 2000);' "ws://127.0.0.1:$port/ws")
+    stop_visualizer
+    ;;
+  remote)
+    start_visualizer --dds cyclonedds --domain 44 --allow-remote-input
+    "$build/services/device_gateway/fahr_device_gateway" --dds cyclonedds --domain 44 --backend remote \
+      --duration-s 6 >"$out/gateway.log" 2>&1 &
+    pids+=($!)
+    (cd "$js" && node --input-type=module -e '
+      import WebSocket from "ws";
+      import wsProtocol from "@foxglove/ws-protocol";
+      import { parseIDL } from "@foxglove/omgidl-parser";
+      import { MessageReader } from "@foxglove/omgidl-serialization";
+      const page = new WebSocket(process.argv[1] + "/ws");
+      const fox = new wsProtocol.FoxgloveClient({ ws: new WebSocket(process.argv[1], [wsProtocol.FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
+      let reader = null, last = null, sub = null;
+      fox.on("advertise", (chs) => { for (const c of chs) if (c.topic === "fahr/DevicePose") { reader = new MessageReader(c.schemaName, parseIDL(c.schema)); sub = fox.subscribe(c.id); } });
+      fox.on("message", ({ subscriptionId, data }) => { if (subscriptionId === sub) last = reader.readMessage(new Uint8Array(data.buffer, data.byteOffset, data.byteLength)); });
+      const target = [0.02, -0.01, 0.5];  // z beyond the workspace: clamped
+      page.on("open", () => setInterval(() => page.send(JSON.stringify({ op: "pose", p: target, q: [1, 0, 0, 0] })), 20));
+      setTimeout(() => {
+        const p = last?.world_from_stylus?.position_m;
+        console.log(`visualizer_run_test: mouse pose sent ${JSON.stringify(target)}, gateway DevicePose at ${p ? [p.x, p.y, p.z].map((v) => v.toFixed(4)).join(", ") : "none"}`);
+        process.exit(p && Math.abs(p.z) < 0.5 && p.z !== 0 ? 0 : 1);
+      }, 4000);' "ws://127.0.0.1:$port")
+    stop_visualizer
+    grep -E "remote|backend" "$out/gateway.log" | head -n 3 || true
+    ;;
+  *) echo "visualizer_run_test: mode must be install, foxglove, browser, replay or remote" >&2; exit 2 ;;
+esac
+echo "visualizer_run_test: passed ($mode)"

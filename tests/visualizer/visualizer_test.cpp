@@ -1,0 +1,285 @@
+// services/visualizer in one process: the live store, the page's frames
+// (strain 0 at rest), and the server against hostile and slow clients (a
+// Boost.Beast client in the test): malformed, oversized, flooding and
+// forbidden messages are refused and counted, the server stays up; a client
+// that stops reading loses its oldest frames while another keeps its rate
+// and the sources never wait.
+#include <gtest/gtest.h>
+
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+
+#include "fahr/common/clock.h"
+#include "fahr/visualizer_service/live_state.h"
+#include "fahr/visualizer_service/page_model.h"
+#include "fahr/visualizer_service/server.h"
+#include "sample_factory.h"
+
+namespace fahr::visualizer_service {
+namespace {
+
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+template <class T>
+void put(LiveState& live, std::size_t topic, const T& sample) {
+  const auto bytes = test::cdr_bytes(sample);
+  live.put(topic, bytes, common::wall_now_ns());
+}
+
+TEST(LiveState, KeepsTheNewestSamplePerTopicAndKeyAndCountsMalformedBytes) {
+  LiveState live;
+  msg::DevicePose pose;
+  test::fill(pose, 1, 2);
+  pose.device_id(3);
+  put(live, kDevicePose, pose);
+  put(live, kDevicePose, pose);
+  pose.device_id(4);
+  put(live, kDevicePose, pose);
+  const std::uint8_t junk[5] = {1, 2, 3, 4, 5};
+  live.put(kDevicePose, junk, 0);
+  std::vector<Slot> slots;
+  EXPECT_EQ(live.collect(slots), 2U);
+  EXPECT_EQ(live.collect(slots), 0U);  // nothing new
+  EXPECT_EQ(slots[0].key, 3U);
+  EXPECT_EQ(slots[1].key, 4U);
+  EXPECT_EQ(live.stats().malformed, 1U);
+  // Keys past the store's bound are dropped and counted, never grown.
+  for (std::uint32_t k = 0; k < LiveState::kMaxSlots + 10; ++k) {
+    pose.device_id(100 + k);
+    put(live, kDevicePose, pose);
+  }
+  EXPECT_GT(live.stats().slots_full, 0U);
+  EXPECT_EQ(live.collect(slots), LiveState::kMaxSlots - 2);
+}
+
+TEST(PageModel, TheRestStateHasNoStrainAndAStretchHasSome) {
+  // One tet, nodes at the unit corners (1 cm).
+  msg::SceneDescription d;
+  d.body_id(7);
+  d.role(msg::BODY_DEFORMABLE);
+  d.body_name("tongue");
+  d.rest_positions_m({0, 0, 0, 0.01f, 0, 0, 0, 0.01f, 0, 0, 0, 0.01f});
+  d.tets({0, 1, 2, 3});
+  d.triangles({0, 1, 2, 0, 1, 3, 0, 2, 3, 1, 2, 3});
+  LiveState live;
+  put(live, kSceneDescription, d);
+  msg::DeformationState s;
+  s.body_id(7);
+  s.positions_m(d.rest_positions_m());
+  put(live, kDeformationState, s);
+  PageModel model(nullptr);
+  std::vector<Slot> slots;
+  live.collect(slots);
+  model.update(slots, "live");
+  ASSERT_EQ(model.frames().count(kSceneStreamBase + 7), 1U);
+  ASSERT_EQ(model.frames().count(kDeformStreamBase + 7), 1U);
+  EXPECT_NEAR(model.max_node_strain(), 0.0, 1e-6);
+  // Stretch x by 10 %: (1.1^2 - 1) / 2 = 0.105.
+  s.positions_m({0, 0, 0, 0.011f, 0, 0, 0, 0.01f, 0, 0, 0, 0.01f});
+  put(live, kDeformationState, s);
+  live.collect(slots);
+  model.update(slots, "live");
+  EXPECT_NEAR(model.max_node_strain(), 0.105, 1e-4);
+  const auto& frame = *model.frames().at(kDeformStreamBase + 7);
+  EXPECT_TRUE(frame.binary);
+  EXPECT_EQ(frame.data.size(), 24U + 4 * 12 + 4 * 4);  // header, positions, strains
+  const auto& state = *model.frames().at(kStateStream);
+  EXPECT_FALSE(state.binary);
+  EXPECT_TRUE(json::parse(state.data)["op"] == "state");
+}
+
+// A synchronous Beast client.
+struct Client {
+  net::io_context ioc;
+  websocket::stream<tcp::socket> ws{ioc};
+
+  Client(unsigned short port, bool foxglove, int receive_buffer = 0) {
+    tcp::socket& s = ws.next_layer();
+    s.open(tcp::v4());
+    if (receive_buffer > 0) s.set_option(net::socket_base::receive_buffer_size(receive_buffer));
+    s.connect({net::ip::make_address("127.0.0.1"), port});
+    if (foxglove) {
+      ws.set_option(websocket::stream_base::decorator([](websocket::request_type& req) {
+        req.set(beast::http::field::sec_websocket_protocol, "foxglove.websocket.v1");
+      }));
+    }
+    ws.handshake("127.0.0.1", "/ws");
+  }
+  json read_json() {
+    beast::flat_buffer b;
+    while (true) {
+      ws.read(b);
+      if (ws.got_text()) return json::parse(beast::buffers_to_string(b.data()));
+      b.consume(b.size());
+    }
+  }
+  // Reads until a text message with this op arrives (or the socket fails).
+  json read_op(const std::string& op) {
+    for (int i = 0; i < 1000; ++i) {
+      json j = read_json();
+      if (j.value("op", "") == op) return j;
+    }
+    return {};
+  }
+  void send(const std::string& text) {
+    ws.text(true);
+    ws.write(net::buffer(text));
+  }
+};
+
+struct Fixture {
+  LiveState live;
+  std::unique_ptr<Server> server;
+  explicit Fixture(ServerOptions o = {}) {
+    o.port = 0;
+    o.web_root.clear();
+    server = std::make_unique<Server>(o, live, nullptr);
+    server->start();
+  }
+};
+
+TEST(Server, RefusesMalformedOversizedFloodingAndForbiddenMessagesAndStaysUp) {
+  ServerOptions o;
+  o.message_rate_hz = 50;
+  o.message_burst = 20;
+  Fixture f(o);
+  {
+    Client c(f.server->port(), false);
+    EXPECT_EQ(c.read_json()["op"], "hello");
+    for (const char* bad : {"not json", "{\"op\":5}", "[1,2,3]", "{\"op\":\"launch\"}",
+                            "{\"op\":\"rate\",\"hz\":\"fast\"}", "{\"op\":\"rate\"}"}) {
+      c.send(bad);
+      const json r = c.read_op("refused");
+      EXPECT_FALSE(r.is_null()) << bad;
+    }
+    // Binary on the page's stream: refused.
+    c.ws.binary(true);
+    const std::uint8_t junk[8] = {0xff, 0, 1, 2, 3, 4, 5, 6};
+    c.ws.write(net::buffer(junk));
+    EXPECT_EQ(c.read_op("refused")["what"], "malformed");
+    // The mouse device without the station's leave: refused.
+    c.send(R"({"op":"pose","p":[0,0,0],"q":[1,0,0,0]})");
+    EXPECT_EQ(c.read_op("refused")["what"], "pose");
+    // A flood: far past the rate; refused (and the connection survives).
+    for (int i = 0; i < 300; ++i) c.send(R"({"op":"rate","hz":30})");
+    EXPECT_EQ(c.read_op("refused")["what"], "flood");
+  }
+  {
+    // Oversized: Beast closes with 1009 "too big".
+    Client c(f.server->port(), false);
+    c.read_json();
+    c.send(std::string(64 * 1024, 'x'));
+    beast::flat_buffer b;
+    beast::error_code ec;
+    for (int i = 0; i < 100 && !ec; ++i) c.ws.read(b, ec);
+    // Closed with 1009, or reset while the client was still sending.
+    EXPECT_TRUE(ec);
+    if (ec == websocket::error::closed) {
+      EXPECT_EQ(c.ws.reason().code, websocket::close_code::too_big);
+    }
+  }
+  {
+    // Foxglove: serverInfo without clientPublish, advertise of every topic
+    // as cdr/omgidl; publishing and bad subscriptions refused.
+    Client c(f.server->port(), true);
+    const json info = c.read_op("serverInfo");
+    EXPECT_EQ(info["capabilities"].size(), 0U);
+    const json adv = c.read_op("advertise");
+    ASSERT_EQ(adv["channels"].size(), static_cast<std::size_t>(kTopicCount));
+    for (const auto& ch : adv["channels"]) {
+      EXPECT_EQ(ch["encoding"], "cdr");
+      EXPECT_EQ(ch["schemaEncoding"], "omgidl");
+      EXPECT_NE(ch["schema"].get<std::string>().find("struct"), std::string::npos);
+    }
+    c.send(
+        R"({"op":"advertise","channels":[{"id":1,"topic":"fahr/RemoteInput","encoding":"cdr","schemaName":"x"}]})");
+    EXPECT_EQ(c.read_op("status")["level"], 2);
+    c.send(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":999}]})");
+    EXPECT_EQ(c.read_op("status")["level"], 2);
+    c.send(R"({"op":"subscribe","subscriptions":[{"id":-1,"channelId":"a"}]})");
+    EXPECT_EQ(c.read_op("status")["level"], 2);
+  }
+  const ServerStats s = f.server->stats();
+  EXPECT_GE(s.refused_malformed, 9U);
+  EXPECT_EQ(s.refused_oversized, 1U);
+  EXPECT_GT(s.refused_flood, 0U);
+  EXPECT_EQ(s.refused_publish, 2U);
+  // Still serving.
+  Client after(f.server->port(), false);
+  EXPECT_EQ(after.read_json()["op"], "hello");
+}
+
+TEST(Server, ASlowClientLosesItsOldestFramesWhileAnotherKeepsItsRate) {
+  ServerOptions o;
+  o.client_buffer_bytes = 1u << 20;
+  o.client_buffer_frames = 16;
+  o.rate_hz = 60;
+  Fixture f(o);
+  auto subscribe = [](Client& c) {
+    const json adv = c.read_op("advertise");
+    for (const auto& ch : adv["channels"]) {
+      if (ch["topic"] == "fahr/DeformationState")
+        c.send(json{{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", ch["id"]}}}}}
+                   .dump());
+    }
+  };
+  // The slow one: a 4 KiB receive buffer, and it stops reading after subscribing.
+  Client slow(f.server->port(), true, 4096);
+  subscribe(slow);
+  Client fast(f.server->port(), true);
+  subscribe(fast);
+  std::atomic<bool> stop{false};
+  std::atomic<int> fast_messages{0};
+  std::thread reader([&] {
+    beast::flat_buffer b;
+    beast::error_code ec;
+    while (!stop && !ec) {
+      fast.ws.read(b, ec);
+      if (!ec && !fast.ws.got_text()) ++fast_messages;
+      b.consume(b.size());
+    }
+  });
+  // 300 KiB FEM states at 100 Hz for 3 s: the slow client's socket fills
+  // within a second. The source's put() must stay quick throughout.
+  msg::DeformationState s;
+  s.body_id(1);
+  std::vector<float> positions(3 * 25000, 0.01f);
+  std::int64_t worst_put_ns = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 300; ++i) {
+    positions[0] = static_cast<float>(i);
+    s.positions_m(positions);
+    s.header().seq(static_cast<std::uint64_t>(i + 1));
+    const auto bytes = test::cdr_bytes(s);
+    const std::int64_t t0 = common::monotonic_now_ns();
+    f.live.put(kDeformationState, bytes, common::wall_now_ns());
+    worst_put_ns = std::max(worst_put_ns, common::monotonic_now_ns() - t0);
+    std::this_thread::sleep_until(start + (i + 1) * 10ms);
+  }
+  stop = true;
+  const int received = fast_messages.load();
+  fast.ws.next_layer().close();
+  reader.join();
+  const ServerStats stats = f.server->stats();
+  std::printf(
+      "slow client: %llu frames dropped; the reading client got %d of 300 states in 3 s "
+      "(%.0f/s); worst put %.1f us; %llu ticks\n",
+      static_cast<unsigned long long>(stats.frames_dropped), received, received / 3.0,
+      static_cast<double>(worst_put_ns) * 1e-3, static_cast<unsigned long long>(stats.ticks));
+  EXPECT_GT(stats.frames_dropped, 0U);
+  EXPECT_GE(received, 90);  // >= 30/s despite the slow client
+  EXPECT_LT(worst_put_ns, 20'000'000);
+}
+
+}  // namespace
+}  // namespace fahr::visualizer_service
