@@ -152,6 +152,17 @@ int main(int argc, char** argv) try {
                 1e-6 * static_cast<double>(fem_cpu.percentile(0.5).count()),
                 1e-6 * static_cast<double>(fem_cpu.percentile(0.99).count()),
                 1e-6 * static_cast<double>(fem_cpu.max().count()));
+    const auto& thread_cpu = sim.fem_step_thread_cpu();
+    std::printf(
+        "stack_sim: FEM step thread CPU ms median %.2f p99 %.2f max %.2f; background "
+        "factorisation CPU %.2f s, %.2f ms a step\n",
+        1e-6 * static_cast<double>(thread_cpu.percentile(0.5).count()),
+        1e-6 * static_cast<double>(thread_cpu.percentile(0.99).count()),
+        1e-6 * static_cast<double>(thread_cpu.max().count()),
+        1e-9 * static_cast<double>(sim.fem_background_cpu().count()),
+        thread_cpu.count() == 0 ? 0.0
+                                : 1e-6 * static_cast<double>(sim.fem_background_cpu().count()) /
+                                      static_cast<double>(thread_cpu.count()));
     const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
     std::printf("stack_sim: haptic tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f\n",
                 us(cpu.percentile(0.5)), us(cpu.percentile(0.99)), us(cpu.percentile(0.999)),

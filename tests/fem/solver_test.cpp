@@ -118,6 +118,68 @@ TEST(Solvers, CgRefreshesItsFactorOnlyWhenTheSolveGetsExpensive) {
   EXPECT_LT(refreshed_most, never_most);
 }
 
+TEST(Solvers, BackgroundFactorisationsArriveOnTheirStepAndReachTheSameEquilibrium) {
+  // A refactorisation on the background thread replaces the factor exactly
+  // latency / h steps after the step that began it (the step waits for it),
+  // so two runs give the same bits, and the force is exact every step, so
+  // the bar settles where the exact step settles it.
+  const BodyMesh mesh = test::bar_mesh(2);
+  SolverSettings background;
+  background.refactor_period = 0;
+  background.refactor_rotation_rad = 0.1;
+  background.background_factor_latency_s = 0.03;  // three 10 ms steps
+  const auto trajectory = [&](std::vector<int>& installed_at, std::uint64_t& factorisations) {
+    BodySettings settings;
+    settings.solver = background;
+    settings.time_step = std::chrono::duration<double>(0.01);
+    settings.sleep.enabled = false;
+    auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+    EXPECT_NE(body, nullptr);
+    std::vector<double> all;
+    for (int k = 0; k < 400; ++k) {
+      if (body->step().refactorised) installed_at.push_back(k);
+      all.insert(all.end(), body->positions_m().begin(), body->positions_m().end());
+    }
+    factorisations = body->factorisations() - 1;
+    EXPECT_GT(body->background_cpu_ns(), 0);
+    return all;
+  };
+  std::vector<int> first_installs;
+  std::vector<int> second_installs;
+  std::uint64_t first_count = 0;
+  std::uint64_t second_count = 0;
+  const auto first = trajectory(first_installs, first_count);
+  const auto second = trajectory(second_installs, second_count);
+  EXPECT_EQ(std::memcmp(first.data(), second.data(), sizeof(double) * first.size()), 0);
+  EXPECT_EQ(first_installs, second_installs);
+  ASSERT_GT(first_installs.size(), 1u);
+  EXPECT_EQ(first_count, first_installs.size());
+  // One at a time: installs are at least the latency apart.
+  for (std::size_t i = 1; i < first_installs.size(); ++i)
+    EXPECT_GE(first_installs[i] - first_installs[i - 1], 3);
+  const auto reference = run(SolverSettings{}, 400);
+  const std::vector<double> last(first.end() - static_cast<std::ptrdiff_t>(reference.size()),
+                                 first.end());
+  EXPECT_LT(largest_difference(reference, last), 1e-6);
+  // The same trigger inside the step: the background run refactorised less
+  // often, never more.
+  SolverSettings inside = background;
+  inside.background_factor_latency_s = 0.0;
+  std::vector<int> unused;
+  BodySettings settings;
+  settings.solver = inside;
+  settings.time_step = std::chrono::duration<double>(0.01);
+  settings.sleep.enabled = false;
+  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(body, nullptr);
+  for (int k = 0; k < 400; ++k) body->step();
+  EXPECT_LE(first_count, body->factorisations() - 1);
+  EXPECT_EQ(body->background_cpu_ns(), 0);
+  SolverSettings bad;
+  bad.background_factor_latency_s = -1.0;
+  EXPECT_NE(body->set_solver(bad).find("background_factor_latency_s"), std::string::npos);
+}
+
 TEST(Solvers, SetSolverSwitchesARunningBodyAndRejectsBadSettings) {
   const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;

@@ -34,6 +34,10 @@ std::string validate(const SolverSettings& solver) {
   if (!(solver.tangent_reuse_change >= 0.0)) {
     return "solver settings: tangent_reuse_change must be >= 0";
   }
+  if (!(solver.background_factor_latency_s >= 0.0) ||
+      !std::isfinite(solver.background_factor_latency_s)) {
+    return "solver settings: background_factor_latency_s must be finite and >= 0";
+  }
   return {};
 }
 
@@ -143,7 +147,22 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
     return "CHOLMOD symbolic analysis failed";
   assemble_system();
   if (!refactorise()) return "the rest system matrix is not positive definite";
+  return configure_background_factor();
+}
+
+std::string Body::configure_background_factor() {
+  const SolverSettings& solver = settings_.solver;
+  factor_latency_steps_ = 0;
+  if (!(solver.background_factor_latency_s > 0.0) || solver.refactor_period == 1) return {};
+  if (!cholmod_.enable_background()) return "CHOLMOD background factorisation failed to start";
+  factor_latency_steps_ = static_cast<std::uint64_t>(
+      std::max(1.0, std::ceil(solver.background_factor_latency_s / h_ - 1e-9)));
   return {};
+}
+
+void Body::cancel_background_factor() {
+  cholmod_.cancel_factorize();
+  factor_pending_ = false;
 }
 
 void Body::assemble_system() {
@@ -202,6 +221,7 @@ std::string Body::set_solver(const SolverSettings& solver) {
   if (!error.empty()) return error;
   const bool reanalyse = solver.cholmod.factor != settings_.solver.cholmod.factor ||
                          solver.cholmod.ordering != settings_.solver.cholmod.ordering;
+  cancel_background_factor();
   settings_.solver = solver;
   warp_.set_enabled(solver.warp_lagged_factor);
   if (reanalyse && !cholmod_.analyze(assembly_.matrix(), solver.cholmod))
@@ -210,10 +230,15 @@ std::string Body::set_solver(const SolverSettings& solver) {
   if (snh_) update_deformations();
   assemble_system();
   if (!refactorise()) return "the system matrix is not positive definite";
-  return {};
+  return configure_background_factor();
 }
 
 bool Body::refactorise() {
+  mark_factor_state();
+  return cholmod_.factorize();
+}
+
+void Body::mark_factor_state() {
   steps_since_factor_ = 0;
   refresh_due_ = false;
   for (std::size_t i = 0; i < held_at_factor_count_; ++i) held_at_factor_[factor_held_[i]] = 0;
@@ -228,7 +253,6 @@ bool Body::refactorise() {
             stiffening_scales_at_factor_.begin());
   std::copy(deformations_.begin(), deformations_.end(), deformations_at_factor_.begin());
   warp_.mark_factorised();
-  return cholmod_.factorize();
 }
 
 int Body::update_rotations_and_forces(bool accumulate_energy, double* elastic_energy_j) {
@@ -405,6 +429,15 @@ void Body::prepare_system(StepReport& report) {
   const SolverSettings& solver = settings_.solver;
   const bool cg = solver.kind == LinearSolver::kConjugateGradient;
   const bool factor_needed = !cg || solver.preconditioner == CgPreconditioner::kLaggedCholesky;
+  if (factor_pending_ && step_ >= factor_install_step_) {
+    // The background factorisation begun factor_latency_steps_ ago: waited
+    // for if not done, so its step does not depend on the thread's speed.
+    factor_pending_ = false;
+    report.refactorised = cholmod_.finish_factorize();
+    // A failed one (A not positive definite) leaves the factor before; the
+    // triggers then compare against the state it failed at, so ask again.
+    refresh_due_ = refresh_due_ || !report.refactorised;
+  }
   const bool factor_due =
       (solver.refactor_period > 0 && steps_since_factor_ + 1 >= solver.refactor_period) ||
       (factor_needed && refresh_due_) ||
@@ -412,10 +445,17 @@ void Body::prepare_system(StepReport& report) {
        (support_changed_factor_due(cg) || rotated_since_factor() || stiffened_since_factor() ||
         deformed_since_factor()));
   if (factor_needed) warp_.update_rotations(rest_, rotations_);
+  // One background factorisation at a time: a trigger while one is under
+  // way waits for it (the triggers then compare against its state).
+  const bool begin = factor_due && factor_needed && !factor_pending_;
   // CG multiplies with the current A; the direct solve only needs A when it
   // refactorises.
-  if (cg || (factor_due && factor_needed)) assemble_system();
-  if (factor_due && factor_needed) {
+  if (cg || begin) assemble_system();
+  if (begin && background_factor()) {
+    mark_factor_state();
+    factor_pending_ = cholmod_.begin_factorize();
+    factor_install_step_ = step_ + factor_latency_steps_;
+  } else if (begin) {
     report.refactorised = refactorise();
   } else {
     ++steps_since_factor_;
@@ -552,6 +592,7 @@ void Body::wake() {
 }
 
 bool Body::reset_to_rest() {
+  cancel_background_factor();
   x_ = rest_x_;
   v_.setZero();
   clear_external_forces();

@@ -3,10 +3,16 @@
 #include "fahr/fem/cholmod_solver.h"
 
 #include <cholmod.h>
+#include <pthread.h>
 
 #include <algorithm>
 #include <array>
+#include <condition_variable>
 #include <cstring>
+#include <ctime>
+#include <mutex>
+#include <thread>
+#include <vector>
 
 namespace fahr::fem {
 
@@ -31,6 +37,67 @@ struct CholmodSolver::State {
   bool numeric = false;
   std::size_t rows = 0;
 
+  // The background factorisation: its own CHOLMOD workspace, a second
+  // factor with the same analysis, and a copy of the values it factorises
+  // (the caller may assemble the next A meanwhile). `running` and `ok` are
+  // guarded by `mutex`; the thread touches nothing else of the State but
+  // these members while a job runs.
+  struct Background {
+    cholmod_common common{};
+    cholmod_factor* factor = nullptr;
+    cholmod_sparse view{};
+    std::vector<double> values;
+    std::thread thread;
+    clockid_t cpu_clock{};
+    std::mutex mutex;
+    std::condition_variable wake;
+    bool job = false;      // a factorisation was asked for and not taken yet
+    bool running = false;  // begun and not finished or cancelled
+    bool ok = false;
+    bool stop = false;
+  };
+  std::unique_ptr<Background> background;
+
+  void run_background() {
+    Background& b = *background;
+    std::unique_lock lock(b.mutex);
+    for (;;) {
+      b.wake.wait(lock, [&] { return b.job || b.stop; });
+      if (b.stop) return;
+      lock.unlock();
+      const int ok = cholmod_factorize(&b.view, b.factor, &b.common);
+      const bool good = ok != 0 && b.common.status == CHOLMOD_OK;
+      lock.lock();
+      b.ok = good;
+      b.job = false;
+      b.wake.notify_all();
+    }
+  }
+
+  // Waits for the running job, if any; true if it produced a factor.
+  bool wait_background() {
+    Background& b = *background;
+    std::unique_lock lock(b.mutex);
+    b.wake.wait(lock, [&] { return !b.job; });
+    const bool good = b.running && b.ok;
+    b.running = false;
+    return good;
+  }
+
+  void stop_background() {
+    if (!background) return;
+    {
+      std::lock_guard lock(background->mutex);
+      background->stop = true;
+    }
+    background->wake.notify_all();
+    if (background->thread.joinable()) background->thread.join();
+    if (background->factor != nullptr)
+      cholmod_free_factor(&background->factor, &background->common);
+    cholmod_finish(&background->common);
+    background.reset();
+  }
+
   // The set kept for this column count, else the least recently used one
   // (whose buffers CHOLMOD will reallocate to the new shape).
   Buffers& buffers_for(int columns) {
@@ -54,6 +121,7 @@ struct CholmodSolver::State {
   }
 
   ~State() {
+    stop_background();
     if (factor != nullptr) cholmod_free_factor(&factor, &common);
     for (Buffers& b : sets) release(b);
     cholmod_finish(&common);
@@ -118,6 +186,9 @@ bool CholmodSolver::analyze(const SparseMatrix& matrix, const CholmodOptions& op
         options.ordering == CholmodOrdering::kAmd ? CHOLMOD_AMD : CHOLMOD_METIS;
     s.common.postorder = 1;
   }
+  // A new analysis: the background's factor belongs to the old one.
+  const bool had_background = s.background != nullptr;
+  s.stop_background();
   if (s.factor != nullptr) cholmod_free_factor(&s.factor, &s.common);
   s.numeric = false;
   s.rows = static_cast<std::size_t>(matrix.rows());
@@ -136,7 +207,77 @@ bool CholmodSolver::analyze(const SparseMatrix& matrix, const CholmodOptions& op
   s.view.sorted = 1;
   s.view.packed = 1;
   s.factor = cholmod_analyze(&s.view, &s.common);
-  return s.factor != nullptr && s.common.status >= CHOLMOD_OK;
+  const bool analysed = s.factor != nullptr && s.common.status >= CHOLMOD_OK;
+  return analysed && (!had_background || enable_background());
+}
+
+bool CholmodSolver::enable_background() {
+  State& s = *state_;
+  if (s.background) return true;
+  if (s.factor == nullptr) return false;
+  auto b = std::make_unique<State::Background>();
+  cholmod_start(&b->common);
+  b->common.print = 0;
+  b->common.supernodal = s.common.supernodal;
+  // The same symbolic analysis (ordering, supernodes), no numeric values.
+  cholmod_factor* symbolic = cholmod_copy_factor(s.factor, &s.common);
+  if (symbolic == nullptr) {
+    cholmod_finish(&b->common);
+    return false;
+  }
+  b->factor = symbolic;
+  b->values.assign(s.view.nzmax, 0.0);
+  b->view = s.view;
+  b->view.x = b->values.data();
+  s.background = std::move(b);
+  State* state = &s;
+  s.background->thread = std::thread([state] { state->run_background(); });
+  pthread_getcpuclockid(s.background->thread.native_handle(), &s.background->cpu_clock);
+  return true;
+}
+
+bool CholmodSolver::begin_factorize() {
+  State& s = *state_;
+  if (!s.background) return false;
+  State::Background& b = *s.background;
+  {
+    std::lock_guard lock(b.mutex);
+    if (b.running) return false;
+    std::memcpy(b.values.data(), s.view.x, sizeof(double) * b.values.size());
+    b.running = true;
+    b.job = true;
+    b.ok = false;
+  }
+  b.wake.notify_all();
+  return true;
+}
+
+bool CholmodSolver::factorizing() const {
+  if (!state_->background) return false;
+  std::lock_guard lock(state_->background->mutex);
+  return state_->background->running;
+}
+
+bool CholmodSolver::finish_factorize() {
+  State& s = *state_;
+  if (!s.background || !s.wait_background()) return false;
+  // The new factor takes the place of the old, which becomes the next
+  // job's: both were allocated with the same (system) allocator.
+  std::swap(s.factor, s.background->factor);
+  s.numeric = true;
+  ++s.factorisations;
+  return true;
+}
+
+void CholmodSolver::cancel_factorize() {
+  if (state_->background) state_->wait_background();
+}
+
+std::int64_t CholmodSolver::background_cpu_ns() const {
+  if (!state_->background) return 0;
+  timespec t{};
+  if (clock_gettime(state_->background->cpu_clock, &t) != 0) return 0;
+  return std::int64_t{t.tv_sec} * 1'000'000'000 + t.tv_nsec;
 }
 
 bool CholmodSolver::factorize() {

@@ -246,7 +246,7 @@ FemSolverSettings parse_solver(const ParseContext& ctx, const MapReader& top) {
       ctx.log, top.value("solver"), "solver",
       {"linear_solver", "cg_tolerance", "cg_max_iterations", "projection_max_iterations",
        "projection_tolerance_m", "compliance", "compliance_columns", "max_candidate_contacts",
-       "max_contact_age_ms", "sleep_speed_mps", "volume_floor_ratio"});
+       "max_contact_age_ms", "sleep_speed_mps", "volume_floor_ratio", "factor_latency_ms"});
   map.read_enum("linear_solver", kLinearSolverNames, s.linear_solver);
   if (s.linear_solver != LinearSolver::kPcg) {
     for (const char* key : {"cg_tolerance", "cg_max_iterations"}) {
@@ -264,6 +264,7 @@ FemSolverSettings parse_solver(const ParseContext& ctx, const MapReader& top) {
   map.read_ms("max_contact_age_ms", open_closed(0.0, 10000.0), s.max_contact_age);
   map.read("sleep_speed_mps", closed(0.0, 1.0), s.sleep_speed_mps);
   map.read("volume_floor_ratio", closed(0.0, 0.9), s.volume_floor_ratio);
+  map.read_ms("factor_latency_ms", closed(0.0, 1000.0), s.factor_latency);
   return s;
 }
 

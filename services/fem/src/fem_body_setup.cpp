@@ -75,6 +75,8 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
     s.solver.refactor_deformation_change = 0.0;
     s.solver.cg_refresh_iterations = 12;
   }
+  s.solver.background_factor_latency_s =
+      std::chrono::duration<double>(scene.solver.factor_latency).count();
   s.solver.cg_relative_tolerance = scene.solver.cg_tolerance;
   s.solver.cg_max_iterations = scene.solver.cg_max_iterations;
   s.projection.max_sweeps = scene.solver.projection_max_iterations;

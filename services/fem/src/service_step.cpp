@@ -161,4 +161,11 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("spheres", static_cast<double>(setup_.links.size()));
 }
 
+std::int64_t ServiceStep::take_background_cpu_ns() {
+  const std::int64_t now = setup_.body->background_cpu_ns();
+  const std::int64_t used = now - background_cpu_taken_ns_;
+  background_cpu_taken_ns_ = now;
+  return used;
+}
+
 }  // namespace fahr::fem_service

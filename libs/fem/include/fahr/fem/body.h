@@ -191,6 +191,9 @@ class Body {
   double factor_nonzeros() const { return cholmod_.factor_nonzeros(); }
   // Numeric factorisations so far, set-up included.
   std::uint64_t factorisations() const { return cholmod_.factorisations(); }
+  // CPU time of the background factorisation thread so far, ns
+  // (SolverSettings::background_factor_latency_s; 0 without it).
+  std::int64_t background_cpu_ns() const { return cholmod_.background_cpu_ns(); }
 
  private:
   Body() = default;
@@ -214,6 +217,13 @@ class Body {
   void finish_step(StepReport& report);
   void assemble_system();
   bool refactorise();
+  // What refactorise() records of the state A was assembled at (the
+  // triggers compare against it), without the factorisation.
+  void mark_factor_state();
+  // Starts or installs background factorisations (prepare_system).
+  bool background_factor() const { return factor_latency_steps_ > 0; }
+  void cancel_background_factor();
+  std::string configure_background_factor();
   // Brings the factor W is solved on up to date where the solver keeps none.
   bool prepare_compliance_factor();
   // True if an element rotated more than the setting since the factorisation.
@@ -274,6 +284,11 @@ class Body {
   std::size_t support_changes_ = 0;
   static constexpr std::size_t kSupportChangesForRefresh = 8;
   int steps_since_factor_ = 0;
+  // Background factorisation: steps from its start to its use (0: none),
+  // whether one is under way, and the step it is installed at.
+  std::uint64_t factor_latency_steps_ = 0;
+  bool factor_pending_ = false;
+  std::uint64_t factor_install_step_ = 0;
   // A CG solve took more than cg_refresh_iterations: refactorise next step.
   bool refresh_due_ = false;
   bool external_force_set_ = false;

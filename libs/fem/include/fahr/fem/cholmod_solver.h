@@ -1,5 +1,10 @@
 // Sparse Cholesky on SuiteSparse CHOLMOD: symbolic analysis once, numeric
 // factorisation when the values change, solves into preallocated storage.
+// A numeric factorisation may also run on a thread of its own while solves
+// go on with the factor before it (the asynchronous factorisation of
+// Courtecuisse, Allard, Duriez and Cotin, "Asynchronous preconditioners for
+// efficient solving of non-linear deformable objects", VRIPHYS 2010); the
+// caller decides when the new factor replaces the old one.
 #pragma once
 
 #include <cstdint>
@@ -60,6 +65,23 @@ class CholmodSolver {
   // dimension A.rows(). No allocation after the first call with this count
   // while at most kColumnCounts different counts are in use.
   void solve_columns(std::span<const double> b, std::span<double> x, int columns);
+
+  // Background factorisation. enable_background() (set-up: it starts the
+  // thread and allocates a second factor and a copy of the values) after
+  // analyze(). begin_factorize() copies the matrix's current values and
+  // factorises them on the thread; solves meanwhile use the factor before.
+  // False if no background is enabled or one is already running.
+  // finish_factorize() waits for it and, if the values were positive
+  // definite, makes it the factor solves use (a factorisation counted);
+  // false if it failed, the factor before then stays. cancel_factorize()
+  // waits and throws the result away (before a synchronous factorize()).
+  bool enable_background();
+  bool begin_factorize();
+  bool factorizing() const;
+  bool finish_factorize();
+  void cancel_factorize();
+  // CPU time the background thread has used so far, ns (0 without one).
+  std::int64_t background_cpu_ns() const;
 
   // Non-zeros of the factor L, for reports.
   double factor_nonzeros() const;

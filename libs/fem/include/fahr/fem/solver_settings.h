@@ -57,6 +57,16 @@ struct SolverSettings {
   // about 1 %, a tenth of what the refresh trigger allows. The force is
   // exact every step either way, so the equilibrium does not depend on it.
   double tangent_reuse_change = 0.01;
+  // A refactorisation the triggers above ask for runs on a thread of its
+  // own, from A as assembled at that step, and replaces the factor in use
+  // this long after (rounded up to whole steps), the step waiting for it
+  // then if it is not done: the step never pays a factorisation, and the
+  // same inputs give the same bits however fast the thread was (lockstep).
+  // The factor in use is then older by this latency; the force is exact
+  // every step, so the equilibrium does not depend on it. 0: the
+  // factorisation runs inside the step that asks for it. Ignored with
+  // refactor_period 1 (the exact step).
+  double background_factor_latency_s = 0.0;
   // Rotate a reused factorisation per node into the current frame (see
   // warped_factor.h). Off only to measure what it buys.
   bool warp_lagged_factor = false;

@@ -47,6 +47,10 @@ struct FemSolverSettings {
   // No tet ends a FEM step below this share of its rest volume
   // (libs/fem volume_floor.h), [0, 0.9]; 0: no floor.
   double volume_floor_ratio = 0.0;
+  // A refactorisation runs beside the step and is used this long after it
+  // began (libs/fem SolverSettings::background_factor_latency_s), [0, 1 s];
+  // 0: inside the step.
+  std::chrono::nanoseconds factor_latency{0};
 };
 
 }  // namespace fahr::scene

@@ -71,6 +71,10 @@ class ServiceStep {
   // divergence), for the service's ServiceEvents; called off the step.
   void take_errors(std::vector<std::string>& errors);
 
+  // CPU the body's background factorisation thread used since the last
+  // call, ns: with the step thread's own, the step's CPU on all threads.
+  std::int64_t take_background_cpu_ns();
+
   // The service's own ServiceStatus metrics.
   void metrics(std::vector<std::pair<std::string, double>>& out) const;
 
@@ -99,6 +103,7 @@ class ServiceStep {
   std::uint64_t anatomy_beyond_steps_ = 0;
   double anatomy_depth_max_m_ = 0.0;
   std::uint64_t stale_sets_ = 0;
+  std::int64_t background_cpu_taken_ns_ = 0;
 };
 
 }  // namespace fahr::fem_service

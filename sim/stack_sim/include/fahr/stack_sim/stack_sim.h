@@ -102,7 +102,11 @@ class StackSim {
   const metrics::DurationHistogram& haptic_tick_cpu() const { return haptic_tick_cpu_; }
   // Thread-CPU time of each FEM service step so far (the step and its
   // DeformationState, no transport), 50 us bins (up to 100 ms): against the FEM's period.
+  // A FEM step's CPU on all the FEM's threads: its own and the background
+  // factorisation's since the step before; and the step's thread alone.
   const metrics::DurationHistogram& fem_step_cpu() const { return fem_step_cpu_; }
+  const metrics::DurationHistogram& fem_step_thread_cpu() const { return fem_step_thread_cpu_; }
+  std::chrono::nanoseconds fem_background_cpu() const { return fem_background_cpu_; }
   std::chrono::nanoseconds last_fem_step_cpu() const { return last_fem_step_cpu_; }
 
   // Output hashes as the distributed lockstep computes them.
@@ -141,6 +145,8 @@ class StackSim {
 
   metrics::DurationHistogram haptic_tick_cpu_{std::chrono::microseconds(5)};
   metrics::DurationHistogram fem_step_cpu_{std::chrono::microseconds(50)};
+  metrics::DurationHistogram fem_step_thread_cpu_{std::chrono::microseconds(50)};
+  std::chrono::nanoseconds fem_background_cpu_{0};
   std::chrono::nanoseconds last_fem_step_cpu_{0};
   common::OutputHash gateway_hash_;
   common::OutputHash haptic_hash_;
