@@ -198,6 +198,37 @@ void Body::assemble_system() {
   }
 }
 
+void Body::assemble_current(SystemAssembly& out) const {
+  const double alpha = settings_.material.rayleigh_mass_per_s;
+  const double beta = settings_.material.rayleigh_stiffness_s;
+  const double stiffness_scale = h_ * beta + h_ * h_;
+  if (snh_) {
+    out.zero();
+    for (std::size_t e = 0; e < rest_.size(); ++e) {
+      const Eigen::Matrix3d f =
+          geometry::deformation_gradient(x_.data(), rest_.tets[e], rest_.dm_inv[e]);
+      out.add_element(e,
+                      element_stiffness(shape_gradients(rest_.dm_inv[e]), rest_.volume_m3[e],
+                                        snh_->projected_hessian(f)),
+                      stiffness_scale);
+    }
+    out.add_mass(mass_per_dof_, 1.0 + h_ * alpha);
+  } else {
+    std::vector<Eigen::Matrix3d> rotations(rest_.size());
+    std::vector<double> scales(stiffening_ ? rest_.size() : 0, 1.0);
+    for (std::size_t e = 0; e < rest_.size(); ++e) {
+      const Eigen::Matrix3d f =
+          geometry::deformation_gradient(x_.data(), rest_.tets[e], rest_.dm_inv[e]);
+      rotations[e] = rotation_from_deformation(f).rotation;
+      if (stiffening_) scales[e] = stiffening_scale(f, settings_.material.yeoh_c20_over_c10);
+    }
+    out.assemble(rest_, rotations, lame_, mass_per_dof_, 1.0 + h_ * alpha, stiffness_scale, scales);
+  }
+  for (std::size_t i = 0; i < support_count_; ++i) {
+    out.add_normal_stiffness(supports_[i].node, supports_[i].normal, support_ratio_);
+  }
+}
+
 void Body::set_supports(std::span<const NodeSupport> supports, double stiffness_ratio) {
   support_count_ = 0;
   support_ratio_ = stiffness_ratio > 0.0 ? stiffness_ratio : 0.0;

@@ -188,6 +188,14 @@ class Body {
   const BodySettings& settings() const { return settings_; }
   bool hyperelastic() const { return snh_.has_value(); }
   const SparseMatrix& system_matrix() const { return assembly_.matrix(); }
+  // A as the next step would linearise it, at the current positions with
+  // every element's tangent (or rotation) computed afresh and the current
+  // supports, written into `out` (built for this body: same node count,
+  // rest data and fixed DOFs). For audits of a lagged factor and of W; the
+  // body is not changed. Allocates (the corotational rotations).
+  void assemble_current(SystemAssembly& out) const;
+  // The fixed DOFs, one flag per DOF, as assembly and compliance take them.
+  std::span<const std::uint8_t> fixed_dofs() const { return fixed_dof_; }
   double factor_nonzeros() const { return cholmod_.factor_nonzeros(); }
   // Numeric factorisations so far, set-up included.
   std::uint64_t factorisations() const { return cholmod_.factorisations(); }
