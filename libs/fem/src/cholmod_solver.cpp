@@ -4,6 +4,8 @@
 
 #include <cholmod.h>
 #include <pthread.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -15,6 +17,11 @@
 #include <vector>
 
 namespace fahr::fem {
+
+namespace {
+// The background factorisation's nice value (the logger's writer has 10).
+constexpr int kBackgroundNice = 10;
+}  // namespace
 
 struct CholmodSolver::State {
   cholmod_common common{};
@@ -59,6 +66,10 @@ struct CholmodSolver::State {
   std::unique_ptr<Background> background;
 
   void run_background() {
+    // Below the servo and haptic threads on a machine with few cores: on
+    // Linux nice is per thread (PRIO_PROCESS with the thread's id). The
+    // step waits for this thread only at the install step.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kBackgroundNice);
     Background& b = *background;
     std::unique_lock lock(b.mutex);
     for (;;) {
