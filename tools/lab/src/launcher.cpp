@@ -205,14 +205,10 @@ Child make_child(const Plan& plan, const PlannedParticipant& p, const fs::path& 
       if (s.args.empty()) add({"--backend", "simulated", "--script", "intubation"});
       break;
     }
-    case ServiceKind::kSummary: {
-      char duration[32];
-      std::snprintf(duration, sizeof duration, "%g",
-                    station.duration_s > 0 ? station.duration_s + 2 : 0.0);
-      add({program_path("fahr_run_summary", "tools/run_summary").string(), "--duration-s",
-           duration});
+    case ServiceKind::kSummary:
+      // Listens until the station stops it (it prints on SIGINT).
+      add({program_path("fahr_run_summary", "tools/run_summary").string(), "--duration-s", "0"});
       break;
-    }
   }
   for (const auto& a : dds) c.argv.push_back(a);
   if (!s.cpus.empty() && s.kind != ServiceKind::kLogger && s.kind != ServiceKind::kSummary &&
