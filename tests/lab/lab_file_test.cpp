@@ -3,9 +3,9 @@
 
 #include <string>
 
-#include "fahr/lab/lab.h"
-#include "fahr/lab/plan.h"
-#include "fahr/lab/profiles.h"
+#include "fahr/lab_plan/lab.h"
+#include "fahr/lab_plan/plan.h"
+#include "fahr/lab_plan/profiles.h"
 
 namespace fahr::lab {
 namespace {

@@ -13,9 +13,9 @@
 #include <cstdio>
 #include <exception>
 
-#include "fahr/lab/lab.h"
-#include "fahr/lab/plan.h"
-#include "fahr/lab/profiles.h"
+#include "fahr/lab_plan/lab.h"
+#include "fahr/lab_plan/plan.h"
+#include "fahr/lab_plan/profiles.h"
 #include "src/launcher.h"
 
 int main(int argc, char** argv) try {

@@ -27,7 +27,7 @@
 #include <thread>
 #include <vector>
 
-#include "fahr/lab/profiles.h"
+#include "fahr/lab_plan/profiles.h"
 
 namespace fahr::lab {
 

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "fahr/lab/plan.h"
+#include "fahr/lab_plan/plan.h"
 
 namespace fahr::lab {
 

@@ -1,5 +1,5 @@
 // Generated vendor configuration of a lab's participants.
-#include "fahr/lab/profiles.h"
+#include "fahr/lab_plan/profiles.h"
 
 #include <cstdio>
 #include <fstream>
@@ -164,6 +164,11 @@ std::string joined_args(const ServiceSpec& s, const Station& station) {
     std::snprintf(d, sizeof d, "%g", station.duration_s);
     add("--duration-s");
     add(d);
+  }
+  // The gateway's device: the simulated hand on the intubation script unless
+  // the lab file names one (as fahr_lab up does).
+  if (s.kind == ServiceKind::kDeviceGateway && s.args.empty()) {
+    for (const char* a : {"--backend", "simulated", "--script", "intubation"}) add(a);
   }
   for (const auto& a : s.args) add(a);
   return out;

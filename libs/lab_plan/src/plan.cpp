@@ -1,5 +1,5 @@
 // Participant indices, ports and peers of a lab.
-#include "fahr/lab/plan.h"
+#include "fahr/lab_plan/plan.h"
 
 #include <cstdio>
 #include <map>

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "fahr/lab/lab.h"
+#include "fahr/lab_plan/lab.h"
 
 namespace fahr::lab {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "fahr/lab/plan.h"
+#include "fahr/lab_plan/plan.h"
 
 namespace fahr::lab {
 

@@ -7,7 +7,7 @@
 #include <set>
 #include <sstream>
 
-#include "fahr/lab/lab.h"
+#include "fahr/lab_plan/lab.h"
 #include "yaml_reader.h"
 
 namespace fahr::lab {
