@@ -20,18 +20,21 @@ install(DIRECTORY deployment/scenes deployment/dds deployment/labs
   DESTINATION ${FAHR_DATA_DIR}/deployment)
 install(DIRECTORY meshes/ DESTINATION ${FAHR_DATA_DIR}/meshes
   PATTERN "*.png" EXCLUDE)
-# systemd template units with the installed programs' full paths; the
-# station's target; the socket-buffer limits.
+# systemd template units, written at install time so that ExecStart names
+# the programs where this install puts them (cmake --install --prefix, or
+# CPack's /usr); the station's target; the socket-buffer limits.
 file(GLOB FAHR_UNIT_TEMPLATES ${CMAKE_CURRENT_SOURCE_DIR}/deployment/systemd/*.service.in)
-set(FAHR_UNITS ${CMAKE_CURRENT_SOURCE_DIR}/deployment/systemd/fahr-station@.target)
-foreach(template IN LISTS FAHR_UNIT_TEMPLATES)
-  get_filename_component(unit ${template} NAME_WLE)
-  configure_file(${template} ${CMAKE_CURRENT_BINARY_DIR}/deployment/systemd/${unit} @ONLY)
-  list(APPEND FAHR_UNITS ${CMAKE_CURRENT_BINARY_DIR}/deployment/systemd/${unit})
-endforeach()
 set(FAHR_SYSTEMD_UNIT_DIR lib/systemd/system CACHE STRING
   "where the systemd units go, relative to the prefix")
-install(FILES ${FAHR_UNITS} DESTINATION ${FAHR_SYSTEMD_UNIT_DIR})
+install(CODE "
+  foreach(template ${FAHR_UNIT_TEMPLATES})
+    get_filename_component(unit \${template} NAME_WLE)
+    set(CMAKE_INSTALL_FULL_BINDIR \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}\")
+    set(destination \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${FAHR_SYSTEMD_UNIT_DIR}\")
+    message(STATUS \"Installing: \${destination}/\${unit}\")
+    configure_file(\${template} \${destination}/\${unit} @ONLY)
+  endforeach()")
+install(FILES deployment/systemd/fahr-station@.target DESTINATION ${FAHR_SYSTEMD_UNIT_DIR})
 install(FILES deployment/systemd/60-fahr.conf DESTINATION lib/sysctl.d)
 install(FILES deployment/compose.yaml deployment/Dockerfile DESTINATION ${FAHR_DATA_DIR}/deployment)
 

@@ -425,7 +425,9 @@ int station_up(const Plan& plan, const Station& station, const UpOptions& option
                                 WIFEXITED(status) && WEXITSTATUS(status) == 0;
       if (gateway_done) {
         c.state = "finished";
-        why_stopped = "the gateway's run of " + std::to_string(station.duration_s) + " s ended";
+        char text[64];
+        std::snprintf(text, sizeof text, "the gateway's run of %g s ended", station.duration_s);
+        why_stopped = text;
         g_stop.store(true);
         break;
       }
