@@ -4,7 +4,9 @@
 # in each, every service started by fahr_lab up from one lab file:
 #   h1 (10.77.0.1): device gateway + haptic
 #   h2 (10.77.0.2): FEM
-#   h3 (10.77.0.3): logger + run summary, and the probes
+#   h3 (10.77.0.3): logger (on the haptic service's vendor, so the
+#                   FEM-to-recorder latency is the FEM-to-haptic vendor pair's)
+#                   + run summary, and the probes
 # A second station of the lab shares the domain under another partition; a
 # probe in its partition must match nothing of the running station. Another
 # probe in the station's partition measures discovery: a participant joining
@@ -95,7 +97,7 @@ stations:
       device_gateway: {host: h1, vendor: $gateway_v}
       haptic: {host: h1, vendor: $haptic_v}
       fem: {host: h2, vendor: $fem_v}
-      logger: {host: h3, vendor: cyclonedds, args: [--decimate, fahr/DeformationState=10]}
+      logger: {host: h3, vendor: $haptic_v, args: [--decimate, fahr/DeformationState=10]}
       summary: {host: h3, vendor: cyclonedds}
   - name: bed-2
     domain: 17
@@ -164,6 +166,16 @@ fem_line=$(grep "steps, stale contact sets" "$r2/fem.log" || true)
 haptic_line=$(grep "ticks on .* FEM states" "$r1/haptic.log" || true)
 gateway_line=$(grep "^device_gateway: ticks" "$r1/device_gateway.log" || true)
 logger_table=$(grep "^fahr_logger: " "$r3/logger.log" | grep -v "recording to" || true)
+# The whole run's latencies from the recording (the namespaces share one
+# kernel clock, so receive minus source time is a one-way latency): motion
+# to force over every answered pose, each topic from its writer's host to
+# the recorder's, and the loss books (gaps before the recorder matched a
+# writer are discovery, not loss).
+trace=""
+if [ -x "$build/tools/trace/fahr_trace" ]; then
+  trace=$("$build/tools/trace/fahr_trace" "$r3/bed-1.mcap" -o "$work/trace.json" 2>&1 |
+    sed -n '/^motion-to-force/,/^DevicePose period/p;/^loss per writer/,$p' | grep -v "^DevicePose period" || true)
+fi
 
 {
   echo "### gateway $gateway_v, haptic $haptic_v, FEM $fem_v: ${seconds} s across three namespaces"
@@ -177,11 +189,19 @@ logger_table=$(grep "^fahr_logger: " "$r3/logger.log" | grep -v "recording to" |
   echo
   echo "$summary"
   echo
-  echo "Recording, per writer (sent = recorded + gaps + drops + skipped):"
-  echo
-  echo '```'
-  echo "$logger_table"
-  echo '```'
+  if [ -n "$trace" ]; then
+    echo "From the recording (fahr_trace; FEM on h2, gateway and haptic on h1, recorder on h3 on $haptic_v):"
+    echo
+    echo '```'
+    echo "$trace"
+    echo '```'
+  else
+    echo "Recording, per writer (sent = recorded + gaps + drops + skipped):"
+    echo
+    echo '```'
+    echo "$logger_table"
+    echo '```'
+  fi
 } >"$work/report.md"
 cat "$work/report.md"
 [ -n "$report" ] && cat "$work/report.md" >>"$report"
