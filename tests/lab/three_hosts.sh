@@ -164,6 +164,7 @@ other=$(grep -o "endpoints matched: [0-9]*, samples: [0-9]*" "$work/probe_other.
 summary=$(sed -n '/^## fahr run summary/,$p' "$r3/summary.log")
 fem_line=$(grep "steps, stale contact sets" "$r2/fem.log" || true)
 haptic_line=$(grep "ticks on .* FEM states" "$r1/haptic.log" || true)
+pose_line=$(grep "DevicePoses received" "$r1/haptic.log" || true)
 gateway_line=$(grep "^device_gateway: ticks" "$r1/device_gateway.log" || true)
 logger_table=$(grep "^fahr_logger: " "$r3/logger.log" | grep -v "recording to" || true)
 # The whole run's latencies from the recording (the namespaces share one
@@ -184,7 +185,7 @@ fi
   echo "- station bed-2 (same domain, partition bed-2) probe: ${other:-no result}"
   echo "- multicast packets dropped by nftables per host:$drops"
   echo "- FEM: ${fem_line#fahr_fem_service: }"
-  echo "- haptic: ${haptic_line#fahr_haptic_service: }"
+  echo "- haptic: ${haptic_line#fahr_haptic_service: }; ${pose_line#fahr_haptic_service: }"
   echo "- gateway: ${gateway_line#device_gateway: }"
   echo
   echo "$summary"
