@@ -19,8 +19,10 @@ packages=(
   clang libclang-rt-14-dev
   # style checks (tools/lint.sh): Debian's clang-format and clang-tidy 14
   clang-format clang-tidy
-  # network namespaces for multi-process tests
-  iproute2 nftables
+  # network namespaces for multi-process tests; the lab test drops multicast
+  # with nftables and checks the systemd units (systemd-analyze); the .deb
+  # is listed with dpkg-deb (dpkg)
+  iproute2 nftables systemd dpkg
   # MCAP recordings: chunk compression (zstd, lz4) and CRC-32 (zlib)
   libzstd-dev liblz4-dev zlib1g-dev
   # the recorder's HTML report is checked by rendering it headless; the

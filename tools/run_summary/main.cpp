@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "fahr/common/config_error.h"
+#include "fahr/common/stop_signal.h"
 #include "fahr/common/subscriber.h"
 #include "fahr/common/wire_eigen.h"
 
@@ -122,11 +123,12 @@ int main(int argc, char** argv) try {
   CLI::App app{"Summarise a running fahr co-simulation"};
   std::string dds, domain, profile;
   double duration_s = 10;
-  app.add_option("--duration-s", duration_s, "how long to listen");
+  app.add_option("--duration-s", duration_s, "how long to listen (0: until SIGINT or SIGTERM)");
   app.add_option("--dds", dds, "DDS vendor");
   app.add_option("--domain", domain, "DDS domain id");
   app.add_option("--dds-profile", profile, "vendor XML configuration");
   CLI11_PARSE(app, argc, argv);
+  common::install_stop_handlers();
   try {
     common::Participant participant(
         common::transport_config_from(dds, domain, profile, "fahr_run_summary"));
@@ -191,9 +193,18 @@ int main(int argc, char** argv) try {
           tally.limit_n = p.renderable_force_n();
           tally.peak_rendered_n = std::max(tally.peak_rendered_n, norm(p.rendered_force_n()));
         });
-    std::this_thread::sleep_for(std::chrono::duration<double>(duration_s));
+    // Until the duration has passed (0: until SIGINT/SIGTERM), or a stop
+    // signal comes first (fahr_lab stops a station that way): the summary
+    // of what was heard is printed either way.
+    const auto started = std::chrono::steady_clock::now();
+    const auto elapsed_s = [&] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    };
+    while (!common::stop_requested() && (duration_s <= 0 || elapsed_s() < duration_s)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
     std::lock_guard lock(tally.mutex);
-    print(tally, duration_s);
+    print(tally, elapsed_s());
     return 0;
   } catch (const common::ConfigError& e) {
     std::fprintf(stderr, "fahr_run_summary: %s\n", e.what());

@@ -35,6 +35,10 @@ using eprosima::fastrtps::rtps::SerializedPayload_t;
 // preallocated at the type's bound (a DeformationState's bound is 1.7 MB).
 constexpr std::uint32_t kPreallocateLimitBytes = 64 * 1024;
 
+// Requested socket buffer size when a profile sets none; the kernel caps
+// it at net.core.rmem_max / wmem_max (deployment/README.md).
+constexpr std::uint32_t kSocketBufferBytes = 4U * 1024U * 1024U;
+
 Duration_t to_duration(std::chrono::nanoseconds d) {
   const auto ns = d.count();
   return Duration_t(static_cast<std::int32_t>(ns / 1'000'000'000),
@@ -305,13 +309,31 @@ class FastParticipant final : public ParticipantBackend {
         validate(check);
       }
     }
-    if (!profile.empty() && factory->load_XML_profiles_file(profile) != ReturnCode_t::RETCODE_OK) {
-      throw ConfigError("DDS profile '" + profile +
-                        "': Fast DDS could not parse it (malformed XML profile)");
+    // Fast DDS 2.9 takes the factory's default participant QoS from the XML
+    // default profile only when it resets that QoS, and loads its own default
+    // file once (load_profiles). So: the vendor's file first, then this one,
+    // then the reset. Without the reset a profile's transports, peers and
+    // socket buffers were silently ignored.
+    factory->load_profiles();
+    if (!profile.empty()) {
+      if (factory->load_XML_profiles_file(profile) != ReturnCode_t::RETCODE_OK) {
+        throw ConfigError("DDS profile '" + profile +
+                          "': Fast DDS could not parse it (malformed XML profile)");
+      }
+      factory->set_default_participant_qos(dds::PARTICIPANT_QOS_DEFAULT);
     }
-    // The factory's default QoS carries an XML default profile, if any.
     dds::DomainParticipantQos qos = factory->get_default_participant_qos();
     qos.name(config.participant_name);
+    // Socket buffers the size of a burst of large samples, unless a profile
+    // chose them (docs/design/mixed-vendor-load.md): with the system's
+    // default 208 KiB a Cyclone writer's 250 KB DeformationState overflowed
+    // the receive buffer and took DevicePoses on the same socket with it.
+    auto& transport = qos.transport();
+    if (transport.listen_socket_buffer_size == 0) {
+      transport.listen_socket_buffer_size = kSocketBufferBytes;
+    }
+    if (transport.send_socket_buffer_size == 0)
+      transport.send_socket_buffer_size = kSocketBufferBytes;
     participant_ = factory->create_participant(config.domain_id, qos);
     if (participant_ == nullptr) {
       throw std::runtime_error("Fast DDS could not create a participant in domain " +

@@ -38,6 +38,12 @@ void validate(const TransportConfig& config) {
     throw ConfigError("domain_id: " + std::to_string(config.domain_id) + " is out of range [0, " +
                       std::to_string(kMaxDomainId) + "]");
   }
+  // DDS matches partition names with '*', '?' and '[' as patterns: a lab
+  // station's partition is a plain name, or it could match another's.
+  if (config.partition.find_first_of("*?[]\\") != std::string::npos) {
+    throw ConfigError("partition '" + config.partition +
+                      "': wildcard characters (* ? [ ] \\) would match other stations' partitions");
+  }
   if (config.profile_file.empty()) return;
   std::ifstream in(config.profile_file);
   if (!in)
@@ -72,6 +78,7 @@ TransportConfig transport_config_from(std::string_view vendor_flag, std::string_
   }
   config.profile_file =
       profile_flag.empty() ? env_or_empty("FAHR_DDS_PROFILE") : std::string(profile_flag);
+  config.partition = env_or_empty("FAHR_PARTITION");
   validate(config);
   return config;
 }

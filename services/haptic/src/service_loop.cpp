@@ -70,6 +70,12 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
   }
   report.print(contact_sets.handed(), contact_sets.written(), contact_sets.refused(),
                feed.metrics());
+  // Received against the gateway's sequence numbers: a tick runs on the
+  // newest pose, so fewer ticks than poses is lateness; a gap is a pose the
+  // transport lost.
+  std::printf("fahr_haptic_service: DevicePoses received %llu, lost in transport %llu\n",
+              static_cast<unsigned long long>(poses.received()),
+              static_cast<unsigned long long>(poses.missed()));
 }
 
 // One tick per granted base step (the haptic rate is the base rate). At

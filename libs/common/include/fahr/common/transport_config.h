@@ -22,7 +22,8 @@ struct TransportConfig {
   // variable (FASTRTPS_DEFAULT_PROFILES_FILE / CYCLONEDDS_URI) or defaults.
   std::string profile_file;
   // Optional DDS partition for every endpoint, to separate lab stations that
-  // share a domain.
+  // share a domain (FAHR_PARTITION; fahr_lab sets it per station). A plain
+  // name: wildcards are refused.
   std::string partition;
 };
 
@@ -30,7 +31,7 @@ struct TransportConfig {
 // missing or unreadable, profile of the wrong kind for the vendor.
 void validate(const TransportConfig& config);
 
-// Reads FAHR_DDS, FAHR_DOMAIN_ID and FAHR_DDS_PROFILE, overridden by the
+// Reads FAHR_DDS, FAHR_DOMAIN_ID, FAHR_DDS_PROFILE and FAHR_PARTITION, overridden by the
 // non-empty command-line values given. Throws ConfigError on bad values.
 TransportConfig transport_config_from(std::string_view vendor_flag, std::string_view domain_flag,
                                       std::string_view profile_flag, std::string participant_name);
