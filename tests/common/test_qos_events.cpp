@@ -87,17 +87,25 @@ TEST_P(QosEvents, DeadlineMissesCountTheSilence) {
   EXPECT_GT(gap_stop_ns - gap_start_ns, 90'000'000) << "no 100 ms silence seen";
   int in_gap = 0;
   int while_periodic = 0;
+  int unfounded = 0;
   for (auto t : misses_ns) {
     if (t < arrivals_ns.front() || t > arrivals_ns.back())
       continue;  // before the first / after the last sample
     if (t >= gap_start_ns && t <= gap_stop_ns + 2'000'000) {
       ++in_gap;
-    } else {
-      ++while_periodic;
+      continue;
     }
+    ++while_periodic;
+    // Outside the silence a miss is right only if the writer was late
+    // there (a loaded machine can hold it past the 10 ms deadline): the
+    // last sample before it arrived at least the deadline (less 1 ms for
+    // the two timestamps' clocks) earlier.
+    const auto after = std::upper_bound(arrivals_ns.begin(), arrivals_ns.end(), t);
+    if (after == arrivals_ns.begin() || t - *(after - 1) < 9'000'000) ++unfounded;
   }
   EXPECT_NEAR(in_gap, 10, 1) << "missed deadlines during the 100 ms silence";
-  EXPECT_EQ(while_periodic, 0) << "missed deadlines while the writer kept its 5 ms period";
+  EXPECT_EQ(unfounded, 0) << "missed deadlines while samples kept arriving within 10 ms ("
+                          << while_periodic << " misses outside the silence)";
 }
 
 TEST_P(QosEvents, StoppedWriterIsReportedNotAlive) {
