@@ -92,8 +92,8 @@ case "$mode" in
     ;;
   browser)
     start_visualizer --dds cyclonedds --domain 42
-    start_run 25 intubation
-    node "$js/browser_check.mjs" "$url" "$out" 8 live | tee "$out/browser.json"
+    start_run 30 intubation
+    node "$js/browser_check.mjs" "$url" "$out" 14 live | tee "$out/browser.json"
     stop_visualizer
     ;;
   replay)

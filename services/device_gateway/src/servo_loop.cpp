@@ -112,16 +112,19 @@ int run_realtime(const GatewayOptions& o, GatewaySetup& setup, common::Participa
         participant, common::QosProfile::for_role(common::TopicRole::kServoStream),
         kRemoteInputTopic);
   }
-  // The first tick waits (at most 5 s) until the haptic side is matched
-  // both ways: poses sent before that reach nobody, and a scripted hand's
-  // first second would be lost to discovery. Without a match the loop runs
-  // anyway; the safety gate keeps the force at zero.
+  // A scripted hand (the simulated and replayed devices) waits at its first
+  // tick (at most 5 s) until the haptic side is matched both ways: poses
+  // sent before that reach nobody, and the script's first second would be
+  // lost to discovery. A hand that moves by itself (a Touch X, the remote
+  // input) does not wait. Without a match the loop runs anyway; the safety
+  // gate keeps the force at zero.
+  const bool scripted = o.backend == "simulated" || o.backend == "replay";
   const auto match_until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (!common::stop_requested() && std::chrono::steady_clock::now() < match_until &&
+  while (scripted && !common::stop_requested() && std::chrono::steady_clock::now() < match_until &&
          (pose_pub.matched_readers() == 0 || command_sub.matched_writers() == 0)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  if (pose_pub.matched_readers() == 0 || command_sub.matched_writers() == 0) {
+  if (scripted && (pose_pub.matched_readers() == 0 || command_sub.matched_writers() == 0)) {
     std::fprintf(stderr, "fahr_device_gateway: no haptic service matched within 5 s; running\n");
   }
   try_realtime(o.rt_priority);
