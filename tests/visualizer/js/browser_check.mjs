@@ -69,10 +69,16 @@ await page.screenshot({ path: join(out, `${mode}_early.png`) });
 await page.waitForTimeout(1000);
 s = await stats();
 const f0 = s.deformFrames;
+const sim0 = s.deformSimTime;
 const t0 = Date.now();
 await page.waitForTimeout(3000);
 s = await stats();
-result.deformFramesPerSecond = ((s.deformFrames - f0) * 1000) / (Date.now() - t0);
+const wall = (Date.now() - t0) / 1000;
+result.deformFramesPerSecond = (s.deformFrames - f0) / wall;
+// The states the FEM made in that time (its simulated time over its step,
+// FEM_HZ of the scene, 200 for the shipped one): the page can show no more.
+const femHz = Number(process.env.FEM_HZ ?? 200);
+result.femStatesPerSecond = ((s.deformSimTime - sim0) * femHz) / wall;
 // Let the run go on (the blade presses), then look again.
 let arrowSeen = s.arrowVisible;
 let ghostSeen = s.ghostVisible;
@@ -126,7 +132,14 @@ result.replay = s.replay;
 result.consoleErrors = consoleErrors;
 writeFileSync(join(out, `${mode}_stats.json`), JSON.stringify(s, null, 1));
 
-if (mode !== "replay" && (result.deformFramesPerSecond < 10 || result.deformFramesPerSecond > 65)) problems.push(`${result.deformFramesPerSecond.toFixed(1)} deformation frames per second (display rate: 10-65)`);
+// At the display rate (at most 60 a second) or every state the FEM made when
+// it made fewer (a loaded machine): at least 80 % of that, and alive.
+if (mode !== "replay" && !Number.isFinite(result.femStatesPerSecond)) problems.push("no FEM time in the deformation frames");
+if (mode !== "replay") {
+  const expected = Math.min(60, result.femStatesPerSecond);
+  if (result.deformFramesPerSecond < Math.max(2, 0.8 * expected) || result.deformFramesPerSecond > 65)
+    problems.push(`${result.deformFramesPerSecond.toFixed(1)} deformation frames per second (the FEM made ${result.femStatesPerSecond.toFixed(1)}, the display takes up to 60)`);
+}
 if (result.bodies.length < 2) problems.push("fewer than two bodies drawn");
 if (mode !== "replay" || !s.replay?.paused) {
   if (!(result.vertexChecksumChange > 0)) problems.push("the tongue's vertices did not change");

@@ -21,6 +21,7 @@ const stats = {
   stateFrames: 0,
   deformTimes: [],
   positionsChecksum: 0,
+  deformSimTime: 0, // the FEM's simulated time of the last deformation frame, s
   maxStrain: 0,
   arrowVisible: false,
   ghostVisible: false,
@@ -186,6 +187,7 @@ function applyDeformation(buf) {
   entry.geometry.computeBoundingSphere();
   stats.maxStrain = max;
   stats.positionsChecksum = sum;
+  stats.deformSimTime = new Float64Array(buf, 16, 1)[0];
   stats.deformFrames++;
   stats.deformTimes.push(performance.now());
   if (stats.deformTimes.length > 200) stats.deformTimes.shift();
