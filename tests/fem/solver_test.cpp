@@ -128,12 +128,15 @@ TEST(Solvers, BackgroundFactorisationsArriveOnTheirStepAndReachTheSameEquilibriu
   background.refactor_period = 0;
   background.refactor_rotation_rad = 0.1;
   background.background_factor_latency_s = 0.03;  // three 10 ms steps
-  const auto trajectory = [&](std::vector<int>& installed_at, std::uint64_t& factorisations) {
+  const auto bar = [&](const SolverSettings& solver) {
     BodySettings settings;
-    settings.solver = background;
+    settings.solver = solver;
     settings.time_step = std::chrono::duration<double>(0.01);
     settings.sleep.enabled = false;
-    auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+    return test::make_body(settings, mesh, test::fixed_x0(mesh));
+  };
+  const auto trajectory = [&](std::vector<int>& installed_at, std::uint64_t& factorisations) {
+    auto body = bar(background);
     EXPECT_NE(body, nullptr);
     std::vector<double> all;
     for (int k = 0; k < 400; ++k) {
@@ -165,12 +168,7 @@ TEST(Solvers, BackgroundFactorisationsArriveOnTheirStepAndReachTheSameEquilibriu
   // often, never more.
   SolverSettings inside = background;
   inside.background_factor_latency_s = 0.0;
-  std::vector<int> unused;
-  BodySettings settings;
-  settings.solver = inside;
-  settings.time_step = std::chrono::duration<double>(0.01);
-  settings.sleep.enabled = false;
-  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  auto body = bar(inside);
   ASSERT_NE(body, nullptr);
   for (int k = 0; k < 400; ++k) body->step();
   EXPECT_LE(first_count, body->factorisations() - 1);

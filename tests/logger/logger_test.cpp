@@ -12,9 +12,9 @@
 
 #include "fahr/common/publisher.h"
 #include "fahr/common/service_reporter.h"
+#include "fahr/common/wire_header.h"
 #include "fahr/logger_service/loss_accounting.h"
 #include "fahr/logger_service/recorder.h"
-#include "fahr/logger_service/wire_header.h"
 #include "fahr/mcap/reader.h"
 #include "sample_factory.h"
 
@@ -56,13 +56,13 @@ TEST(WireHeader, ReadsSequenceWriterAndKeyFromTheBytes) {
   pose.header().source_time_ns(-42);
   pose.device_id(17);
   const auto bytes = test::cdr_bytes(pose);
-  const auto h = read_wire_header(bytes, true);
+  const auto h = common::read_wire_header(bytes, true);
   ASSERT_TRUE(h.has_value());
   EXPECT_EQ(h->seq, 123456789012ULL);
   EXPECT_EQ(h->writer_id, 0xdeadbeefU);
   EXPECT_EQ(h->source_time_ns, -42);
   EXPECT_EQ(h->key, 17U);
-  EXPECT_FALSE(read_wire_header(std::span(bytes).first(20), true).has_value());
+  EXPECT_FALSE(common::read_wire_header(std::span(bytes).first(20), true).has_value());
 }
 
 TEST(LossAccounting, GapsLateSamplesAndTheWritersOwnCountCloseTheBooks) {
@@ -139,7 +139,7 @@ TEST(Recorder, OneChannelPerTopicAndKeyWithTheBytesTimesAndSequences) {
       EXPECT_EQ(m.sequence, last_seq + 1);
       last_seq = m.sequence;
       EXPECT_LE(m.publish_time, m.log_time);
-      const auto h = read_wire_header(m.data, true);
+      const auto h = common::read_wire_header(m.data, true);
       ASSERT_TRUE(h.has_value());
       EXPECT_EQ(static_cast<std::uint64_t>(h->source_time_ns), m.publish_time);
       bytes_equal = std::equal(m.data.begin(), m.data.end(), last_pose.begin(), last_pose.end());

@@ -40,12 +40,8 @@ fi
 # The reader's packages, exactly as locked; reinstalled only when the lock changes.
 js="$build/tests/logger/js"
 if [ "$2" = install ]; then
-  mkdir -p "$js"
-  cp "$repo/tests/logger/js/package.json" "$repo/tests/logger/js/package-lock.json" "$js/"
-  if ! cmp -s "$js/package-lock.json" "$js/node_modules/.fahr-lock" 2>/dev/null; then
-    (cd "$js" && npm ci --no-audit --no-fund --loglevel=error)
-    cp "$js/package-lock.json" "$js/node_modules/.fahr-lock"
-  fi
+  . "$repo/tests/support/npm_ci_locked.sh"
+  npm_ci_locked "$repo/tests/logger/js" "$js"
   echo "record_run_test: reader packages installed in $js"
   exit 0
 fi

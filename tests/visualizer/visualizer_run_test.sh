@@ -36,12 +36,8 @@ for tool in node npm chromium; do
 done
 js="$build/tests/visualizer/js"
 if [ "$mode" = install ]; then
-  mkdir -p "$js"
-  cp "$repo/tests/visualizer/js/package.json" "$repo/tests/visualizer/js/package-lock.json" "$js/"
-  if ! cmp -s "$js/package-lock.json" "$js/node_modules/.fahr-lock" 2>/dev/null; then
-    (cd "$js" && npm ci --no-audit --no-fund --loglevel=error)
-    cp "$js/package-lock.json" "$js/node_modules/.fahr-lock"
-  fi
+  . "$repo/tests/support/npm_ci_locked.sh"
+  npm_ci_locked "$repo/tests/visualizer/js" "$js"
   echo "visualizer_run_test: clients installed in $js"
   exit 0
 fi

@@ -263,12 +263,6 @@ bool CholmodSolver::begin_factorize() {
   return true;
 }
 
-bool CholmodSolver::factorizing() const {
-  if (!state_->background) return false;
-  std::lock_guard lock(state_->background->mutex);
-  return state_->background->running;
-}
-
 bool CholmodSolver::finish_factorize() {
   State& s = *state_;
   if (!s.background || !s.wait_background()) return false;

@@ -9,8 +9,8 @@
 
 #include "fahr/common/cdr_bytes.h"
 #include "fahr/common/clock.h"
+#include "fahr/common/wire_header.h"
 #include "fahr/idl/schemas.h"
-#include "fahr/logger_service/wire_header.h"
 #include "service_statusPubSubTypes.h"
 
 namespace fahr::logger_service {
@@ -158,7 +158,7 @@ void Recorder::on_sample(std::size_t topic, std::span<const std::uint8_t> cdr,
                          std::int64_t /*dds_source_ns*/) {
   const std::int64_t receive_ns = common::wall_now_ns();
   const Topic& t = topics_[topic];
-  const auto header = read_wire_header(cdr, t.keyed);
+  const auto header = common::read_wire_header(cdr, t.keyed);
   if (!header) return;  // not fahr's CDR: nothing to account it to
   accounting_.on_receive(t.name, header->writer_id, header->seq);
   std::unique_lock lock(queue_mutex_);

@@ -3,26 +3,9 @@
 
 #include <algorithm>
 
+#include "fahr/common/wire_header.h"
+
 namespace fahr::visualizer_service {
-namespace {
-
-// XCDR1 (PLAIN_CDR) big or little endian: the only encapsulations fahr's
-// writers produce. The SampleHeader (idl/fahr/common.idl) is u64 seq, i64
-// source_time_ns, i64 sim_time_ns, u64 sim_step, u32 writer_id: 36 bytes,
-// then the u32 key of keyed types.
-constexpr std::size_t kEncapsulation = 4;
-constexpr std::size_t kHeaderBytes = 36;
-
-std::uint64_t read_uint(std::span<const std::uint8_t> b, std::size_t at, int n, bool little) {
-  std::uint64_t v = 0;
-  for (int i = 0; i < n; ++i) {
-    const std::uint64_t byte = b[at + static_cast<std::size_t>(i)];
-    v |= little ? byte << (8 * i) : byte << (8 * (n - 1 - i));
-  }
-  return v;
-}
-
-}  // namespace
 
 const std::array<TopicInfo, kTopicCount>& topic_table() {
   static const std::array<TopicInfo, kTopicCount> table = {{
@@ -44,37 +27,27 @@ std::size_t topic_index(std::string_view name) {
   return kTopicCount;
 }
 
-bool read_wire_key(std::span<const std::uint8_t> cdr, bool keyed, WireKey& out) {
-  if (cdr.size() < kEncapsulation + kHeaderBytes + (keyed ? 4 : 0)) return false;
-  if (cdr[0] != 0 || (cdr[1] != 0 && cdr[1] != 1)) return false;
-  const bool little = cdr[1] == 1;
-  const auto b = cdr.subspan(kEncapsulation);
-  out.source_time_ns = static_cast<std::int64_t>(read_uint(b, 8, 8, little));
-  out.sim_time_ns = static_cast<std::int64_t>(read_uint(b, 16, 8, little));
-  out.key = keyed ? static_cast<std::uint32_t>(read_uint(b, kHeaderBytes, 4, little)) : 0;
-  return true;
-}
-
 LiveState::LiveState() {
   slots_.reserve(kMaxSlots);
 }
 
 void LiveState::put(std::size_t topic, std::span<const std::uint8_t> cdr, std::int64_t receive_ns) {
   received_.fetch_add(1, std::memory_order_relaxed);
-  WireKey wk;
-  if (topic >= kTopicCount || !read_wire_key(cdr, topic_table()[topic].keyed, wk)) {
+  const auto wk = topic < kTopicCount ? common::read_wire_header(cdr, topic_table()[topic].keyed)
+                                      : std::nullopt;
+  if (!wk) {
     malformed_.fetch_add(1, std::memory_order_relaxed);
     return;
   }
   std::lock_guard lock(mutex_);
   auto it = std::find_if(slots_.begin(), slots_.end(),
-                         [&](const Slot& s) { return s.topic == topic && s.key == wk.key; });
+                         [&](const Slot& s) { return s.topic == topic && s.key == wk->key; });
   if (it == slots_.end()) {
     if (slots_.size() >= kMaxSlots) {
       slots_full_.fetch_add(1, std::memory_order_relaxed);
       return;
     }
-    slots_.push_back(Slot{topic, wk.key, 0, 0, {}});
+    slots_.push_back(Slot{topic, wk->key, 0, 0, {}});
     it = slots_.end() - 1;
   }
   it->bytes.assign(cdr.begin(), cdr.end());

@@ -77,7 +77,6 @@ class CholmodSolver {
   // waits and throws the result away (before a synchronous factorize()).
   bool enable_background();
   bool begin_factorize();
-  bool factorizing() const;
   bool finish_factorize();
   void cancel_factorize();
   // CPU time the background thread has used so far, ns (0 without one).

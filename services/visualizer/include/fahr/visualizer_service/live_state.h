@@ -76,13 +76,4 @@ class LiveState {
   std::atomic<std::uint64_t> received_{0}, malformed_{0}, slots_full_{0};
 };
 
-// The key of a fahr sample (the u32 after the SampleHeader) and its header's
-// sim time; false if the bytes are too short or not XCDR1.
-struct WireKey {
-  std::uint32_t key = 0;
-  std::int64_t source_time_ns = 0;
-  std::int64_t sim_time_ns = 0;
-};
-bool read_wire_key(std::span<const std::uint8_t> cdr, bool keyed, WireKey& out);
-
 }  // namespace fahr::visualizer_service

@@ -1,8 +1,8 @@
 // SampleHeader fields at their XCDR1 offsets: seq 0, source_time_ns 8,
 // sim_time_ns 16, sim_step 24, writer_id 32; a key right after, at 36.
-#include "fahr/logger_service/wire_header.h"
+#include "fahr/common/wire_header.h"
 
-namespace fahr::logger_service {
+namespace fahr::common {
 namespace {
 
 constexpr std::size_t kEncapsulation = 4;
@@ -26,9 +26,10 @@ std::optional<WireHeader> read_wire_header(std::span<const std::uint8_t> cdr, bo
   WireHeader h;
   h.seq = load(cdr, kEncapsulation + 0, 8, little);
   h.source_time_ns = static_cast<std::int64_t>(load(cdr, kEncapsulation + 8, 8, little));
+  h.sim_time_ns = static_cast<std::int64_t>(load(cdr, kEncapsulation + 16, 8, little));
   h.writer_id = static_cast<std::uint32_t>(load(cdr, kEncapsulation + 32, 4, little));
   if (keyed) h.key = static_cast<std::uint32_t>(load(cdr, kEncapsulation + 36, 4, little));
   return h;
 }
 
-}  // namespace fahr::logger_service
+}  // namespace fahr::common
