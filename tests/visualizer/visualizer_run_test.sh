@@ -94,10 +94,12 @@ case "$mode" in
     ;;
   replay)
     bash "$repo/deployment/run_local.sh" "$build" --dds cyclonedds --domain 42 --mode lockstep \
-      --duration-s 3 --record "$out/run.mcap" >"$out/run.log" 2>&1 || {
+      --duration-s 7 --record "$out/run.mcap" >"$out/run.log" 2>&1 || {
       echo "visualizer_run_test: the recorded run failed:" >&2; tail -n 30 "$out/run.log" >&2; exit 1; }
-    start_visualizer --replay "$out/run.mcap" --speed 0.5
-    node "$js/browser_check.mjs" "$url" "$out" 3 replay | tee "$out/replay.json"
+    # The blade reaches the tongue about 3 s into the script: 7 s recorded,
+    # played from its start at full speed, watched to its end.
+    start_visualizer --replay "$out/run.mcap" --speed 1
+    node "$js/browser_check.mjs" "$url" "$out" 4 replay | tee "$out/replay.json"
     # Seek to the middle and pause: the position must follow.
     (cd "$js" && node --input-type=module -e '
       import WebSocket from "ws";

@@ -55,6 +55,13 @@ async function waitFor(pred, timeoutMs, what) {
 
 const result = { mode };
 let s = await waitFor((x) => x.sceneFrames > 0 && x.deformFrames > 0, 60000, "the scene and a deformation");
+if (mode === "replay") {
+  // The server plays the recording from its start, whenever the page comes:
+  // from the beginning again, so the watch below sees it play.
+  await page.evaluate(() => window.fahrSend({ op: "replay", action: "seek", value: 0 }));
+  const before = s.deformFrames;
+  s = await waitFor((x) => x.deformFrames > before, 10000, "a deformation after the seek");
+}
 result.bodies = s.bodies;
 await page.evaluate(() => window.fahrSetCamera("side"));
 await page.waitForTimeout(300);
