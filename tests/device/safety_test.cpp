@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "fahr/device/servo_core.h"
 #include "test_support.h"
@@ -198,6 +199,24 @@ TEST_F(SafetyTest, CommandsBackDuringTheRampResumeWithoutAStep) {
   EXPECT_EQ(pose.safety_state, SafetyState::kForceEnabled);
   EXPECT_NEAR(pose.rendered_force_n.y(), ramped_n + max_step_n(), 1e-9);
   EXPECT_EQ(core_.safety_counters().resumed_events, 1U);
+}
+
+TEST_F(SafetyTest, EngagingCatchesUpAtTheResumeStep) {
+  // Commands of 0.25 N (small enough to engage): on the tick the device
+  // engages, the output climbs at resume_step_n a tick until it meets them.
+  const double step_n = core_.config().safety.resume_step_n;
+  std::vector<double> enabled;
+  for (int i = 0; i < 100; ++i) {
+    const ForceCommandSample c = command(Vec3(0.0, 0.25, 0.0));
+    const auto& pose = tick(core_.ticks() == 0 ? nullptr : &c);
+    if (pose.safety_state == SafetyState::kForceEnabled)
+      enabled.push_back(pose.rendered_force_n.y());
+  }
+  ASSERT_GE(enabled.size(), 3U);
+  EXPECT_NEAR(enabled[0], step_n, 1e-12);
+  EXPECT_NEAR(enabled[1], 2 * step_n, 1e-12);
+  EXPECT_NEAR(enabled[2], 0.25, 1e-12);
+  EXPECT_EQ(core_.safety_counters().catch_up_ticks, 2U);
 }
 
 TEST_F(SafetyTest, NoKickOnConnect) {

@@ -61,6 +61,7 @@ Vec3 SafetyGate::next_target(const Vec3& candidate_n, const Vec3& commanded_n, b
       if (small_ticks_ < config_.engage_cycles) return Vec3::Zero();
       state_ = SafetyState::kForceEnabled;
       ++counters_.engage_events;
+      catching_up_ = true;
       return candidate_n;
     case SafetyState::kForceEnabled:
       if (!silent) return candidate_n;
@@ -86,6 +87,17 @@ Vec3 SafetyGate::next_target(const Vec3& candidate_n, const Vec3& commanded_n, b
 Vec3 SafetyGate::rate_limit(const Vec3& target_n) {
   const Vec3 step = target_n - last_output_n_;
   const double size = step.norm();
+  if (catching_up_) {
+    // After engaging or resuming: at most resume_step_n a tick until the
+    // output meets the commands.
+    const double limit = std::min(max_step_n_, config_.resume_step_n);
+    if (size <= limit) {
+      catching_up_ = false;
+      return target_n;
+    }
+    ++counters_.catch_up_ticks;
+    return last_output_n_ + step * (limit / size);
+  }
   if (size <= max_step_n_) return target_n;
   ++counters_.rate_limited_ticks;
   return last_output_n_ + step * (max_step_n_ / size);

@@ -23,6 +23,7 @@ void check(const GatewayConfig& config) {
     throw std::invalid_argument("safety.max_answer_age_ticks must be >= 1");
   if (!(s.max_force_rate_nps > 0.0))
     throw std::invalid_argument("safety.max_force_rate_nps must be > 0");
+  if (!(s.resume_step_n > 0.0)) throw std::invalid_argument("safety.resume_step_n must be > 0");
   if (!(s.engage_threshold_n >= 0.0))
     throw std::invalid_argument("safety.engage_threshold_n must be >= 0");
   if (!(config.render.max_correction_m > 0.0 && config.render.max_correction_m <= 0.1)) {

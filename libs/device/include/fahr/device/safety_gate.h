@@ -45,6 +45,13 @@ struct SafetyConfig {
   // the Touch X peak build in 4 ms (a stiff contact) but turns a step from a
   // corrupt command into a ramp the passivity observer can see.
   double max_force_rate_nps = 2000.0;
+  // Largest change of the force per tick, N, > 0, from the tick the device
+  // engages (ENGAGING -> ENABLED) until the output has caught up with the
+  // commands: a haptic service that (re)connects is never felt as a step.
+  // Commands back during a ramp-down keep max_force_rate_nps (a stiff
+  // contact must build fast to stay passive); the haptic service slews
+  // from the force the device reports then (services/haptic).
+  double resume_step_n = 0.1;
 };
 
 // Why a command was or was not taken.
@@ -68,6 +75,7 @@ struct SafetyCounters {
   std::uint64_t silence_events = 0;      // ENABLED -> RAMPING_DOWN transitions
   std::uint64_t engage_events = 0;       // ENGAGING -> ENABLED transitions
   std::uint64_t resumed_events = 0;      // RAMPING_DOWN -> ENABLED (commands back in time)
+  std::uint64_t catch_up_ticks = 0;      // ticks resume_step_n cut the change
   std::uint64_t fault_ticks = 0;
   std::uint64_t non_finite_outputs = 0;  // internal error guard; must stay 0
 };
@@ -107,6 +115,7 @@ class SafetyGate {
   std::uint32_t ticks_since_command_ = 0;
   std::uint32_t small_ticks_ = 0;
   double ramp_factor_ = 1.0;
+  bool catching_up_ = false;  // engaged or resumed, output not yet at the commands
   Vec3 last_output_n_ = Vec3::Zero();
   SafetyCounters counters_;
 };
