@@ -32,9 +32,11 @@ void check(const GatewayConfig& config) {
   if (!(config.mapping.motion_scale > 0.0 && config.mapping.motion_scale <= 100.0)) {
     throw std::invalid_argument("mapping.motion_scale must be in (0, 100]");
   }
-  if (!(config.passivity.max_damping_nspm >= 0.0 && config.passivity.max_stored_energy_j > 0.0)) {
+  if (!(config.passivity.max_damping_nspm >= 0.0 && config.passivity.max_stored_energy_j > 0.0 &&
+        config.passivity.max_damping_release_n > 0.0)) {
     throw std::invalid_argument(
-        "passivity: max_damping_nspm must be >= 0, max_stored_energy_j > 0");
+        "passivity: max_damping_nspm must be >= 0, max_stored_energy_j > 0, max_damping_release_n "
+        "> 0");
   }
 }
 
