@@ -66,8 +66,8 @@ int run(int argc, char** argv) {
       set_up(*scene, collision == "triangle" ? CollisionMethod::kTriangle : CollisionMethod::kAist);
   HapticLoop loop(setup);
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
-  common::Participant participant(
-      runtime::transport_for(*scene, options.dds, options.domain, options.profile, "haptic"));
+  common::Participant participant(runtime::transport_for(
+      *scene, options.dds, options.domain, options.profile, "haptic", options.security));
   common::TickRecorder recorder;
   // Real time: FEM states are digested on the feed's own thread.
   std::unique_ptr<TissueFeed> feed;

@@ -44,8 +44,13 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_path, "file to write")->required();
   app.add_option("--dds", dds, "DDS vendor");
   app.add_option("--domain", domain, "DDS domain id");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   CLI11_PARSE(app, argc, argv);
-  common::Participant participant(common::transport_config_from(dds, domain, "", "fault_probe"));
+  common::Participant participant(
+      common::transport_config_from(dds, domain, "", "fault_probe", security));
   std::mutex mutex;
   std::vector<Line> lines;
   lines.reserve(static_cast<std::size_t>(duration_s * 2500) + 1000);

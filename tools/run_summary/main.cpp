@@ -188,10 +188,14 @@ int main(int argc, char** argv) try {
   app.add_option("--dds", dds, "DDS vendor");
   app.add_option("--domain", domain, "DDS domain id");
   app.add_option("--dds-profile", profile, "vendor XML configuration");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   CLI11_PARSE(app, argc, argv);
   try {
     common::Participant participant(
-        common::transport_config_from(dds, domain, profile, "fahr_run_summary"));
+        common::transport_config_from(dds, domain, profile, "fahr_run_summary", security));
     Tally tally;
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
