@@ -31,6 +31,7 @@
 #   logger, fahr_run_summary, fahr_dds_check, fault_probe: publish nothing
 #   intruder        a valid identity allowed only ServiceStatus (tests: a
 #                   participant the station knows, without the right to command)
+#   fahr_transport_latency  publishes the bench's fahr/bench/ping and pong
 # Every identity subscribes to every fahr topic; every one but the
 # subscribe-only ones publishes its ServiceStatus, ServiceEvents and StepAck.
 # Domains 0-230. Validity: --days (default 3650) from today.
@@ -74,7 +75,7 @@ sign() {  # sign IN.xml OUT.p7s: S/MIME, clear text, signed by the CA
 }
 
 topics=(DevicePose ForceCommand ContactSet DeformationState SceneDescription ServiceStatus
-  ServiceEvents SimClock StepAck RemoteInput)
+  ServiceEvents SimClock StepAck RemoteInput bench/ping bench/pong)
 reports=(ServiceStatus ServiceEvents StepAck)
 
 # Governance: who may join (only authenticated, permitted participants), and
@@ -183,6 +184,7 @@ identity fahr_run_summary
 identity fahr_dds_check
 identity fault_probe
 identity intruder ServiceStatus
+identity fahr_transport_latency bench/ping bench/pong
 rm -f "$out/ca.cert.srl"
 chmod 600 "$out/ca.key.pem" "$out"/identities/*/key.pem
 echo "make_station_security: $protection station files in $out ($(ls "$out/identities" | wc -l) identities)"
