@@ -12,9 +12,10 @@
 //   matched readers M" — or "command: refused: <why>" when its participant
 //   or writer is not allowed to exist.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <map>
 #include <memory>
@@ -78,9 +79,15 @@ int main(int argc, char** argv) {
     }
     msg::ForceCommand command;
     command.device_id(1);
-    command.force_n().y(2.0);
     std::uint64_t wrote = 0;
+    const auto start = std::chrono::steady_clock::now();
     while (std::chrono::steady_clock::now() < end) {
+      // Zero for 0.1 s (the gateway's engage rule wants a small force), then
+      // up to 2 N over a second: what a hostile participant that knows the
+      // rules would send.
+      const double t =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      command.force_n().y(std::clamp(2.0 * (t - 0.1), 0.0, 2.0));
       if (poses.fetch_newest()) {
         command.answered_pose_seq(poses.newest().header().seq());
         command.answered_position_m(poses.newest().world_from_stylus().position_m());

@@ -11,6 +11,9 @@
 #     ForceCommand: its writer is refused, the listener receives nothing of it;
 #  5. the station runs with security on (deployment/run_local.sh --security,
 #     6 s): ForceCommands flow, the FEM's states are used.
+# And the gateway itself against a well-formed hostile commander (zero, then
+# up to 2 N, answering its poses): rendered without security, never accepted
+# from the intruder's identity with it.
 # Without security the same intruder's commands do reach the listener (shown
 # first: the reason security exists).
 #
@@ -77,6 +80,33 @@ round "${secured[@]}" --identity device_gateway -- "${secured[@]}" --identity in
 check "the intruder's ForceCommand writer is refused" grep -q "refused" <<<"$command_line"
 check "the intruder's commands never reach the gateway's identity (${received:-0})" \
   [ "${received:-1}" -eq 0 ]
+
+# The gateway itself against the same hostile commander (no haptic service):
+# without security it renders the hostile force; with it, nothing arrives.
+gateway_round() {  # gateway_round GATEWAY-ARGS... -- COMMANDER-ARGS...
+  local gateway_args=() command_args=()
+  while [ "$1" != -- ]; do gateway_args+=("$1"); shift; done
+  shift
+  command_args=("$@")
+  "$build/services/device_gateway/fahr_device_gateway" --dds "$vendor" --domain $((domain + 2)) \
+    --backend simulated --script intubation --duration-s 5 "${gateway_args[@]}" >"$out/gateway.txt" 2>&1 &
+  local gateway=$!
+  sleep 0.5
+  "$peer" command --seconds 4 --dds "$vendor" --domain $((domain + 2)) "${command_args[@]}" \
+    >"$out/command.txt" 2>&1 || true
+  wait "$gateway" || true
+  peak=$(sed -n 's/.*peak force \([0-9.]*\) N.*/\1/p' "$out/gateway.txt" | tail -n 1)
+  accepted=$(sed -n 's/.*commands accepted \([0-9]*\).*/\1/p' "$out/gateway.txt" | tail -n 1)
+  echo "  gateway: peak force ${peak:-?} N, commands accepted ${accepted:-?}"
+}
+echo "security_test: $vendor: a well-formed hostile ForceCommand at the gateway, security off"
+gateway_round --
+check "without security the gateway renders the hostile force (peak ${peak:-0} N)" \
+  awk "BEGIN { exit !(${peak:-0} > 1.0) }"
+echo "security_test: $vendor: the same at a secured gateway, from the intruder's identity"
+gateway_round --security "$out/station" -- "${secured[@]}" --identity intruder
+check "the secured gateway accepts none of it (accepted ${accepted:-?}, peak ${peak:-?} N)" \
+  [ "${accepted:-1}" -eq 0 ]
 
 echo "security_test: $vendor: 5. the station with security on"
 FAHR_RUN_LOCAL_IN_NETNS=1 FAHR_RUN_LOG_DIR="$out/run" bash "$repo/deployment/run_local.sh" "$build" \

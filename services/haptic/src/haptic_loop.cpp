@@ -343,10 +343,14 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
     return;
   }
   if (tissue_lost_) {
-    // A state came again (the same FEM after a stall, or a new one): the
-    // proxy starts at the hand and the force slews from the ramp's value.
+    // A state came again: the force slews from the ramp's value. The same
+    // FEM after a stall has the tongue where it left it (relaxed, if
+    // anything: the ContactSets were empty), so the proxy stays where that
+    // tongue held it and goes on from there; a new writer or a new epoch
+    // (below) moves it to the hand.
     tissue_lost_ = false;
-    begin_resume(device);
+    slewing_ = true;
+    slew_ticks_left_ = kSlewWindowTicks;
     relaxed_add<std::uint64_t>(metrics_.tissue_returns, 1);
   }
   if (tissue.from_fem && tissue.fem_writer != fem_writer_) {
