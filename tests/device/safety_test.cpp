@@ -201,6 +201,27 @@ TEST_F(SafetyTest, CommandsBackDuringTheRampResumeWithoutAStep) {
   EXPECT_EQ(core_.safety_counters().resumed_events, 1U);
 }
 
+// A command marked as a transition (the haptic service ramping or slewing)
+// moves the output at most resume_step_n a tick, however far it jumps (two
+// commands landing in one tick, the older skipped); an ordinary one at the
+// rate limit.
+TEST_F(SafetyTest, TransitionCommandsMoveAtTheResumeStep) {
+  engage();
+  const double step_n = core_.config().safety.resume_step_n;
+  ForceCommandSample c = command(Vec3(0.0, 1.0, 0.0));
+  c.transition = true;
+  double previous = last_force_n_.y();
+  for (int i = 0; i < 5; ++i) {
+    c.answered_pose_seq = core_.ticks();
+    tick(&c);
+    EXPECT_NEAR(last_force_n_.y() - previous, step_n, 1e-12);
+    previous = last_force_n_.y();
+  }
+  ForceCommandSample ordinary = command(Vec3(0.0, 1.0, 0.0));
+  tick(&ordinary);
+  EXPECT_NEAR(last_force_n_.y(), 1.0, 1e-12);
+}
+
 TEST_F(SafetyTest, EngagingCatchesUpAtTheResumeStep) {
   // Commands of 0.25 N (small enough to engage): on the tick the device
   // engages, the output climbs at resume_step_n a tick until it meets them.

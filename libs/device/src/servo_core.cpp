@@ -75,6 +75,7 @@ const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now,
         *incoming, tick_, renderer_.has_command() ? renderer_.answered_pose_seq() : 0);
     if (verdict == Verdict::kAccepted) {
       accepted = true;
+      transition_ = incoming->transition;
       renderer_.set_command(*incoming);
       std::chrono::nanoseconds published{0};
       if (pose_times_.find(incoming->answered_pose_seq, published))
@@ -89,7 +90,8 @@ const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now,
   // holds in every DevicePose; the next tick's limit differs by one tick of
   // heating at most.
   const double renderable_n = thermal_.renderable_force_n();
-  const Vec3 output = safety_.limit(candidate, commanded, accepted, reading.fault, renderable_n);
+  const Vec3 output =
+      safety_.limit(candidate, commanded, accepted, reading.fault, renderable_n, transition_);
   passivity_.account(output, velocity, dt_);
   thermal_.update(output.norm(), dt_);
   backend_.apply(config_.mapping.force_to_device(output));
