@@ -8,7 +8,8 @@ case breaks a rule:
   tick, from the fault until the haptic service renders the tissue again
   (the first FORCE_RENDERED command after the service is back: the ramp, the
   hold and the resume slew), is at most 0.1 N (plus 1e-6 for the wire's
-  rounding); the logger's window ends 1 s after it is back;
+  rounding); the logger's window (until 1 s after it is back) holds
+  ordinary rendering only: its steps are reported, not judged;
 - FEM: the loss is seen (a ForceCommand with reason FORCE_TISSUE_LOST)
   within DETECT_FEM_MS of the fault; the force is zero within 200 ms of
   that; rendering resumes (FORCE_RENDERED) after the FEM is back;
@@ -24,7 +25,9 @@ Times are wall-clock (the probe stamps each sample as it arrives).
 import os
 import sys
 
-STEP_LIMIT_N = 0.1 + 1e-6
+# The probe prints force components to 1e-6 N: their differences' norm
+# carries that rounding.
+STEP_LIMIT_N = 0.1 + 1e-5
 # The passivity controller's damper may act while the hand moves, whatever
 # is commanded: "zero" leaves it a few hundredths of a newton.
 ZERO_N = 0.05
@@ -130,7 +133,9 @@ def main(folder):
         at_fault = [p for p in by_time if p[0] <= fault]
         force_at_fault = at_fault[-1][4] if at_fault else 0.0
 
-        if step > STEP_LIMIT_N:
+        # (The logger's window holds ordinary rendering only: its steps are
+        # the contact model's, reported, not judged.)
+        if service != "logger" and step > STEP_LIMIT_N:
             problems.append(f"force step {step:.3f} N > 0.1 N at {ms(step_at - fault):.0f} ms")
         if service in ("fem", "haptic"):
             if detected is None:
