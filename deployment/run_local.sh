@@ -10,7 +10,7 @@
 #                           [--mode realtime|lockstep] [--haptic-collision aist|triangle]
 #                           [--cpus-fem LIST] [--cpus-haptic LIST]
 #                           [--record FILE.mcap] [--record-decimate TOPIC=N] [--record-arg ARG]
-#                           [--replay FILE.mcap]
+#                           [--replay FILE.mcap] [--security DIR]
 #
 # --record FILE.mcap: fahr_logger joins first and records every topic of the
 # run to FILE.mcap (FILE.mcap.part until it closes, after the services have
@@ -22,6 +22,9 @@
 # --replay FILE.mcap (lockstep only): fahr_replay stands in for the gateway
 # and feeds the recorded run's DevicePoses, step by step; the haptic and FEM
 # hashes then equal the recorded run's.
+# --security DIR: DDS Security on every participant, with the station's
+# files in DIR (deployment/security/make_station_security.sh); each program
+# joins with its own identity.
 # --haptic-collision triangle: the haptic service finds the blade's contacts
 # with the tongue by the triangle-level baseline instead of the AIST.
 # --cpus-fem / --cpus-haptic: run that service on these CPUs only (its
@@ -60,6 +63,7 @@ haptic_extra=()
 record=""
 record_extra=()
 replay=""
+security=""
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -79,7 +83,8 @@ while [ $# -gt 0 ]; do
     --record-decimate) record_extra+=(--decimate "$2"); shift 2 ;;
     --record-arg) record_extra+=("$2"); shift 2 ;;
     --replay) replay="$2"; shift 2 ;;
-    -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
+    --security) security=$(cd "$2" && pwd); shift 2 ;;
+    -h|--help) sed -n '2,42p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
@@ -124,6 +129,7 @@ done
 transport_flags() {
   local vendor=$1
   printf '%s\n' --dds "$vendor" --domain "$domain"
+  if [ -n "$security" ]; then printf '%s\n' --security "$security"; fi
   if [ -z "${FAHR_RUN_LOCAL_IN_NETNS:-}" ]; then
     printf '%s\n' --dds-profile "$repo/deployment/dds/${vendor}_loopback.xml"
   fi

@@ -40,10 +40,14 @@ class EchoPath {
   virtual ~EchoPath() = default;
 };
 
+// `security`: a station's DDS Security folder (deployment/security/), or
+// empty for none; the identity is fahr_transport_latency.
 std::unique_ptr<PingPath> make_transport_ping(common::Vendor vendor, std::uint32_t domain,
-                                              const Payload& payload);
+                                              const Payload& payload,
+                                              const std::string& security = {});
 std::unique_ptr<EchoPath> make_transport_echo(common::Vendor vendor, std::uint32_t domain,
-                                              const Payload& payload);
+                                              const Payload& payload,
+                                              const std::string& security = {});
 std::unique_ptr<PingPath> make_raw_fast_ping(std::uint32_t domain, const Payload& payload);
 std::unique_ptr<EchoPath> make_raw_fast_echo(std::uint32_t domain, const Payload& payload);
 std::unique_ptr<PingPath> make_raw_cyclone_ping(std::uint32_t domain, const Payload& payload);

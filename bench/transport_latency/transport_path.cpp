@@ -16,11 +16,13 @@ common::QosProfile bench_qos() {
   return qos;
 }
 
-common::TransportConfig config_for(common::Vendor vendor, std::uint32_t domain) {
+common::TransportConfig config_for(common::Vendor vendor, std::uint32_t domain,
+                                   const std::string& security) {
   common::TransportConfig config;
   config.vendor = vendor;
   config.domain_id = domain;
   config.participant_name = "fahr_transport_latency";
+  config.security_dir = security;
   return config;
 }
 
@@ -45,8 +47,9 @@ void size(msg::DeformationState& s, std::size_t bytes) {
 template <class T>
 class TransportPing final : public PingPath {
  public:
-  TransportPing(common::Vendor vendor, std::uint32_t domain, const Payload& payload)
-      : participant_(config_for(vendor, domain)),
+  TransportPing(common::Vendor vendor, std::uint32_t domain, const Payload& payload,
+                const std::string& security)
+      : participant_(config_for(vendor, domain, security)),
         pub_(participant_, bench_qos(), kTransportPing),
         sub_(participant_, bench_qos(), kTransportPong,
              [this](const T& sample, const common::SampleInfo&) {
@@ -73,8 +76,8 @@ class TransportPing final : public PingPath {
 template <class T>
 class TransportEcho final : public EchoPath {
  public:
-  TransportEcho(common::Vendor vendor, std::uint32_t domain)
-      : participant_(config_for(vendor, domain)),
+  TransportEcho(common::Vendor vendor, std::uint32_t domain, const std::string& security)
+      : participant_(config_for(vendor, domain, security)),
         pub_(participant_, bench_qos(), kTransportPong),
         sub_(participant_, bench_qos(), kTransportPing,
              [this](const T& sample, const common::SampleInfo&) {
@@ -92,16 +95,17 @@ class TransportEcho final : public EchoPath {
 }  // namespace
 
 std::unique_ptr<PingPath> make_transport_ping(common::Vendor vendor, std::uint32_t domain,
-                                              const Payload& payload) {
+                                              const Payload& payload, const std::string& security) {
   if (payload.small)
-    return std::make_unique<TransportPing<msg::DevicePose>>(vendor, domain, payload);
-  return std::make_unique<TransportPing<msg::DeformationState>>(vendor, domain, payload);
+    return std::make_unique<TransportPing<msg::DevicePose>>(vendor, domain, payload, security);
+  return std::make_unique<TransportPing<msg::DeformationState>>(vendor, domain, payload, security);
 }
 
 std::unique_ptr<EchoPath> make_transport_echo(common::Vendor vendor, std::uint32_t domain,
-                                              const Payload& payload) {
-  if (payload.small) return std::make_unique<TransportEcho<msg::DevicePose>>(vendor, domain);
-  return std::make_unique<TransportEcho<msg::DeformationState>>(vendor, domain);
+                                              const Payload& payload, const std::string& security) {
+  if (payload.small)
+    return std::make_unique<TransportEcho<msg::DevicePose>>(vendor, domain, security);
+  return std::make_unique<TransportEcho<msg::DeformationState>>(vendor, domain, security);
 }
 
 }  // namespace fahr::bench

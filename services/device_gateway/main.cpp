@@ -27,7 +27,7 @@ int run(int argc, char** argv) {
   if (!setup) return 2;
   common::install_stop_handlers();
   common::Participant participant(common::transport_config_from(
-      options->dds, options->domain, options->profile, "device_gateway"));
+      options->dds, options->domain, options->profile, "device_gateway", options->security));
   common::TickRecorder recorder;
   GatewayMetrics metrics;
   common::ServiceReporter reporter(

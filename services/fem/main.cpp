@@ -42,8 +42,8 @@ int run(int argc, char** argv) {
   common::install_stop_handlers();
   FemBodySetup setup = set_up_body(*scene, scene->bodies[*choice.body]);
   ServiceStep fem_step(setup);
-  common::Participant participant(
-      runtime::transport_for(*scene, options.dds, options.domain, options.profile, "fem"));
+  common::Participant participant(runtime::transport_for(*scene, options.dds, options.domain,
+                                                         options.profile, "fem", options.security));
   common::TickRecorder recorder;
   common::ServiceReporter reporter(
       participant,

@@ -66,8 +66,8 @@ int run(int argc, char** argv) {
       set_up(*scene, collision == "triangle" ? CollisionMethod::kTriangle : CollisionMethod::kAist);
   HapticLoop loop(setup);
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
-  common::Participant participant(
-      runtime::transport_for(*scene, options.dds, options.domain, options.profile, "haptic"));
+  common::Participant participant(runtime::transport_for(
+      *scene, options.dds, options.domain, options.profile, "haptic", options.security));
   common::TickRecorder recorder;
   // Real time: FEM states are digested on the feed's own thread.
   std::unique_ptr<TissueFeed> feed;
@@ -76,10 +76,13 @@ int run(int argc, char** argv) {
       std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period());
   common::ServiceReporter reporter(
       participant, {"haptic", scene->rates.haptic_hz, status_period > 0ms ? status_period : 250ms},
-      recorder, [&](auto& metrics) {
+      recorder,
+      [&](auto& metrics) {
         loop.append_metrics(metrics);
         if (feed) feed->append_metrics(metrics);
-      });
+      },
+      // The FEM lost and back, a restarted FEM, a silent device: said here.
+      [&](auto& errors) { loop.take_errors(errors); });
   // Transient local: the writer must live as long as the run for late
   // joiners to get the samples.
   common::Publisher<msg::SceneDescription> scene_out(participant);

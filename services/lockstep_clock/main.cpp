@@ -43,6 +43,10 @@ int run(int argc, char** argv) {
   app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds, inprocess");
   app.add_option("--domain", domain, "DDS domain id 0-230");
   app.add_option("--dds-profile", profile, "vendor XML configuration");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
 
@@ -57,7 +61,7 @@ int run(int argc, char** argv) {
   }
   try {
     common::Participant participant(
-        common::transport_config_from(dds, domain, profile, "lockstep_clock"));
+        common::transport_config_from(dds, domain, profile, "lockstep_clock", security));
     const auto base = std::chrono::duration_cast<std::chrono::nanoseconds>(
         std::chrono::duration<double, std::milli>(base_period_ms));
     common::LockstepCoordinator coordinator(participant, base);

@@ -68,6 +68,10 @@ int run(int argc, char** argv) {
                  "DDS vendor: fastdds or cyclonedds (default $FAHR_DDS, else fastdds)");
   app.add_option("--domain", domain, "DDS domain 0-230 (default $FAHR_DOMAIN_ID, else 0)");
   app.add_option("--dds-profile", profile, "vendor XML profile (default $FAHR_DDS_PROFILE)");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   app.add_option("--duration-s", duration_s, "stop after this long (0: at SIGINT/SIGTERM)");
   app.add_option("--compression", compression, "chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}));
@@ -115,7 +119,8 @@ int run(int argc, char** argv) {
   }
 
   common::install_stop_handlers();
-  common::Participant participant(common::transport_config_from(dds, domain, profile, "logger"));
+  common::Participant participant(
+      common::transport_config_from(dds, domain, profile, "logger", security));
   options.run_metadata = run_metadata(participant, scene);
   Recorder recorder(participant, options);
   std::printf("fahr_logger: recording to %s (%s, %s bytes, %s chunks of %llu KiB)\n",

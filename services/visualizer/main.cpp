@@ -40,6 +40,10 @@ int run(int argc, char** argv) {
                  "DDS vendor: fastdds or cyclonedds (default $FAHR_DDS, else fastdds)");
   app.add_option("--domain", domain, "DDS domain 0-230 (default $FAHR_DOMAIN_ID, else 0)");
   app.add_option("--dds-profile", profile, "vendor XML profile (default $FAHR_DDS_PROFILE)");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   app.add_option("--address", options.address, "address to listen on (default 127.0.0.1)");
   app.add_option("--port", options.port, "port (default 8765; 0: any free port)");
   app.add_option("--rate-hz", options.rate_hz, "most frames per second per client")
@@ -85,7 +89,7 @@ int run(int argc, char** argv) {
     hooks.replay_position = [&] { return replay->position_json(); };
   } else {
     participant = std::make_unique<common::Participant>(
-        common::transport_config_from(dds, domain, profile, "visualizer"));
+        common::transport_config_from(dds, domain, profile, "visualizer", security));
     dds_source = std::make_unique<DdsSource>(*participant, live);
     if (options.allow_remote_input) {
       remote = std::make_unique<RemoteInput>(*participant);

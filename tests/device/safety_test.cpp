@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "fahr/device/servo_core.h"
 #include "test_support.h"
@@ -198,6 +199,45 @@ TEST_F(SafetyTest, CommandsBackDuringTheRampResumeWithoutAStep) {
   EXPECT_EQ(pose.safety_state, SafetyState::kForceEnabled);
   EXPECT_NEAR(pose.rendered_force_n.y(), ramped_n + max_step_n(), 1e-9);
   EXPECT_EQ(core_.safety_counters().resumed_events, 1U);
+}
+
+// A command marked as a transition (the haptic service ramping or slewing)
+// moves the output at most resume_step_n a tick, however far it jumps (two
+// commands landing in one tick, the older skipped); an ordinary one at the
+// rate limit.
+TEST_F(SafetyTest, TransitionCommandsMoveAtTheResumeStep) {
+  engage();
+  const double step_n = core_.config().safety.resume_step_n;
+  ForceCommandSample c = command(Vec3(0.0, 1.0, 0.0));
+  c.transition = true;
+  double previous = last_force_n_.y();
+  for (int i = 0; i < 5; ++i) {
+    c.answered_pose_seq = core_.ticks();
+    tick(&c);
+    EXPECT_NEAR(last_force_n_.y() - previous, step_n, 1e-12);
+    previous = last_force_n_.y();
+  }
+  ForceCommandSample ordinary = command(Vec3(0.0, 1.0, 0.0));
+  tick(&ordinary);
+  EXPECT_NEAR(last_force_n_.y(), 1.0, 1e-12);
+}
+
+TEST_F(SafetyTest, EngagingCatchesUpAtTheResumeStep) {
+  // Commands of 0.25 N (small enough to engage): on the tick the device
+  // engages, the output climbs at resume_step_n a tick until it meets them.
+  const double step_n = core_.config().safety.resume_step_n;
+  std::vector<double> enabled;
+  for (int i = 0; i < 100; ++i) {
+    const ForceCommandSample c = command(Vec3(0.0, 0.25, 0.0));
+    const auto& pose = tick(core_.ticks() == 0 ? nullptr : &c);
+    if (pose.safety_state == SafetyState::kForceEnabled)
+      enabled.push_back(pose.rendered_force_n.y());
+  }
+  ASSERT_GE(enabled.size(), 3U);
+  EXPECT_NEAR(enabled[0], step_n, 1e-12);
+  EXPECT_NEAR(enabled[1], 2 * step_n, 1e-12);
+  EXPECT_NEAR(enabled[2], 0.25, 1e-12);
+  EXPECT_EQ(core_.safety_counters().catch_up_ticks, 2U);
 }
 
 TEST_F(SafetyTest, NoKickOnConnect) {

@@ -262,6 +262,128 @@ TEST(HapticLoop, ANewResetEpochSlewsTheForce) {
   EXPECT_LE(with_epoch, kResetSlewN + 1e-9);
 }
 
+// The FEM lost mid-press: the tongue is not rendered, the force ramps to
+// zero within the ramp (150 servo ticks), at most 0.1 N a tick, with no
+// local stiffness and an empty ContactSet, each command saying why. When a
+// state comes again the force resumes through the reset slew.
+TEST(HapticLoop, ALostTissueRampsTheForceToZeroAndResumesThroughTheSlew) {
+  PressRig rig;
+  ASSERT_TRUE(rig.press());
+  HapticLoop& loop = rig.loop;
+  Eigen::Vector3d previous = to_eigen(rig.command.force_n());
+  ASSERT_GT(previous.norm(), 0.3) << "the press made no force to ramp";
+  std::uint64_t tick = rig.tick;
+  double largest = 0.0;
+  std::uint64_t zero_after = 0;
+  for (std::uint64_t i = 0; i < 200; ++i, ++tick) {
+    loop.tick(device_pose(tick, rig.deep, kPressPitchDeg), rig.snapshot, rig.command, rig.contacts,
+              true);
+    const Eigen::Vector3d force = to_eigen(rig.command.force_n());
+    largest = std::max(largest, (force - previous).norm());
+    previous = force;
+    EXPECT_EQ(rig.command.reason(), msg::FORCE_TISSUE_LOST);
+    EXPECT_TRUE(rig.contacts.contacts().empty());
+    for (const double k : rig.command.stiffness_npm().m()) EXPECT_EQ(k, 0.0);
+    if (zero_after == 0 && force.norm() == 0.0) zero_after = i + 1;
+  }
+  std::printf("tissue lost: zero after %llu ticks, largest step %.3f N\n",
+              static_cast<unsigned long long>(zero_after), largest);
+  EXPECT_LE(largest, kResetSlewN + 1e-9);
+  EXPECT_GT(zero_after, 100u);
+  EXPECT_LE(zero_after, static_cast<std::uint64_t>(kLossRampTicks));
+  EXPECT_EQ(loop.metrics().tissue_losses.load(), 1u);
+  // States again: the force climbs back at most 0.1 N a tick while it
+  // slews (saying so); after that it is the response's.
+  largest = 0.0;
+  bool resumed = false;
+  double peak = 0.0;
+  for (std::uint64_t i = 0; i < 300; ++i, ++tick) {
+    if (tick % 5 == 0) {
+      rig.state = rest_with_compliance(rig.setup, rig.contacts, tick / 5);
+      ASSERT_TRUE(rig.digest.digest(rig.state, rig.snapshot));
+    }
+    loop.tick(device_pose(tick, rig.deep, kPressPitchDeg), rig.snapshot, rig.command, rig.contacts);
+    const Eigen::Vector3d force = to_eigen(rig.command.force_n());
+    if (rig.command.reason() == msg::FORCE_RESUMING) {
+      largest = std::max(largest, (force - previous).norm());
+      resumed = true;
+    }
+    peak = std::max(peak, force.norm());
+    previous = force;
+  }
+  EXPECT_TRUE(resumed);
+  EXPECT_EQ(rig.command.reason(), msg::FORCE_RENDERED);
+  EXPECT_GT(peak, 0.3) << "the force did not come back";
+  EXPECT_LE(largest, kResetSlewN + 1e-9);
+  EXPECT_EQ(loop.metrics().tissue_returns.load(), 1u);
+}
+
+// A restarted FEM service is a new writer whose tongue starts at rest and
+// whose epochs count from 0 again: the same slew as a new reset epoch.
+TEST(HapticLoop, ANewFemWriterResumesThroughTheSlew) {
+  PressRig rig;
+  // The press on states of writer 7.
+  for (; rig.tick < 400; ++rig.tick) {
+    if (rig.tick % 5 == 0 && rig.tick > 0) {
+      rig.state = rest_with_compliance(rig.setup, rig.contacts, rig.tick / 5);
+      rig.state.header().writer_id(7);
+      ASSERT_TRUE(rig.digest.digest(rig.state, rig.snapshot));
+    }
+    const double s = std::min(1.0, static_cast<double>(rig.tick) / 200.0);
+    rig.loop.tick(device_pose(rig.tick, kPressTipM + s * (rig.deep - kPressTipM), kPressPitchDeg),
+                  rig.snapshot, rig.command, rig.contacts);
+  }
+  Eigen::Vector3d previous = to_eigen(rig.command.force_n());
+  ASSERT_GT(previous.norm(), 0.3);
+  double largest = 0.0;
+  for (std::uint64_t tick = rig.tick; tick < 700; ++tick) {
+    if (tick % 5 == 0) {
+      // Writer 9, a stiffer tongue, its steps and epoch from 0.
+      rig.state = rest_with_compliance(rig.setup, rig.contacts, (tick - 400) / 5, 0.002f);
+      rig.state.header().writer_id(9);
+      ASSERT_TRUE(rig.digest.digest(rig.state, rig.snapshot));
+    }
+    rig.loop.tick(device_pose(tick, rig.deep, kPressPitchDeg), rig.snapshot, rig.command,
+                  rig.contacts);
+    const Eigen::Vector3d force = to_eigen(rig.command.force_n());
+    largest = std::max(largest, (force - previous).norm());
+    previous = force;
+  }
+  EXPECT_EQ(rig.loop.metrics().fem_writers.load(), 1u);
+  EXPECT_LE(largest, kResetSlewN + 1e-9);
+}
+
+// A device that renders nothing (disabled or engaging) gets zero force and
+// no stiffness, so it can engage while the blade presses; once it renders,
+// the force climbs from zero at most 0.1 N a tick.
+TEST(HapticLoop, AnIdleDeviceGetsZeroThenTheSlew) {
+  PressRig rig;
+  ASSERT_TRUE(rig.press());
+  std::uint64_t tick = rig.tick;
+  for (int i = 0; i < 60; ++i, ++tick) {
+    msg::DevicePose pose = device_pose(tick, rig.deep, kPressPitchDeg);
+    pose.safety_state(msg::DEVICE_ENGAGING);
+    rig.loop.tick(pose, rig.snapshot, rig.command, rig.contacts);
+    EXPECT_EQ(to_eigen(rig.command.force_n()).norm(), 0.0);
+    EXPECT_EQ(rig.command.reason(), msg::FORCE_DEVICE_NOT_ENABLED);
+  }
+  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+  double largest = 0.0;
+  for (int i = 0; i < 200; ++i, ++tick) {
+    if (tick % 5 == 0) {
+      rig.state = rest_with_compliance(rig.setup, rig.contacts, tick / 5);
+      ASSERT_TRUE(rig.digest.digest(rig.state, rig.snapshot));
+    }
+    rig.loop.tick(device_pose(tick, rig.deep, kPressPitchDeg), rig.snapshot, rig.command,
+                  rig.contacts);
+    const Eigen::Vector3d force = to_eigen(rig.command.force_n());
+    largest = std::max(largest, (force - previous).norm());
+    previous = force;
+  }
+  EXPECT_GT(previous.norm(), 0.3);
+  EXPECT_LE(largest, kResetSlewN + 1e-9);
+}
+
 #ifndef FAHR_SANITIZE_BUILD
 TEST(HapticLoop, TickAndDigestAllocateNothing) {
   PressRig rig;

@@ -37,6 +37,8 @@ msg::DevicePose device_pose(std::uint64_t tick, const Eigen::Vector3d& position_
               pose.world_from_stylus().orientation());
   pose.renderable_force_n(renderable_force_n);
   pose.max_stiffness_npm(1480.0);
+  // A device rendering the commands (one that is not gets zero force).
+  pose.safety_state(msg::DEVICE_FORCE_ENABLED);
   return pose;
 }
 

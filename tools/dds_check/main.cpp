@@ -86,13 +86,18 @@ int main(int argc, char** argv) try {
   app.add_option("--dds", dds, "DDS vendor (default: $FAHR_DDS, else fastdds)");
   app.add_option("--domain", domain, "DDS domain id 0-230 (default: $FAHR_DOMAIN_ID, else 0)");
   app.add_option("--dds-profile", profile, "vendor XML configuration (default: $FAHR_DDS_PROFILE)");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   app.add_option("--listen-s", listen_s, "seconds to listen for services' ServiceStatus");
   bool station = false;
   app.add_flag("--station", station,
                "probe every station topic: discovery time, endpoints matched, samples");
   CLI11_PARSE(app, argc, argv);
   try {
-    auto config = fahr::common::transport_config_from(dds, domain, profile, "fahr_dds_check");
+    auto config =
+        fahr::common::transport_config_from(dds, domain, profile, "fahr_dds_check", security);
     const auto joined = Clock::now();
     fahr::common::Participant participant(config);
     if (station) {

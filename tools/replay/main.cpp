@@ -162,10 +162,15 @@ int run(int argc, char** argv) {
   app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds");
   app.add_option("--domain", domain, "DDS domain 0-230");
   app.add_option("--dds-profile", profile, "vendor XML profile");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   common::install_stop_handlers();
-  common::Participant participant(common::transport_config_from(dds, domain, profile, "replay"));
+  common::Participant participant(
+      common::transport_config_from(dds, domain, profile, "replay", security));
   if (mode == "lockstep") return replay_lockstep(path, participant);
   std::set<std::string> topics;
   std::stringstream csv(topics_csv);

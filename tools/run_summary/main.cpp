@@ -3,7 +3,9 @@
 // late periods and tick CPU time, deadline misses and errors from its
 // ServiceEvents, motion-to-force latency (from the gateway's metrics), peak
 // force against the device's limit and lost-track episodes (from
-// ForceCommand).
+// ForceCommand). A service whose reports stop for more than a second has a
+// silence (a gap); one silent at the end is dead and gets no rate; one that
+// comes back as another participant was restarted.
 //
 //   fahr_run_summary --duration-s S [--dds V] [--domain N] [--dds-profile F]
 #include <CLI/CLI.hpp>
@@ -28,7 +30,24 @@ namespace {
 
 using namespace fahr;
 
+// A gap longer than this between two ServiceStatus of a service (any of
+// its instances) is a silence: a dead, stopped or stalled service (reports
+// come 4 times a second).
+constexpr double kSilenceS = 1.0;
+
+struct Silence {
+  double from_s = 0;     // the last report before it, s after the summary began
+  double to_s = -1;      // the first report after it; < 0: still silent at the end
+  bool restart = false;  // it came back as another participant (a restart)
+};
+
 struct ServiceTally {
+  // Each ServiceStatus's arrival, s after the summary began, and its writer.
+  double last_report_s = -1;
+  std::uint32_t last_writer = 0;
+  bool stopping = false;  // the newest report said SERVICE_STOPPING
+  std::set<std::uint32_t> writers;
+  std::vector<Silence> silences;
   std::string vendor;
   double nominal_hz = 0;
   std::vector<double> measured_hz;
@@ -56,7 +75,22 @@ struct Tally {
   double limit_n = 0;
   double peak_rendered_n = 0;
   std::uint64_t poses = 0;
+  std::map<int, std::uint64_t> command_reasons;  // ForceCommand.reason -> samples
 };
+
+const char* reason_name(int reason) {
+  switch (reason) {
+    case msg::FORCE_RENDERED:
+      return "rendered";
+    case msg::FORCE_RESUMING:
+      return "resuming (slew)";
+    case msg::FORCE_TISSUE_LOST:
+      return "tissue lost (ramp to zero)";
+    case msg::FORCE_DEVICE_NOT_ENABLED:
+      return "device not enabled (zero)";
+  }
+  return "unknown";
+}
 
 double norm(const msg::Vec3& v) {
   return common::to_eigen(v).norm();
@@ -72,24 +106,52 @@ void print(const Tally& t, double duration_s) {
   std::printf("\n## fahr run summary (%.1f s)\n\n", duration_s);
   std::printf(
       "| service | vendor | nominal Hz | measured Hz (median) | ticks | late periods | tick CPU "
-      "p99 us (worst) | period max ms (worst) | deadline misses |\n");
-  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+      "p99 us (worst) | period max ms (worst) | deadline misses | silences | restarts |\n");
+  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const auto& [name, s] : t.services) {
     long misses = 0;
     for (int k : {msg::QOS_REQUESTED_DEADLINE_MISSED, msg::QOS_OFFERED_DEADLINE_MISSED}) {
       auto it = s.qos_events.find(k);
       if (it != s.qos_events.end()) misses += it->second;
     }
-    std::printf("| %s | %s | %.0f | %.1f | %llu | %llu | %.1f | %.2f | %ld |\n", name.c_str(),
-                s.vendor.c_str(), s.nominal_hz, median(s.measured_hz),
+    // A service silent at the end (and not stopping) has no rate: it is dead.
+    const bool dead = !s.silences.empty() && s.silences.back().to_s < 0;
+    char rate[64];
+    if (dead) {
+      std::snprintf(rate, sizeof(rate), "dead since %.2f s", s.silences.back().from_s);
+    } else {
+      std::snprintf(rate, sizeof(rate), "%.1f", median(s.measured_hz));
+    }
+    std::printf("| %s | %s | %.0f | %s | %llu | %llu | %.1f | %.2f | %ld | %zu | %zu |\n",
+                name.c_str(), s.vendor.c_str(), s.nominal_hz, rate,
                 static_cast<unsigned long long>(s.ticks),
                 static_cast<unsigned long long>(s.late_periods),
                 static_cast<double>(s.worst_cpu_p99_ns) / 1e3,
-                static_cast<double>(s.worst_period_max_ns) / 1e6, misses);
+                static_cast<double>(s.worst_period_max_ns) / 1e6, misses, s.silences.size(),
+                s.writers.empty() ? std::size_t{0} : s.writers.size() - 1);
+  }
+  bool gaps = false;
+  for (const auto& [name, s] : t.services) {
+    for (const Silence& g : s.silences) {
+      if (!gaps) std::printf("\nGaps (no ServiceStatus for more than %.1f s):\n\n", kSilenceS);
+      gaps = true;
+      if (g.to_s < 0) {
+        std::printf("- %s: silent from %.2f s to the end (dead)\n", name.c_str(), g.from_s);
+      } else {
+        std::printf("- %s: silent from %.2f s to %.2f s (%.2f s), back %s\n", name.c_str(),
+                    g.from_s, g.to_s, g.to_s - g.from_s,
+                    g.restart ? "as a new participant (restarted)" : "as the same participant");
+      }
+    }
   }
   std::printf("\n| figure | value |\n|---|---:|\n");
   std::printf("| DevicePose samples | %llu |\n", static_cast<unsigned long long>(t.poses));
   std::printf("| ForceCommand samples | %llu |\n", static_cast<unsigned long long>(t.commands));
+  for (const auto& [reason, count] : t.command_reasons) {
+    if (reason == msg::FORCE_RENDERED) continue;
+    std::printf("| ForceCommand samples: %s | %llu |\n", reason_name(reason),
+                static_cast<unsigned long long>(count));
+  }
   std::printf("| device force limit (renderable, last) N | %.2f |\n", t.limit_n);
   std::printf("| peak rendered force N | %.2f |\n", t.peak_rendered_n);
   std::printf("| peak commanded force N | %.2f |\n", t.peak_command_n);
@@ -127,18 +189,36 @@ int main(int argc, char** argv) try {
   app.add_option("--dds", dds, "DDS vendor");
   app.add_option("--domain", domain, "DDS domain id");
   app.add_option("--dds-profile", profile, "vendor XML configuration");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   CLI11_PARSE(app, argc, argv);
   common::install_stop_handlers();
   try {
     common::Participant participant(
-        common::transport_config_from(dds, domain, profile, "fahr_run_summary"));
+        common::transport_config_from(dds, domain, profile, "fahr_run_summary", security));
     Tally tally;
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
     common::QosProfile reports = common::QosProfile::for_role(common::TopicRole::kReport);
     common::Subscriber<msg::ServiceStatus> status(
         participant, reports, common::TopicTraits<msg::ServiceStatus>::kName,
         [&](const msg::ServiceStatus& s, const common::SampleInfo&) {
           std::lock_guard lock(tally.mutex);
           auto& t = tally.services[s.service_name().to_string()];
+          const double now_s = std::chrono::duration<double>(Clock::now() - start).count();
+          const std::uint32_t writer = s.header().writer_id();
+          if (!t.silences.empty() && t.silences.back().to_s < 0) {
+            t.silences.back().to_s = now_s;
+            t.silences.back().restart = writer != t.last_writer;
+          } else if (t.last_report_s >= 0 && now_s - t.last_report_s > kSilenceS) {
+            t.silences.push_back({t.last_report_s, now_s, writer != t.last_writer});
+          }
+          t.last_report_s = now_s;
+          t.last_writer = writer;
+          t.writers.insert(writer);
+          t.stopping = s.state() == msg::SERVICE_STOPPING;
           t.vendor = s.dds_vendor().to_string();
           t.nominal_hz = s.nominal_rate_hz();
           if (s.measured_rate_hz() > 0) t.measured_hz.push_back(s.measured_rate_hz());
@@ -178,6 +258,7 @@ int main(int argc, char** argv) try {
         [&](const msg::ForceCommand& c, const common::SampleInfo&) {
           std::lock_guard lock(tally.mutex);
           ++tally.commands;
+          ++tally.command_reasons[static_cast<int>(c.reason())];
           tally.peak_command_n = std::max(tally.peak_command_n, norm(c.force_n()));
           tally.peak_reaction_n = std::max(tally.peak_reaction_n, c.tissue_reaction_n());
           if (c.lost_track() && !tally.lost_track) ++tally.lost_track_episodes;
@@ -204,6 +285,14 @@ int main(int argc, char** argv) try {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     std::lock_guard lock(tally.mutex);
+    // Silent at the end, without having said it stops: dead (or stalled).
+    const double end_s = std::chrono::duration<double>(Clock::now() - start).count();
+    for (auto& [name, t] : tally.services) {
+      if (t.last_report_s >= 0 && !t.stopping && end_s - t.last_report_s > kSilenceS &&
+          (t.silences.empty() || t.silences.back().to_s >= 0)) {
+        t.silences.push_back({t.last_report_s, -1, false});
+      }
+    }
     print(tally, elapsed_s());
     return 0;
   } catch (const common::ConfigError& e) {

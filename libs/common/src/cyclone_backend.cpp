@@ -10,6 +10,7 @@
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 #include <dds/ddsi/ddsi_sertype.h>
+#include <dds/security/dds_security_api_defs.h>
 
 #include <array>
 #include <atomic>
@@ -31,6 +32,12 @@ namespace {
 
 using eprosima::fastdds::dds::TopicDataType;
 using eprosima::fastrtps::rtps::SerializedPayload_t;
+
+#ifndef FAHR_CYCLONE_SECURITY_PLUGIN_DIR
+#define FAHR_CYCLONE_SECURITY_PLUGIN_DIR "/usr/lib/x86_64-linux-gnu/libddsc0debian"
+#endif
+// Where Debian's cyclonedds package installs the security plugins.
+constexpr const char* kCycloneSecurityPluginDir = FAHR_CYCLONE_SECURITY_PLUGIN_DIR;
 
 // Partition of the endpoints that discover a type's sertype; no service
 // ever uses it, so they match nothing outside this participant.
@@ -271,6 +278,7 @@ class CycloneParticipant final : public ParticipantBackend {
     if (!config.profile_file.empty()) create_domain(config);
     dds_qos_t* qos = dds_create_qos();
     dds_qset_entity_name(qos, config.participant_name.c_str());
+    if (!config.security_dir.empty()) set_security(config, qos);
     participant_ = dds_create_participant(config.domain_id, qos, nullptr);
     dds_delete_qos(qos);
     if (participant_ < 0) {
@@ -315,6 +323,32 @@ class CycloneParticipant final : public ParticipantBackend {
   bool raw_bytes_as_received() const override { return true; }
 
  private:
+  // DDS Security 1.1's builtin plugins as Debian installs them (Cyclone
+  // 0.10: dds_security_auth, dds_security_ac, dds_security_crypto, outside
+  // the loader's path), configured by the participant's properties.
+  static void set_security(const TransportConfig& config, dds_qos_t* qos) {
+    const SecurityFiles f = security_files(config);
+    const std::string plugins = kCycloneSecurityPluginDir;
+    const auto prop = [qos](const char* name, const std::string& value) {
+      dds_qset_prop(qos, name, value.c_str());
+    };
+    prop(DDS_SEC_PROP_AUTH_LIBRARY_PATH, plugins + "/libdds_security_auth.so");
+    prop(DDS_SEC_PROP_AUTH_LIBRARY_INIT, "init_authentication");
+    prop(DDS_SEC_PROP_AUTH_LIBRARY_FINALIZE, "finalize_authentication");
+    prop(DDS_SEC_PROP_CRYPTO_LIBRARY_PATH, plugins + "/libdds_security_crypto.so");
+    prop(DDS_SEC_PROP_CRYPTO_LIBRARY_INIT, "init_crypto");
+    prop(DDS_SEC_PROP_CRYPTO_LIBRARY_FINALIZE, "finalize_crypto");
+    prop(DDS_SEC_PROP_ACCESS_LIBRARY_PATH, plugins + "/libdds_security_ac.so");
+    prop(DDS_SEC_PROP_ACCESS_LIBRARY_INIT, "init_access_control");
+    prop(DDS_SEC_PROP_ACCESS_LIBRARY_FINALIZE, "finalize_access_control");
+    prop(DDS_SEC_PROP_AUTH_IDENTITY_CA, "file:" + f.ca_cert);
+    prop(DDS_SEC_PROP_AUTH_IDENTITY_CERT, "file:" + f.cert);
+    prop(DDS_SEC_PROP_AUTH_PRIV_KEY, "file:" + f.key);
+    prop(DDS_SEC_PROP_ACCESS_PERMISSIONS_CA, "file:" + f.ca_cert);
+    prop(DDS_SEC_PROP_ACCESS_GOVERNANCE, "file:" + f.governance);
+    prop(DDS_SEC_PROP_ACCESS_PERMISSIONS, "file:" + f.permissions);
+  }
+
   void create_domain(const TransportConfig& config) {
     std::ifstream in(config.profile_file);
     std::stringstream text;
@@ -360,6 +394,14 @@ class CycloneParticipant final : public ParticipantBackend {
     const dds_entity_t reader = dds_create_reader(probe_subscriber, topic, qos, nullptr);
     const dds_entity_t writer = dds_create_writer(probe_publisher, topic, qos, nullptr);
     dds_delete_qos(qos);
+    if (writer < 0 || reader < 0) {
+      // DDS Security: this participant's permissions do not allow it.
+      const dds_return_t rc = writer < 0 ? writer : reader;
+      dds_delete(probe_publisher);
+      dds_delete(probe_subscriber);
+      throw std::runtime_error("Cyclone DDS refused a writer of " + spec.topic_name + ": " +
+                               retcode_text(rc));
+    }
     const auto* descriptor =
         static_cast<const dds_topic_descriptor_t*>(spec.type->cyclone_descriptor);
     void* zero = std::calloc(1, descriptor->m_size);

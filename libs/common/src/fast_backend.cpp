@@ -334,6 +334,22 @@ class FastParticipant final : public ParticipantBackend {
     }
     if (transport.send_socket_buffer_size == 0)
       transport.send_socket_buffer_size = kSocketBufferBytes;
+    if (!config.security_dir.empty()) {
+      // The builtin plugins of DDS Security 1.1 (Fast DDS 2.9 is built with them).
+      const SecurityFiles f = security_files(config);
+      auto& p = qos.properties().properties();
+      const std::string auth = "dds.sec.auth.builtin.PKI-DH.";
+      const std::string access = "dds.sec.access.builtin.Access-Permissions.";
+      p.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+      p.emplace_back(auth + "identity_ca", "file://" + f.ca_cert);
+      p.emplace_back(auth + "identity_certificate", "file://" + f.cert);
+      p.emplace_back(auth + "private_key", "file://" + f.key);
+      p.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
+      p.emplace_back(access + "permissions_ca", "file://" + f.ca_cert);
+      p.emplace_back(access + "governance", "file://" + f.governance);
+      p.emplace_back(access + "permissions", "file://" + f.permissions);
+      p.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+    }
     participant_ = factory->create_participant(config.domain_id, qos);
     if (participant_ == nullptr) {
       throw std::runtime_error("Fast DDS could not create a participant in domain " +

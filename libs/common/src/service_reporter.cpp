@@ -32,7 +32,7 @@ namespace {
 // Bounds of idl/fahr/service_status.idl.
 constexpr std::size_t kMaxSpansPerReport = 1024;
 constexpr std::size_t kMaxQosEventsPerReport = 128;
-constexpr std::size_t kMaxMetrics = 32;
+constexpr std::size_t kMaxMetrics = 48;
 constexpr std::size_t kMaxErrorsPerReport = 8;
 constexpr std::size_t kMaxErrorChars = 200;
 

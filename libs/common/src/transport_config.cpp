@@ -3,6 +3,7 @@
 
 #include <charconv>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -33,7 +34,27 @@ std::uint32_t parse_domain(std::string_view text, std::string_view source) {
 
 }  // namespace
 
+SecurityFiles security_files(const TransportConfig& config) {
+  std::filesystem::path dir = std::filesystem::absolute(config.security_dir);
+  const std::filesystem::path id = dir / "identities" / config.identity_name();
+  return {(dir / "ca.cert.pem").string(), (dir / "governance.p7s").string(),
+          (id / "cert.pem").string(), (id / "key.pem").string(), (id / "permissions.p7s").string()};
+}
+
 void validate(const TransportConfig& config) {
+  if (!config.security_dir.empty()) {
+    if (config.vendor == Vendor::kInProcess)
+      throw ConfigError("--security: the in-process bus has no DDS Security");
+    const SecurityFiles f = security_files(config);
+    for (const std::string* file : {&f.ca_cert, &f.governance, &f.cert, &f.key, &f.permissions}) {
+      if (!std::ifstream(*file)) {
+        throw ConfigError("--security " + config.security_dir + ": '" + *file +
+                          "' cannot be read (no identity '" + config.identity_name() +
+                          "' in this station's folder? deployment/security/"
+                          "make_station_security.sh makes them)");
+      }
+    }
+  }
   if (config.domain_id > kMaxDomainId) {
     throw ConfigError("domain_id: " + std::to_string(config.domain_id) + " is out of range [0, " +
                       std::to_string(kMaxDomainId) + "]");
@@ -67,7 +88,8 @@ void validate(const TransportConfig& config) {
 }
 
 TransportConfig transport_config_from(std::string_view vendor_flag, std::string_view domain_flag,
-                                      std::string_view profile_flag, std::string participant_name) {
+                                      std::string_view profile_flag, std::string participant_name,
+                                      std::string_view security_flag) {
   TransportConfig config;
   config.vendor = resolve_vendor(vendor_flag);
   config.participant_name = std::move(participant_name);
@@ -79,6 +101,9 @@ TransportConfig transport_config_from(std::string_view vendor_flag, std::string_
   config.profile_file =
       profile_flag.empty() ? env_or_empty("FAHR_DDS_PROFILE") : std::string(profile_flag);
   config.partition = env_or_empty("FAHR_PARTITION");
+  config.security_dir =
+      security_flag.empty() ? env_or_empty("FAHR_DDS_SECURITY") : std::string(security_flag);
+  config.identity = env_or_empty("FAHR_DDS_IDENTITY");
   validate(config);
   return config;
 }

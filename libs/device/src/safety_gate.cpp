@@ -61,6 +61,7 @@ Vec3 SafetyGate::next_target(const Vec3& candidate_n, const Vec3& commanded_n, b
       if (small_ticks_ < config_.engage_cycles) return Vec3::Zero();
       state_ = SafetyState::kForceEnabled;
       ++counters_.engage_events;
+      catching_up_ = true;
       return candidate_n;
     case SafetyState::kForceEnabled:
       if (!silent) return candidate_n;
@@ -83,16 +84,33 @@ Vec3 SafetyGate::next_target(const Vec3& candidate_n, const Vec3& commanded_n, b
   return Vec3::Zero();
 }
 
-Vec3 SafetyGate::rate_limit(const Vec3& target_n) {
+Vec3 SafetyGate::rate_limit(const Vec3& target_n, bool transition) {
   const Vec3 step = target_n - last_output_n_;
   const double size = step.norm();
+  if (transition && !catching_up_) {
+    const double limit = std::min(max_step_n_, config_.resume_step_n);
+    if (size <= limit) return target_n;
+    ++counters_.catch_up_ticks;
+    return last_output_n_ + step * (limit / size);
+  }
+  if (catching_up_) {
+    // After engaging or resuming: at most resume_step_n a tick until the
+    // output meets the commands.
+    const double limit = std::min(max_step_n_, config_.resume_step_n);
+    if (size <= limit) {
+      catching_up_ = false;
+      return target_n;
+    }
+    ++counters_.catch_up_ticks;
+    return last_output_n_ + step * (limit / size);
+  }
   if (size <= max_step_n_) return target_n;
   ++counters_.rate_limited_ticks;
   return last_output_n_ + step * (max_step_n_ / size);
 }
 
 Vec3 SafetyGate::limit(const Vec3& candidate_n, const Vec3& commanded_n, bool accepted_now,
-                       bool fault, double renderable_n) {
+                       bool fault, double renderable_n, bool transition) {
   ticks_since_command_ = accepted_now ? 0 : ticks_since_command_ + 1;
   if (fault) {
     // A faulted device gets no force at all, not even a ramp.
@@ -106,7 +124,7 @@ Vec3 SafetyGate::limit(const Vec3& candidate_n, const Vec3& commanded_n, bool ac
   if (saturated.norm() < target.norm()) ++counters_.saturated_ticks;
   // Saturate, rate limit, saturate again: the second pass only bites if the
   // renderable force itself fell faster than the rate limit (limits first).
-  Vec3 output = saturate(rate_limit(saturated), renderable_n);
+  Vec3 output = saturate(rate_limit(saturated, transition), renderable_n);
   if (!output.allFinite()) {
     ++counters_.non_finite_outputs;
     output.setZero();

@@ -23,6 +23,7 @@ void check(const GatewayConfig& config) {
     throw std::invalid_argument("safety.max_answer_age_ticks must be >= 1");
   if (!(s.max_force_rate_nps > 0.0))
     throw std::invalid_argument("safety.max_force_rate_nps must be > 0");
+  if (!(s.resume_step_n > 0.0)) throw std::invalid_argument("safety.resume_step_n must be > 0");
   if (!(s.engage_threshold_n >= 0.0))
     throw std::invalid_argument("safety.engage_threshold_n must be >= 0");
   if (!(config.render.max_correction_m > 0.0 && config.render.max_correction_m <= 0.1)) {
@@ -31,9 +32,11 @@ void check(const GatewayConfig& config) {
   if (!(config.mapping.motion_scale > 0.0 && config.mapping.motion_scale <= 100.0)) {
     throw std::invalid_argument("mapping.motion_scale must be in (0, 100]");
   }
-  if (!(config.passivity.max_damping_nspm >= 0.0 && config.passivity.max_stored_energy_j > 0.0)) {
+  if (!(config.passivity.max_damping_nspm >= 0.0 && config.passivity.max_stored_energy_j > 0.0 &&
+        config.passivity.max_damping_release_n > 0.0)) {
     throw std::invalid_argument(
-        "passivity: max_damping_nspm must be >= 0, max_stored_energy_j > 0");
+        "passivity: max_damping_nspm must be >= 0, max_stored_energy_j > 0, max_damping_release_n "
+        "> 0");
   }
 }
 
@@ -72,6 +75,7 @@ const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now,
         *incoming, tick_, renderer_.has_command() ? renderer_.answered_pose_seq() : 0);
     if (verdict == Verdict::kAccepted) {
       accepted = true;
+      transition_ = incoming->transition;
       renderer_.set_command(*incoming);
       std::chrono::nanoseconds published{0};
       if (pose_times_.find(incoming->answered_pose_seq, published))
@@ -86,7 +90,8 @@ const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now,
   // holds in every DevicePose; the next tick's limit differs by one tick of
   // heating at most.
   const double renderable_n = thermal_.renderable_force_n();
-  const Vec3 output = safety_.limit(candidate, commanded, accepted, reading.fault, renderable_n);
+  const Vec3 output =
+      safety_.limit(candidate, commanded, accepted, reading.fault, renderable_n, transition_);
   passivity_.account(output, velocity, dt_);
   thermal_.update(output.norm(), dt_);
   backend_.apply(config_.mapping.force_to_device(output));

@@ -18,6 +18,9 @@ void add_service_options(CLI::App& app, ServiceOptions& o) {
   app.add_option("--dds", o.dds, "DDS vendor: fastdds, cyclonedds, inprocess");
   app.add_option("--domain", o.domain, "DDS domain id 0-230");
   app.add_option("--dds-profile", o.profile, "vendor XML configuration");
+  app.add_option("--security", o.security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   app.add_option(
       "--duration-s", o.duration_s,
       "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");

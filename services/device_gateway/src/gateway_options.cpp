@@ -12,7 +12,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: fahr_device_gateway [--dds fastdds|cyclonedds|inprocess] [--domain N] [--dds-profile "
-    "FILE]\n"
+    "FILE] [--security DIR]\n"
     "         [--mode realtime|lockstep] [--backend simulated|replay|remote|openhaptics]\n"
     "         [--script intubation|overshoot] [--model touch_x|touch] [--duration-s S]\n"
     "         [--replay-file FILE] [--record-file FILE] [--device-id N] [--rt-priority 1-99]\n"
@@ -59,6 +59,8 @@ std::optional<GatewayOptions> parse_options(int argc, char** argv) {
       o.domain = value;
     else if (flag == "--dds-profile" || flag == "--profile")
       o.profile = value;
+    else if (flag == "--security")
+      o.security = value;
     else if (flag == "--mode")
       o.mode = value;
     else if (flag == "--backend")

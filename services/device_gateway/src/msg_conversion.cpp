@@ -31,6 +31,7 @@ void from_msg(const msg::ForceCommand& in, device::ForceCommandSample& out) {
   out.force_n = to_eigen(in.force_n());
   out.stiffness_npm = to_eigen(in.stiffness_npm());
   out.torque_nm = to_eigen(in.torque_nm());
+  out.transition = in.reason() != msg::FORCE_RENDERED;
 }
 
 void reading_from_msg(const msg::DevicePose& in, device::DeviceReading& out) {

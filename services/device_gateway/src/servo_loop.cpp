@@ -30,6 +30,9 @@ using namespace std::chrono_literals;
 constexpr std::string_view kRemoteInputTopic = "fahr/RemoteInput";
 // Poses kept for --record-file are preallocated: at most this many seconds.
 constexpr double kMaxRecordedSeconds = 3600.0;
+// Periods behind schedule after which the real-time loop gives up the
+// missed ticks and starts again from now (50 ms).
+constexpr std::int64_t kResyncPeriods = 50;
 
 void try_realtime(int priority) {
   if (priority <= 0) return;
@@ -165,10 +168,25 @@ int run_realtime(const GatewayOptions& o, GatewaySetup& setup, common::Participa
       core.latency().reset();
     }
     deadline_ns += period_ns;
+    // Far behind (the process was stopped, or starved): a servo loop that
+    // ran every missed tick back to back would replay a second of device
+    // time in a burst; it starts again from now instead, the ticks skipped.
+    const std::int64_t behind_ns = common::monotonic_now_ns() - deadline_ns;
+    if (behind_ns > kResyncPeriods * period_ns) {
+      state.skipped_ticks += static_cast<std::uint64_t>(behind_ns / period_ns);
+      ++state.resyncs;
+      deadline_ns = common::monotonic_now_ns();
+    }
     wait_until(deadline_ns, static_cast<std::int64_t>(o.spin_us) * 1000);
   }
   fill_snapshot(core, setup, state);
   metrics.offer(state.snapshot);
+  if (state.resyncs > 0) {
+    std::printf("device_gateway: %llu times behind by more than %lld periods: %llu ticks skipped\n",
+                static_cast<unsigned long long>(state.resyncs),
+                static_cast<long long>(kResyncPeriods),
+                static_cast<unsigned long long>(state.skipped_ticks));
+  }
   return 0;
 }
 

@@ -42,6 +42,8 @@ void GatewayMetrics::fill(std::vector<std::pair<std::string, double>>& metrics) 
   metrics.emplace_back("saturated_ticks", static_cast<double>(s.safety.saturated_ticks));
   metrics.emplace_back("rate_limited_ticks", static_cast<double>(s.safety.rate_limited_ticks));
   metrics.emplace_back("silence_events", static_cast<double>(s.safety.silence_events));
+  metrics.emplace_back("resumed_events", static_cast<double>(s.safety.resumed_events));
+  metrics.emplace_back("catch_up_ticks", static_cast<double>(s.safety.catch_up_ticks));
   metrics.emplace_back("remote_rejected", static_cast<double>(s.remote_rejected));
 }
 

@@ -54,8 +54,15 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
   const auto period = scene.rates.fem_period();
   const auto start = Clock::now();
   auto next = start;
+  std::uint64_t resyncs = 0;
   for (std::uint64_t tick = 0; !common::stop_requested(); ++tick) {
     next += period;
+    // Far behind (stopped, starved): start again from now rather than run
+    // the missed steps back to back.
+    if (Clock::now() - next > 10 * period) {
+      next = Clock::now();
+      ++resyncs;
+    }
     std::this_thread::sleep_until(next);
     if (duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(duration_s)) break;
     const std::int64_t t0 = common::monotonic_now_ns();
@@ -67,6 +74,10 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
         static_cast<std::int64_t>(fem_step.last_report().time_s * 1e9));
     out.write(fem_step.state());
     record(recorder, fem_step, tick, t0, c0);
+  }
+  if (resyncs > 0) {
+    std::printf("fahr_fem_service: %llu times more than 10 steps behind: started again from now\n",
+                static_cast<unsigned long long>(resyncs));
   }
   return 0;
 }

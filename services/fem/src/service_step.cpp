@@ -52,6 +52,14 @@ void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
     have_contacts_ = false;
     return;
   }
+  if (wire.fem_step() > setup_.body->step_index()) {
+    // It answers a state this body has not produced: one of an FEM service
+    // before a restart (its steps numbered further). Never applied; the
+    // haptic service's next set answers this body's states.
+    ahead_sets_.fetch_add(1, std::memory_order_relaxed);
+    have_contacts_ = false;
+    return;
+  }
   if (!layout_check_.accept(wire.layout_fingerprint())) {
     // Its sphere ids name other spheres: nothing of it is applied, nor the
     // set before it (which it supersedes).
@@ -126,6 +134,9 @@ void ServiceStep::take_errors(std::vector<std::string>& errors) {
   say(non_finite_sets_, non_finite_said_,
       "ContactSet refused: a non-finite number in a contact or the tool's pose; its contacts "
       "are not applied");
+  say(ahead_sets_, ahead_said_,
+      "ContactSet refused: it answers an FEM step this service has not reached (a state of an "
+      "FEM service before a restart)");
   say(failed_solves_, failed_said_,
       "FEM linear solve failed or gave a non-finite velocity: the step kept the positions with "
       "zero velocity");
@@ -138,6 +149,7 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets_));
   out.emplace_back("layout_refused_sets", static_cast<double>(layout_check_.refused()));
   out.emplace_back("non_finite_contact_sets", static_cast<double>(non_finite_sets()));
+  out.emplace_back("ahead_contact_sets", static_cast<double>(ahead_sets()));
   out.emplace_back("failed_solves", static_cast<double>(failed_solves()));
   out.emplace_back("compliance_reuses", static_cast<double>(contact_step_.compliance_reuses()));
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 
 #include "fahr/common/wire_eigen.h"
@@ -308,21 +309,66 @@ void HapticLoop::collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool) 
   relaxed_store(metrics_.anatomy_rows, static_cast<std::uint32_t>(keep));
 }
 
+void HapticLoop::begin_resume(const contact::DeviceSample& device) {
+  response_.reset(device.position_m, device.orientation);
+  slewing_ = true;
+  slew_ticks_left_ = kSlewWindowTicks;
+}
+
 void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
-                      msg::ForceCommand& command, msg::ContactSet& contacts) {
+                      msg::ForceCommand& command, msg::ContactSet& contacts, bool tissue_lost) {
   const auto start = std::chrono::steady_clock::now();
   const contact::DeviceSample device = device_sample(pose);
   if (!started_) {
     response_.reset(device.position_m, device.orientation);
     started_ = true;
   }
+  // The device renders nothing (disabled, engaging, faulted) or ramps our
+  // last force down (commands went silent): the force we send next starts
+  // from what it renders, not from what we sent.
+  const msg::DeviceSafetyState device_state = pose.safety_state();
+  const bool device_idle =
+      device_state != msg::DEVICE_FORCE_ENABLED && device_state != msg::DEVICE_RAMPING_DOWN;
+  if (device_idle || device_state == msg::DEVICE_RAMPING_DOWN) {
+    rendered_n_ = common::to_eigen(pose.rendered_force_n());
+    slewing_ = true;
+    slew_ticks_left_ = kSlewWindowTicks;
+  }
+  device_idle_ = device_idle;
+  if (tissue_lost) {
+    lost_tick(pose, device, tissue, command, contacts);
+    const double tick_us = elapsed_us(start);
+    store_max(metrics_.tick_us_max, tick_us);
+    store_max(metrics_.tick_us_peak, tick_us);
+    return;
+  }
+  if (tissue_lost_) {
+    // A state came again: the force slews from the ramp's value. The same
+    // FEM after a stall has the tongue where it left it (relaxed, if
+    // anything: the ContactSets were empty), so the proxy stays where that
+    // tongue held it and goes on from there; a new writer or a new epoch
+    // (below) moves it to the hand.
+    tissue_lost_ = false;
+    slewing_ = true;
+    slew_ticks_left_ = kSlewWindowTicks;
+    relaxed_add<std::uint64_t>(metrics_.tissue_returns, 1);
+  }
+  if (tissue.from_fem && tissue.fem_writer != fem_writer_) {
+    // A restarted FEM service (a new writer) starts from rest with its own
+    // step and epoch numbering: the same resume as a reset epoch.
+    if (fem_writer_ != 0) {
+      begin_resume(device);
+      relaxed_add<std::uint64_t>(metrics_.fem_writers, 1);
+    }
+    fem_writer_ = tissue.fem_writer;
+    reset_epoch_ = tissue.reset_epoch;
+  }
   if (tissue.from_fem && tissue.reset_epoch != reset_epoch_) {
     // The tongue jumped back to rest: what the proxy held and the contacts
     // it had mean nothing now. The proxy goes to the hand, and the force
     // slews from what was rendered to what the new tongue gives.
     reset_epoch_ = tissue.reset_epoch;
-    response_.reset(device.position_m, device.orientation);
-    slewing_ = true;
+    begin_resume(device);
     relaxed_add<std::uint64_t>(metrics_.tissue_resets, 1);
   }
   if (tissue.from_fem && tissue.fem_step != last_fem_step_) {
@@ -373,7 +419,18 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   phases_.response_us = Micro(response_end - response_start).count();
 
   fill_command(out, pose.device_id(), command);
-  if (slewing_) slew_force(command);
+  command.reason(msg::FORCE_RENDERED);
+  if (device_idle) {
+    // Zero until the device has engaged (its engage rule wants a small
+    // force), then the slew from zero.
+    common::put(Eigen::Vector3d(Eigen::Vector3d::Zero()), command.force_n());
+    common::put(Eigen::Matrix3d(Eigen::Matrix3d::Zero()), command.stiffness_npm());
+    command.reason(msg::FORCE_DEVICE_NOT_ENABLED);
+    relaxed_add<std::uint64_t>(metrics_.device_idle_ticks, 1);
+  } else if (slewing_) {
+    slew_force(command);
+    if (slewing_) command.reason(msg::FORCE_RESUMING);
+  }
   rendered_n_ = common::to_eigen(command.force_n());
   command.header().sim_step(pose.servo_tick());
   command.header().sim_time_ns(pose.header().sim_time_ns());
@@ -424,6 +481,67 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   store_max(metrics_.tick_us_peak, tick_us);
 }
 
+// No usable FEM state for kTissueLossTimeoutNs: the frozen tongue is not
+// rendered. The force ramps from its value at the loss to zero over
+// kLossRampTicks servo ticks, at most kResetSlewN a command, with no local
+// stiffness; the proxy sits at the hand; the ContactSet is empty (no
+// contacts: the FEM, when it comes back, relaxes instead of pressing on a
+// tool it no longer follows).
+void HapticLoop::lost_tick(const msg::DevicePose& pose, const contact::DeviceSample& device,
+                           const TissueSnapshot& tissue, msg::ForceCommand& command,
+                           msg::ContactSet& contacts) {
+  if (!tissue_lost_) {
+    tissue_lost_ = true;
+    loss_from_n_ = rendered_n_;
+    loss_servo_tick_ = pose.servo_tick();
+    relaxed_add<std::uint64_t>(metrics_.tissue_losses, 1);
+  }
+  const double elapsed = pose.servo_tick() > loss_servo_tick_
+                             ? static_cast<double>(pose.servo_tick() - loss_servo_tick_)
+                             : 0.0;
+  const Eigen::Vector3d target =
+      loss_from_n_ * std::max(0.0, 1.0 - (elapsed + 1.0) / kLossRampTicks);
+  Eigen::Vector3d change = target - rendered_n_;
+  if (change.norm() > kResetSlewN) change *= kResetSlewN / change.norm();
+  const Eigen::Vector3d force = device_idle_ ? Eigen::Vector3d(Eigen::Vector3d::Zero())
+                                             : Eigen::Vector3d(rendered_n_ + change);
+  command.device_id(pose.device_id());
+  command.answered_pose_seq(device.pose_seq);
+  common::put(device.position_m, command.answered_position_m());
+  common::put(force, command.force_n());
+  common::put(Eigen::Matrix3d(Eigen::Matrix3d::Zero()), command.stiffness_npm());
+  common::put(Eigen::Vector3d(Eigen::Vector3d::Zero()), command.torque_nm());
+  common::put(device.position_m, command.world_from_proxy().position_m());
+  common::put(device.orientation, command.world_from_proxy().orientation());
+  command.lost_track(false);
+  common::put(Eigen::Vector3d(Eigen::Vector3d::Zero()), command.device_minus_proxy_m());
+  command.tissue_reaction_n(0.0);
+  command.active_contacts(0);
+  command.fem_step(tissue.fem_step);
+  command.reason(msg::FORCE_TISSUE_LOST);
+  command.header().sim_step(pose.servo_tick());
+  command.header().sim_time_ns(pose.header().sim_time_ns());
+  rendered_n_ = force;
+  slewing_ = false;
+
+  contacts.body_id(setup_.deformable->id);
+  contacts.haptic_tick(tick_);
+  contacts.fem_step(tissue.fem_step);
+  contacts.layout_fingerprint(layout_fingerprint_);
+  contacts.tool_frozen(false);
+  contacts.contacts().clear();
+  common::put(device.position_m, contacts.world_from_tool().position_m());
+  common::put(device.orientation, contacts.world_from_tool().orientation());
+  contacts.header().sim_step(pose.servo_tick());
+  contacts.header().sim_time_ns(pose.header().sim_time_ns());
+  ++tick_;
+  relaxed_add<std::uint64_t>(metrics_.ticks, 1);
+  relaxed_add<std::uint64_t>(metrics_.tissue_lost_ticks, 1);
+  relaxed_store(metrics_.tool_rows, 0u);
+  relaxed_store(metrics_.active_contacts, 0u);
+  relaxed_store(metrics_.reaction_n, 0.0);
+}
+
 // The penalty baseline: each penetrating tissue row pushes its sphere with
 // k_p d along n, as a force-only ContactSet entry (the FEM applies it and
 // projects nothing); bone rows push the tool but not the tissue.
@@ -458,8 +576,12 @@ const contact::ForceOutput& HapticLoop::penalty_tick(const contact::DeviceSample
 void HapticLoop::slew_force(msg::ForceCommand& command) {
   const Eigen::Vector3d wanted = common::to_eigen(command.force_n());
   const Eigen::Vector3d change = wanted - rendered_n_;
+  if (slew_ticks_left_ > 0) --slew_ticks_left_;
   if (change.norm() <= kResetSlewN) {
-    slewing_ = false;
+    // Caught up; the slew ends once the window is over too (right after a
+    // reset the response's force is small: the proxy settles, the contacts
+    // come back, and then the force grows).
+    if (slew_ticks_left_ == 0) slewing_ = false;
     return;
   }
   common::put(Eigen::Vector3d(rendered_n_ + change * (kResetSlewN / change.norm())),
@@ -482,12 +604,40 @@ void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out
   out.emplace_back("rows_without_compliance", get(metrics_.rows_without_compliance));
   out.emplace_back("lost_track_ticks", get(metrics_.lost_track_ticks));
   out.emplace_back("tissue_resets", get(metrics_.tissue_resets));
+  out.emplace_back("tissue_losses", get(metrics_.tissue_losses));
+  out.emplace_back("tissue_returns", get(metrics_.tissue_returns));
+  out.emplace_back("fem_restarts_seen", get(metrics_.fem_writers));
+  out.emplace_back("tissue_lost_ticks", get(metrics_.tissue_lost_ticks));
+  out.emplace_back("device_idle_ticks", get(metrics_.device_idle_ticks));
   out.emplace_back("lost_track_episodes", get(metrics_.lost_track_episodes));
   out.emplace_back("tissue_reaction_n", get(metrics_.reaction_n));
   out.emplace_back("anatomy_reaction_n", get(metrics_.obstacle_reaction_n));
   out.emplace_back("peak_force_n", get(metrics_.peak_force_n));
   out.emplace_back("spheres", static_cast<double>(setup_.layout.size()));
   out.emplace_back("tick_us_max", metrics_.tick_us_max.exchange(0.0, std::memory_order_relaxed));
+}
+
+void HapticLoop::take_errors(std::vector<std::string>& errors) {
+  const auto say = [&](const std::atomic<std::uint64_t>& count, std::uint64_t& said,
+                       const char* what) {
+    const std::uint64_t now = count.load(std::memory_order_relaxed);
+    if (now == said) return;
+    char text[200];
+    std::snprintf(text, sizeof(text), "%s (%llu since start)", what,
+                  static_cast<unsigned long long>(now));
+    said = now;
+    errors.emplace_back(text);
+  };
+  say(metrics_.tissue_losses, losses_said_,
+      "FEM lost: no usable DeformationState for 50 ms; the tongue is not rendered, the force "
+      "ramps to zero over 150 ms");
+  say(metrics_.tissue_returns, returns_said_,
+      "FEM back: DeformationStates again; the force resumes through the reset slew");
+  say(metrics_.fem_writers, writers_said_,
+      "a new FEM writer (the FEM service restarted, its tongue at rest): resumed through the "
+      "reset slew");
+  say(metrics_.device_silences, silences_said_,
+      "DevicePose silent for 50 ms (the gateway lost or stalled): holding, no ForceCommand sent");
 }
 
 }  // namespace fahr::haptic_service

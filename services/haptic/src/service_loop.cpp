@@ -47,20 +47,43 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
   std::uint64_t seen = 0;
   std::uint64_t tick = 0;
   std::uint64_t polls = 0;
+  // The gateway gone or stalled: no DevicePose for the loss timeout. The
+  // service holds (sends nothing: nothing asks) and says so once per episode.
+  std::int64_t last_pose_ns = 0;
+  bool device_silent = false;
+  const auto check_device = [&] {
+    if (last_pose_ns == 0 || device_silent) return;
+    if (common::monotonic_now_ns() - last_pose_ns > kTissueLossTimeoutNs) {
+      device_silent = true;
+      loop.note_device_silence();
+    }
+  };
   while (!common::stop_requested()) {
     if (wait.spin) {
       // Check the clock and the stop flag every 4096 polls only.
-      if ((++polls & 4095u) == 0 && duration_s > 0 && Clock::now() - start > duration) break;
+      if ((++polls & 4095u) == 0) {
+        if (duration_s > 0 && Clock::now() - start > duration) break;
+        check_device();
+      }
       if (!poses.fetch_newest()) continue;
     } else {
       if (duration_s > 0 && Clock::now() - start > duration) break;
-      // 50 ms: short enough to notice a stop request, long enough not to spin.
-      seen = poses.wait_for_samples(seen, 50ms);
-      if (!poses.fetch_newest()) continue;
+      // 20 ms: short enough to notice a stop request or a silent device,
+      // long enough not to spin.
+      seen = poses.wait_for_samples(seen, 20ms);
+      if (!poses.fetch_newest()) {
+        check_device();
+        continue;
+      }
     }
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
-    loop.tick(poses.newest(), feed.newest(), command, contact_sets.back());
+    last_pose_ns = t0;
+    device_silent = false;
+    // The FEM is lost once it has sent states and then none for the timeout.
+    const std::int64_t last_state_ns = feed.last_state_ns();
+    const bool tissue_lost = last_state_ns != 0 && t0 - last_state_ns > kTissueLossTimeoutNs;
+    loop.tick(poses.newest(), feed.newest(), command, contact_sets.back(), tissue_lost);
     const std::int64_t c1 = common::thread_cpu_now_ns();
     commands.write(command);
     contact_sets.publish();

@@ -3,6 +3,8 @@
 
 #include <chrono>
 
+#include "fahr/common/clock.h"
+
 namespace fahr::haptic_service {
 
 TissueFeed::TissueFeed(common::Participant& participant, const HapticSetup& setup)
@@ -29,6 +31,7 @@ void TissueFeed::run() {
       continue;
     }
     buffer_.publish();
+    last_state_ns_.store(common::monotonic_now_ns(), std::memory_order_release);
     metrics_.fem_states.fetch_add(1, std::memory_order_relaxed);
     metrics_.obstacle_contacts.store(static_cast<std::uint32_t>(next.obstacle_count),
                                      std::memory_order_relaxed);

@@ -105,6 +105,7 @@ bool TissueDigest::digest(const msg::DeformationState& state, TissueSnapshot& ou
   out.from_fem = true;
   out.fem_step = state.step();
   out.reset_epoch = state.reset_epoch();
+  out.fem_writer = state.header().writer_id();
   query_obstacles(out);
   index_compliance(state, out);
   out.digest_us =

@@ -25,15 +25,34 @@ struct TransportConfig {
   // share a domain (FAHR_PARTITION; fahr_lab sets it per station). A plain
   // name: wildcards are refused.
   std::string partition;
+  // DDS Security: a station's folder (deployment/security/
+  // make_station_security.sh): ca.cert.pem, governance.p7s and
+  // identities/<identity>/{cert.pem,key.pem,permissions.p7s}. Empty: no
+  // security (and a secured station does not let this participant in).
+  std::string security_dir;
+  // The identity in security_dir; empty: participant_name.
+  std::string identity;
+
+  const std::string& identity_name() const {
+    return identity.empty() ? participant_name : identity;
+  }
 };
+
+// The files of a participant's identity in a station's security folder.
+struct SecurityFiles {
+  std::string ca_cert, governance, cert, key, permissions;  // absolute paths
+};
+SecurityFiles security_files(const TransportConfig& config);
 
 // Throws ConfigError naming the field: domain id out of range, profile file
 // missing or unreadable, profile of the wrong kind for the vendor.
 void validate(const TransportConfig& config);
 
-// Reads FAHR_DDS, FAHR_DOMAIN_ID, FAHR_DDS_PROFILE and FAHR_PARTITION, overridden by the
-// non-empty command-line values given. Throws ConfigError on bad values.
+  // Reads FAHR_DDS, FAHR_DOMAIN_ID, FAHR_DDS_PROFILE, FAHR_PARTITION and FAHR_DDS_SECURITY
+  // (and FAHR_DDS_IDENTITY), overridden by the non-empty command-line values given. Throws
+  // ConfigError on bad values (a missing security file named).
 TransportConfig transport_config_from(std::string_view vendor_flag, std::string_view domain_flag,
-                                      std::string_view profile_flag, std::string participant_name);
+                                      std::string_view profile_flag, std::string participant_name,
+                                      std::string_view security_flag = {});
 
 }  // namespace fahr::common

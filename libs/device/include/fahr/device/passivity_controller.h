@@ -12,7 +12,8 @@
 // pushed more energy into the hand than it received. The controller then
 // adds a damping force -beta v with beta chosen to bring W back to zero this
 // tick (bounded by max_damping_nspm so the damper itself stays stable on a
-// sampled device); what the bound leaves is carried to the next tick.
+// sampled device; its force falls by at most max_damping_release_n a tick
+// when no longer needed); what the bound leaves is carried to the next tick.
 //
 // The energy is observed in the world frame. With a workspace motion scale
 // s != 1 it is s times the device-frame energy; its sign, all that passivity
@@ -41,6 +42,10 @@ struct PassivityConfig {
   // F_peak^2 / (2 K_max) = 7.9^2 / (2 * 1480) = 21 mJ for the Touch X;
   // 50 mJ leaves margin for hand damping.
   double max_stored_energy_j = 0.05;
+  // Largest fall of the damper's force |beta v| per tick, N, > 0: the
+  // damper goes as a ramp, not as a step the hand feels (the 0.1 N a tick
+  // of the station's other fault paths). It still comes at once.
+  double max_damping_release_n = 0.1;
 };
 
 class PassivityController {
@@ -63,6 +68,7 @@ class PassivityController {
  private:
   PassivityConfig config_;
   double energy_j_ = 0.0;
+  double beta_ = 0.0;  // the damping of the last tick, N s/m
   double dissipated_j_ = 0.0;
   std::uint64_t active_ticks_ = 0;
 };

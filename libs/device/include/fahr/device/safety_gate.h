@@ -45,6 +45,15 @@ struct SafetyConfig {
   // the Touch X peak build in 4 ms (a stiff contact) but turns a step from a
   // corrupt command into a ramp the passivity observer can see.
   double max_force_rate_nps = 2000.0;
+  // Largest change of the force per tick, N, > 0, from the tick the device
+  // engages (ENGAGING -> ENABLED) until the output has caught up with the
+  // commands, and while the command in use is a transition (the haptic
+  // service ramping or slewing): a haptic service that (re)connects, loses
+  // or regains its tissue is never felt as a step.
+  // Commands back during a ramp-down keep max_force_rate_nps (a stiff
+  // contact must build fast to stay passive); the haptic service slews
+  // from the force the device reports then (services/haptic).
+  double resume_step_n = 0.1;
 };
 
 // Why a command was or was not taken.
@@ -68,6 +77,7 @@ struct SafetyCounters {
   std::uint64_t silence_events = 0;      // ENABLED -> RAMPING_DOWN transitions
   std::uint64_t engage_events = 0;       // ENGAGING -> ENABLED transitions
   std::uint64_t resumed_events = 0;      // RAMPING_DOWN -> ENABLED (commands back in time)
+  std::uint64_t catch_up_ticks = 0;      // ticks resume_step_n cut the change (engage, transitions)
   std::uint64_t fault_ticks = 0;
   std::uint64_t non_finite_outputs = 0;  // internal error guard; must stay 0
 };
@@ -90,15 +100,17 @@ class SafetyGate {
   // controller) asks for; `commanded_n`: the renderer's force alone, judged
   // by the engage rule; `accepted_now`: a command was accepted this tick;
   // `renderable_n`: the device's force limit now. Returns the force to send.
+  // `transition`: the command in use ramps or slews (ForceCommandSample::
+  // transition): the change is bounded by resume_step_n.
   Vec3 limit(const Vec3& candidate_n, const Vec3& commanded_n, bool accepted_now, bool fault,
-             double renderable_n);
+             double renderable_n, bool transition = false);
 
   SafetyState state() const { return state_; }
   const SafetyCounters& counters() const { return counters_; }
 
  private:
   Vec3 next_target(const Vec3& candidate_n, const Vec3& commanded_n, bool accepted_now);
-  Vec3 rate_limit(const Vec3& target_n);
+  Vec3 rate_limit(const Vec3& target_n, bool transition);
 
   SafetyConfig config_;
   double max_step_n_;  // force change allowed per tick, N
@@ -107,6 +119,7 @@ class SafetyGate {
   std::uint32_t ticks_since_command_ = 0;
   std::uint32_t small_ticks_ = 0;
   double ramp_factor_ = 1.0;
+  bool catching_up_ = false;  // engaged or resumed, output not yet at the commands
   Vec3 last_output_n_ = Vec3::Zero();
   SafetyCounters counters_;
 };

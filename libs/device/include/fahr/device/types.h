@@ -41,6 +41,11 @@ struct ForceCommandSample {
   Vec3 force_n = Vec3::Zero();              // F_k, N
   Mat3 stiffness_npm = Mat3::Zero();        // K_k, N/m, symmetric positive semi-definite
   Vec3 torque_nm = Vec3::Zero();            // N m: logged, never rendered (3-DoF device)
+  // The haptic service is ramping or slewing its force (a lost tissue, a
+  // resume: ForceCommand.reason other than FORCE_RENDERED): the gateway
+  // bounds its output's change to SafetyConfig::resume_step_n a tick while
+  // such a command is in use, whatever the commands' arrival jitter.
+  bool transition = false;
 };
 
 // The DevicePose the gateway publishes for one tick (world frame).

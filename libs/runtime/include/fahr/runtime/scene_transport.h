@@ -13,7 +13,7 @@ namespace fahr::runtime {
 // Throws common::ConfigError naming the flag, variable or value at fault.
 common::TransportConfig transport_for(const scene::Scene& scene, const std::string& dds_flag,
                                       const std::string& domain_flag,
-                                      const std::string& profile_flag,
-                                      std::string participant_name);
+                                      const std::string& profile_flag, std::string participant_name,
+                                      const std::string& security_flag = {});
 
 }  // namespace fahr::runtime

@@ -15,6 +15,7 @@ struct ServiceOptions {
   std::string dds;           // empty: FAHR_DDS, else the scene
   std::string domain;        // empty: FAHR_DOMAIN_ID, else the scene
   std::string profile;       // empty: FAHR_DDS_PROFILE, else none
+  std::string security;      // empty: FAHR_DDS_SECURITY, else no DDS Security
   std::string mode;          // empty: the scene's run.mode
   double duration_s = -1.0;  // < 0: the scene's run.duration_s; 0: until SIGINT/SIGTERM
   std::string cpus;          // empty: wherever the kernel puts it (cpu_pinning.h)
@@ -25,7 +26,8 @@ struct ServiceOptions {
   double duration_or_scene_s(const scene::Scene& scene) const;
 };
 
-// Adds --scene (required), --dds, --domain, --dds-profile, --duration-s, --mode, --cpus.
+// Adds --scene (required), --dds, --domain, --dds-profile, --security, --duration-s, --mode,
+// --cpus.
 void add_service_options(CLI::App& app, ServiceOptions& options);
 
 }  // namespace fahr::runtime

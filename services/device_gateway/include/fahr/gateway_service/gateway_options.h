@@ -12,6 +12,7 @@ struct GatewayOptions {
   std::string dds;                    // --dds fastdds|cyclonedds|inprocess (default: FAHR_DDS)
   std::string domain;                 // --domain N
   std::string profile;                // --profile FILE
+  std::string security;               // --security DIR (DDS Security)
   std::string mode = "realtime";      // --mode realtime|lockstep
   std::string backend = "simulated";  // --backend simulated|replay|remote|openhaptics
   std::string script = "intubation";  // --script intubation|overshoot

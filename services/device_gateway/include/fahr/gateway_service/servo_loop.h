@@ -23,6 +23,10 @@ struct LoopState {
   std::vector<device::DevicePoseSample> recorded;
   bool recording = false;
   std::uint64_t seq_mismatches = 0;
+  // Real time: times the loop was far behind and started again from now,
+  // and the ticks it skipped so.
+  std::uint64_t resyncs = 0;
+  std::uint64_t skipped_ticks = 0;
 };
 
 // The recording's room (--record-file: the run's length, or at most an hour

@@ -65,6 +65,9 @@ class ServiceStep {
   // solve failed or gave a non-finite velocity (the body then kept its
   // positions with zero velocity, fem::StepReport::solve_failed).
   std::uint64_t non_finite_sets() const { return non_finite_sets_.load(std::memory_order_relaxed); }
+  // ContactSets refused because they answer a step this body has not
+  // reached: sets of the haptic service answering an FEM before a restart.
+  std::uint64_t ahead_sets() const { return ahead_sets_.load(std::memory_order_relaxed); }
   std::uint64_t failed_solves() const { return failed_solves_.load(std::memory_order_relaxed); }
   // What went wrong since the last call, one sentence per kind (a layout
   // refused, sets with non-finite numbers, failed solves, resets after
@@ -93,10 +96,12 @@ class ServiceStep {
   std::uint64_t divergence_resets_ = 0;
   std::uint64_t refactorisations_ = 0;
   std::atomic<std::uint64_t> non_finite_sets_{0};
+  std::atomic<std::uint64_t> ahead_sets_{0};
   std::atomic<std::uint64_t> failed_solves_{0};
   std::atomic<std::uint64_t> resets_{0};
   // What take_errors() has said so far (its caller's thread only).
   std::uint64_t non_finite_said_ = 0;
+  std::uint64_t ahead_said_ = 0;
   std::uint64_t failed_said_ = 0;
   std::uint64_t resets_said_ = 0;
   std::uint64_t anatomy_returned_ = 0;

@@ -43,7 +43,13 @@ struct LoopMetrics {
   std::atomic<std::uint64_t> tissue_rows_total{0};   // tissue rows solved, all ticks
   std::atomic<std::uint64_t> rows_without_compliance{0};  // of those, rows without W, total
   std::atomic<std::uint64_t> lost_track_ticks{0};
-  std::atomic<std::uint64_t> tissue_resets{0};  // new DeformationState reset epochs seen
+  std::atomic<std::uint64_t> tissue_resets{0};   // new DeformationState reset epochs seen
+  std::atomic<std::uint64_t> tissue_losses{0};   // episodes without a usable FEM state
+  std::atomic<std::uint64_t> tissue_returns{0};  // ends of those episodes
+  std::atomic<std::uint64_t> fem_writers{0};     // FEM writers after the first (restarts)
+  std::atomic<std::uint64_t> tissue_lost_ticks{0};
+  std::atomic<std::uint64_t> device_idle_ticks{0};  // device disabled or engaging: zero commanded
+  std::atomic<std::uint64_t> device_silences{0};    // episodes without a DevicePose (real time)
   std::atomic<std::uint64_t> lost_track_episodes{0};
   std::atomic<double> reaction_n{0.0};  // last tissue reaction, N
   std::atomic<double> obstacle_reaction_n{
@@ -75,16 +81,31 @@ inline constexpr std::size_t kMaxAnatomyRows = 16;
 // (msg::MAX_COMPLIANCE_SPHERES).
 inline constexpr std::size_t kComplianceRequests = 16;
 // Largest change of the commanded force a tick after the tongue was reset
-// (DeformationState::reset_epoch), N.
+// (DeformationState::reset_epoch), a new FEM writer appeared, the tissue
+// came back after a loss or the device (re-)engaged; and while the force
+// ramps down after a loss, N.
 inline constexpr double kResetSlewN = 0.1;
+// Ticks a slew lasts at least: the force it follows is small right after a
+// reset and grows as the proxy settles and the contacts come back.
+inline constexpr std::uint32_t kSlewWindowTicks = 200;
+// Real time: no usable DeformationState for this long and the tissue is
+// lost (the FEM steps every 5 ms; ten steps missing are not jitter).
+inline constexpr std::int64_t kTissueLossTimeoutNs = 50'000'000;
+// Servo ticks over which the force ramps from its value at the loss to
+// zero (150 ms at 1 kHz); each command still changes by at most kResetSlewN.
+inline constexpr double kLossRampTicks = 150.0;
 
 class HapticLoop {
  public:
   explicit HapticLoop(const HapticSetup& setup);
 
   // Answers `pose` on the tissue of `tissue` (the newest snapshot).
+  // `tissue_lost`: the FEM has sent no usable state for kTissueLossTimeoutNs
+  // (real time only): the tongue is not rendered, the force ramps to zero
+  // and the ContactSet is empty until a state comes again; the force then
+  // resumes through the reset slew.
   void tick(const msg::DevicePose& pose, const TissueSnapshot& tissue, msg::ForceCommand& command,
-            msg::ContactSet& contacts);
+            msg::ContactSet& contacts, bool tissue_lost = false);
 
   const contact::ContactResponse& response() const { return response_; }
   const LoopMetrics& metrics() const { return metrics_; }
@@ -93,6 +114,12 @@ class HapticLoop {
   std::uint64_t layout_fingerprint() const { return layout_fingerprint_; }
   // Also resets the per-report maxima (reporter thread).
   void append_metrics(std::vector<std::pair<std::string, double>>& out);
+  // Real time: no DevicePose for kTissueLossTimeoutNs (the loop's thread).
+  void note_device_silence() { metrics_.device_silences.fetch_add(1, std::memory_order_relaxed); }
+  // What changed since the last call, one sentence each (the tissue lost,
+  // back, a new FEM writer, the device silent): the reporter's thread, for
+  // ServiceEvents.
+  void take_errors(std::vector<std::string>& errors);
 
  private:
   contact::DeviceSample device_sample(const msg::DevicePose& pose);
@@ -101,6 +128,10 @@ class HapticLoop {
   void collect_triangle_rows(const TissueSnapshot& tissue);
   void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
   void slew_force(msg::ForceCommand& command);
+  void begin_resume(const contact::DeviceSample& device);
+  void lost_tick(const msg::DevicePose& pose, const contact::DeviceSample& device,
+                 const TissueSnapshot& tissue, msg::ForceCommand& command,
+                 msg::ContactSet& contacts);
   const contact::ForceOutput& penalty_tick(const contact::DeviceSample& device,
                                            const TissueSnapshot& tissue);
 
@@ -142,7 +173,13 @@ class HapticLoop {
 
   std::uint64_t last_fem_step_ = 0;
   std::uint32_t reset_epoch_ = 0;
-  bool slewing_ = false;  // after a reset, until the force caught up
+  std::uint32_t fem_writer_ = 0;  // 0 until the first FEM state
+  bool slewing_ = false;          // after a reset, until the force caught up
+  std::uint32_t slew_ticks_left_ = 0;
+  bool tissue_lost_ = false;
+  Eigen::Vector3d loss_from_n_ = Eigen::Vector3d::Zero();  // the force when the tissue was lost
+  std::uint64_t loss_servo_tick_ = 0;
+  bool device_idle_ = false;  // the last pose said the device renders nothing
   Eigen::Vector3d rendered_n_ = Eigen::Vector3d::Zero();  // the last command's force
   bool started_ = false;
   bool was_lost_ = false;
@@ -150,6 +187,8 @@ class HapticLoop {
   std::uint64_t tick_ = 0;
   LoopMetrics metrics_;
   TickPhases phases_;
+  // What take_errors() has said (the reporter's thread only).
+  std::uint64_t losses_said_ = 0, returns_said_ = 0, writers_said_ = 0, silences_said_ = 0;
 };
 
 }  // namespace fahr::haptic_service

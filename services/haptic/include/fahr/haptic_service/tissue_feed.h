@@ -47,6 +47,11 @@ class TissueFeed {
     return buffer_.front();
   }
 
+  // Monotonic time the newest usable state was digested, ns (0: none yet).
+  // Any thread; the tick compares it with its clock to see the FEM gone
+  // (haptic_loop.h kTissueLossTimeout).
+  std::int64_t last_state_ns() const { return last_state_ns_.load(std::memory_order_acquire); }
+
   const FeedMetrics& metrics() const { return metrics_; }
   // Also resets the per-report maximum (reporter thread).
   void append_metrics(std::vector<std::pair<std::string, double>>& out);
@@ -58,6 +63,7 @@ class TissueFeed {
   common::TripleBuffer<TissueSnapshot> buffer_;
   common::Subscriber<msg::DeformationState> states_;
   FeedMetrics metrics_;
+  std::atomic<std::int64_t> last_state_ns_{0};
   std::atomic<bool> stop_{false};
   std::thread thread_;  // last: starts once everything above exists
 };

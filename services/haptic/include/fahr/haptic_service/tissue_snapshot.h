@@ -31,6 +31,9 @@ struct TissueSnapshot {
   bool from_fem = false;
   std::uint64_t fem_step = 0;
   std::uint32_t reset_epoch = 0;  // DeformationState::reset_epoch
+  // The FEM participant that wrote the state (SampleHeader::writer_id): a
+  // restarted FEM service is a new writer whose tongue starts at rest.
+  std::uint32_t fem_writer = 0;
   collision::SphereState spheres;
   collision::SphereTree tree;
 

@@ -1,0 +1,108 @@
+// fault_probe: listens to a running station and writes every DevicePose and
+// ForceCommand it receives, one line each, for fault_test.sh's analysis:
+//
+//   P <wall ns> <gateway writer> <servo tick> <safety state> <|F| rendered N> <Fx> <Fy> <Fz>
+//   C <wall ns> <haptic writer> <answered pose seq> <reason> <|F| commanded N>
+//
+//   fault_probe --duration-s S --out FILE [--dds V] [--domain N]   (SIGINT ends it early)
+//
+// The DevicePose's rendered force is what the device got on that servo
+// tick, so consecutive servo ticks give the force step per tick.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fahr/common/clock.h"
+#include "fahr/common/stop_signal.h"
+#include "fahr/common/subscriber.h"
+#include "fahr/common/wire_eigen.h"
+
+namespace {
+
+using namespace fahr;
+
+struct Line {
+  char kind;
+  std::int64_t wall_ns;
+  std::uint32_t writer;
+  std::uint64_t count;  // servo tick or answered pose seq
+  int state;            // safety state or reason
+  double f[4];
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fault_test's listener: DevicePose and ForceCommand, one line each"};
+  std::string dds, domain, out_path;
+  double duration_s = 10;
+  app.add_option("--duration-s", duration_s, "how long to listen");
+  app.add_option("--out", out_path, "file to write")->required();
+  app.add_option("--dds", dds, "DDS vendor");
+  app.add_option("--domain", domain, "DDS domain id");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security: the station's folder "
+                 "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
+  CLI11_PARSE(app, argc, argv);
+  common::Participant participant(
+      common::transport_config_from(dds, domain, "", "fault_probe", security));
+  std::mutex mutex;
+  std::vector<Line> lines;
+  lines.reserve(static_cast<std::size_t>(duration_s * 2500) + 1000);
+  const auto qos = common::QosProfile::for_role(common::TopicRole::kServoStream);
+  common::Subscriber<msg::DevicePose> poses(
+      participant, qos, common::TopicTraits<msg::DevicePose>::kName,
+      [&](const msg::DevicePose& p, const common::SampleInfo& info) {
+        const Eigen::Vector3d f = common::to_eigen(p.rendered_force_n());
+        std::lock_guard lock(mutex);
+        lines.push_back({'P',
+                         info.receive_time_ns,
+                         p.header().writer_id(),
+                         p.servo_tick(),
+                         static_cast<int>(p.safety_state()),
+                         {f.norm(), f.x(), f.y(), f.z()}});
+      });
+  common::Subscriber<msg::ForceCommand> commands(
+      participant, qos, common::TopicTraits<msg::ForceCommand>::kName,
+      [&](const msg::ForceCommand& c, const common::SampleInfo& info) {
+        const Eigen::Vector3d f = common::to_eigen(c.force_n());
+        std::lock_guard lock(mutex);
+        lines.push_back({'C',
+                         info.receive_time_ns,
+                         c.header().writer_id(),
+                         c.answered_pose_seq(),
+                         static_cast<int>(c.reason()),
+                         {f.norm(), 0, 0, 0}});
+      });
+  common::install_stop_handlers();
+  std::printf("fault_probe: listening for %.1f s (or until SIGINT)\n", duration_s);
+  std::fflush(stdout);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
+  while (!common::stop_requested() && std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::lock_guard lock(mutex);
+  std::FILE* out = std::fopen(out_path.c_str(), "w");
+  if (out == nullptr) {
+    std::fprintf(stderr, "fault_probe: cannot write %s\n", out_path.c_str());
+    return 1;
+  }
+  for (const Line& l : lines) {
+    if (l.kind == 'P') {
+      std::fprintf(out, "P %lld %u %llu %d %.6f %.6f %.6f %.6f\n",
+                   static_cast<long long>(l.wall_ns), l.writer,
+                   static_cast<unsigned long long>(l.count), l.state, l.f[0], l.f[1], l.f[2],
+                   l.f[3]);
+    } else {
+      std::fprintf(out, "C %lld %u %llu %d %.6f\n", static_cast<long long>(l.wall_ns), l.writer,
+                   static_cast<unsigned long long>(l.count), l.state, l.f[0]);
+    }
+  }
+  std::fclose(out);
+  std::printf("fault_probe: %zu lines written to %s\n", lines.size(), out_path.c_str());
+  return 0;
+}

@@ -1,0 +1,106 @@
+// security_peer: one participant of the DDS Security tests, with the identity
+// it is given (or none).
+//
+//   security_peer listen  --seconds S [--dds V] [--domain N] [--security DIR] [--identity NAME]
+//   security_peer command --seconds S [...]
+//
+// listen: counts the ForceCommands it receives, by writer, and prints
+//   "listen: received N ForceCommand from W writers: <writer>=<n> ...".
+// command: publishes a well-formed ForceCommand every millisecond answering
+//   the newest DevicePose it sees (2 N upward, no stiffness: what a hostile
+//   participant would send), and prints "command: writer <id> wrote N,
+//   matched readers M" — or "command: refused: <why>" when its participant
+//   or writer is not allowed to exist.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "fahr/common/publisher.h"
+#include "fahr/common/subscriber.h"
+
+int main(int argc, char** argv) {
+  using namespace fahr;
+  CLI::App app{"a participant of the DDS Security tests"};
+  std::string mode, dds, domain, security, identity;
+  double seconds = 5;
+  app.add_option("mode", mode, "listen or command")
+      ->required()
+      ->check(CLI::IsMember({"listen", "command"}));
+  app.add_option("--seconds", seconds, "how long");
+  app.add_option("--dds", dds, "DDS vendor");
+  app.add_option("--domain", domain, "DDS domain id");
+  app.add_option("--security", security, "the station's security folder");
+  app.add_option("--identity", identity, "identity in that folder (default: the mode's name)");
+  CLI11_PARSE(app, argc, argv);
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  try {
+    if (!identity.empty()) setenv("FAHR_DDS_IDENTITY", identity.c_str(), 1);
+    const auto config = common::transport_config_from(dds, domain, "", "security_peer", security);
+    common::Participant participant(config);
+    if (mode == "listen") {
+      std::mutex mutex;
+      std::map<std::uint32_t, std::uint64_t> by_writer;
+      std::uint64_t total = 0;
+      common::Subscriber<msg::ForceCommand> commands(
+          participant, common::QosProfile::for_role(common::TopicRole::kServoStream),
+          common::TopicTraits<msg::ForceCommand>::kName,
+          [&](const msg::ForceCommand& c, const common::SampleInfo&) {
+            std::lock_guard lock(mutex);
+            ++by_writer[c.header().writer_id()];
+            ++total;
+          });
+      std::printf("listen: ready\n");
+      while (std::chrono::steady_clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      std::lock_guard lock(mutex);
+      std::printf("listen: received %llu ForceCommand from %zu writers:",
+                  static_cast<unsigned long long>(total), by_writer.size());
+      for (const auto& [writer, n] : by_writer)
+        std::printf(" %u=%llu", writer, static_cast<unsigned long long>(n));
+      std::printf("\n");
+      return 0;
+    }
+    common::Subscriber<msg::DevicePose> poses(participant);
+    std::unique_ptr<common::Publisher<msg::ForceCommand>> out;
+    try {
+      out = std::make_unique<common::Publisher<msg::ForceCommand>>(participant);
+    } catch (const std::exception& e) {
+      std::printf("command: refused: %s\n", e.what());
+      return 0;
+    }
+    msg::ForceCommand command;
+    command.device_id(1);
+    std::uint64_t wrote = 0;
+    const auto start = std::chrono::steady_clock::now();
+    while (std::chrono::steady_clock::now() < end) {
+      // Zero for 0.1 s (the gateway's engage rule wants a small force), then
+      // up to 2 N over a second: what a hostile participant that knows the
+      // rules would send.
+      const double t =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      command.force_n().y(std::clamp(2.0 * (t - 0.1), 0.0, 2.0));
+      if (poses.fetch_newest()) {
+        command.answered_pose_seq(poses.newest().header().seq());
+        command.answered_position_m(poses.newest().world_from_stylus().position_m());
+      }
+      if (command.answered_pose_seq() == 0) command.answered_pose_seq(1);
+      if (out->write(command)) ++wrote;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    std::printf("command: writer %u wrote %llu, matched readers %d\n", participant.writer_id(),
+                static_cast<unsigned long long>(wrote), out->matched_readers());
+    return 0;
+  } catch (const std::exception& e) {
+    std::printf("%s: refused: %s\n", mode.c_str(), e.what());
+    return 0;
+  }
+}
