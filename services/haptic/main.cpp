@@ -72,6 +72,7 @@ int run(int argc, char** argv) {
   // Real time: FEM states are digested on the feed's own thread.
   std::unique_ptr<TissueFeed> feed;
   if (!lockstep) feed = std::make_unique<TissueFeed>(participant, setup);
+  const auto pose_admission = std::make_shared<common::AdmissionCounts>();
   const auto status_period =
       std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period());
   common::ServiceReporter reporter(
@@ -79,7 +80,10 @@ int run(int argc, char** argv) {
       recorder,
       [&](auto& metrics) {
         loop.append_metrics(metrics);
-        if (feed) feed->append_metrics(metrics);
+        if (feed) {
+          feed->append_metrics(metrics);
+          common::append_admission_metrics(*pose_admission, "poses", metrics);
+        }
       },
       // The FEM lost and back, a restarted FEM, a silent device: said here.
       [&](auto& errors) { loop.take_errors(errors); });
@@ -91,9 +95,10 @@ int run(int argc, char** argv) {
 
   // The loop.
   reporter.set_state(msg::SERVICE_RUNNING);
-  const int status = lockstep
-                         ? run_lockstep(participant, setup, loop, recorder)
-                         : (run_realtime(participant, *feed, loop, recorder, duration_s, wait), 0);
+  const int status =
+      lockstep
+          ? run_lockstep(participant, setup, loop, recorder)
+          : (run_realtime(participant, *feed, loop, recorder, duration_s, wait, pose_admission), 0);
 
   // Shutdown.
   reporter.set_state(msg::SERVICE_STOPPING);

@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <thread>
 
 #include "fahr/common/background_publisher.h"
+#include "fahr/common/clock.h"
 #include "fahr/common/config_error.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/subscriber.h"
@@ -208,6 +210,74 @@ TEST(ServiceReporter, ReportsTickStatisticsLatePeriodsAndQosEvents) {
   ASSERT_TRUE(status.fetch_newest());
   EXPECT_EQ(status.newest().metrics()[0].value(), 1.0);
   EXPECT_EQ(status.newest().metrics()[1].value(), 1.0);
+}
+
+// A writer that stamps its own headers, as a hostile participant can.
+class ForgingWriter {
+ public:
+  explicit ForgingWriter(Participant& participant) {
+    common::detail::EndpointSpec spec{
+        &common::detail::type_support<msg::DevicePose>(),
+        std::string(common::TopicTraits<msg::DevicePose>::kName),
+        common::QosProfile::for_role(common::TopicRole::kServoStream)};
+    writer_ = participant.backend().create_writer(spec);
+  }
+  void write(std::uint64_t seq, double x) {
+    msg::DevicePose pose;
+    pose.header().seq(seq);
+    pose.header().writer_id(7);
+    pose.world_from_stylus().position_m().x() = x;
+    writer_->write(&pose, common::wall_now_ns());
+  }
+
+ private:
+  std::unique_ptr<common::detail::WriterBackend> writer_;
+};
+
+TEST(Admission, OneSourceInOrderAndValidAnotherWriterAfterTheSourceFallsSilent) {
+  using namespace std::chrono_literals;
+  Participant a(in_process(9));
+  Participant b(in_process(9));
+  common::Admission<msg::DevicePose> admission{
+      .takeover = 30ms,
+      .valid =
+          [](const msg::DevicePose& p) {
+            return std::isfinite(p.world_from_stylus().position_m().x());
+          },
+      .counts = std::make_shared<common::AdmissionCounts>()};
+  common::Subscriber<msg::DevicePose> sub(b, admission);
+  ForgingWriter source(a);
+  ForgingWriter intruder(a);
+  source.write(1, 0.1);  // the first writer heard becomes the source
+  ASSERT_TRUE(sub.fetch_newest());
+  EXPECT_EQ(sub.newest().world_from_stylus().position_m().x(), 0.1);
+  intruder.write(100, 9.0);  // another writer while the source lives
+  source.write(1, 0.2);      // the source's sequence did not advance
+  source.write(2, std::nan(""));
+  EXPECT_FALSE(sub.fetch_newest());
+  const auto& counts = sub.admission_counts();
+  EXPECT_EQ(counts.foreign.load(), 1U);
+  EXPECT_EQ(counts.out_of_order.load(), 1U);
+  EXPECT_EQ(counts.invalid.load(), 1U);
+  source.write(3, 0.3);
+  ASSERT_TRUE(sub.fetch_newest());
+  EXPECT_EQ(sub.newest().world_from_stylus().position_m().x(), 0.3);
+  // The source silent past the takeover time: the next writer heard is
+  // followed (a restarted service), and the old one is then foreign.
+  std::this_thread::sleep_for(60ms);
+  intruder.write(1, 0.4);
+  ASSERT_TRUE(sub.fetch_newest());
+  EXPECT_EQ(sub.newest().world_from_stylus().position_m().x(), 0.4);
+  source.write(4, 0.5);
+  EXPECT_FALSE(sub.fetch_newest());
+  EXPECT_EQ(counts.source_changes.load(), 1U);
+  EXPECT_EQ(counts.foreign.load(), 2U);
+  // Without an Admission every sample gets in.
+  common::Subscriber<msg::DevicePose> open(b);
+  intruder.write(2, 0.6);
+  source.write(5, 0.7);
+  ASSERT_TRUE(open.fetch_newest());
+  EXPECT_EQ(open.newest().world_from_stylus().position_m().x(), 0.7);
 }
 
 TEST(BackgroundPublisher, WritesTheNewestAndAccountsForEverySample) {

@@ -241,12 +241,12 @@ class CycloneReader final : public ReaderBackend {
     ddsi_serdata* serdata = nullptr;
     dds_sample_info_t info;
     while (dds_takecdr(reader, &serdata, 1, &info, DDS_ANY_STATE) == 1) {
-      if (info.valid_data) deliver(*serdata, info.source_timestamp);
+      if (info.valid_data) deliver(*serdata, info.source_timestamp, info.publication_handle);
       ddsi_serdata_unref(serdata);
     }
   }
 
-  void deliver(const ddsi_serdata& serdata, dds_time_t source_time_ns) {
+  void deliver(const ddsi_serdata& serdata, dds_time_t source_time_ns, std::uint64_t source_key) {
     const std::uint32_t size = ddsi_serdata_size(&serdata);
     ddsrt_iovec_t ref{};
     ddsi_serdata* held = ddsi_serdata_to_ser_ref(&serdata, 0, size, &ref);
@@ -260,7 +260,7 @@ class CycloneReader final : public ReaderBackend {
     const bool ok = decode_cdr(
         *fast_type_, {static_cast<const std::uint8_t*>(ref.iov_base), ref.iov_len}, scratch_);
     ddsi_serdata_to_ser_unref(held, &ref);
-    if (ok) sink_->deliver(scratch_, source_time_ns);
+    if (ok) sink_->deliver(scratch_, source_time_ns, source_key);
   }
 
   EndpointContext ctx_;

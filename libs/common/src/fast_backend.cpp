@@ -39,6 +39,21 @@ constexpr std::uint32_t kPreallocateLimitBytes = 64 * 1024;
 // it at net.core.rmem_max / wmem_max (deployment/README.md).
 constexpr std::uint32_t kSocketBufferBytes = 4U * 1024U * 1024U;
 
+// The writer's GUID (prefix and entity id) folded into 64 bits (FNV-1a).
+std::uint64_t writer_key(const dds::SampleInfo& info) {
+  const auto& guid = info.sample_identity.writer_guid();
+  std::uint64_t h = 14695981039346656037ULL;
+  const auto mix = [&h](const auto& bytes) {
+    for (const auto b : bytes) {
+      h ^= static_cast<std::uint8_t>(b);
+      h *= 1099511628211ULL;
+    }
+  };
+  mix(guid.guidPrefix.value);
+  mix(guid.entityId.value);
+  return h;
+}
+
 Duration_t to_duration(std::chrono::nanoseconds d) {
   const auto ns = d.count();
   return Duration_t(static_cast<std::int32_t>(ns / 1'000'000'000),
@@ -247,7 +262,7 @@ class FastReader final : public ReaderBackend, private dds::DataReaderListener {
         const auto& raw = static_cast<RawSample*>(scratch_)->bytes;
         raw_sink_->deliver_raw(raw.data(), raw.size(), info.source_timestamp.to_ns());
       } else {
-        sink_->deliver(scratch_, info.source_timestamp.to_ns());
+        sink_->deliver(scratch_, info.source_timestamp.to_ns(), writer_key(info));
       }
     }
   }

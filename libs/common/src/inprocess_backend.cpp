@@ -110,7 +110,7 @@ class InProcessWriter final : public WriterBackend {
       latched_time_ns_ = source_time_ns;
     }
     for (auto* reader : topic_->readers) {
-      if (compatible(qos_, reader->qos)) reader->sink->deliver(sample, source_time_ns);
+      if (compatible(qos_, reader->qos)) reader->sink->deliver(sample, source_time_ns, key());
     }
     return true;
   }
@@ -133,10 +133,12 @@ class InProcessWriter final : public WriterBackend {
     record_match(events_, EventKind::kPublicationMatched, name_, change);
     record_match(*reader.events, EventKind::kSubscriptionMatched, name_, change);
     if (change > 0 && has_latched_ && reader.qos.durability == Durability::kTransientLocal) {
-      reader.sink->deliver(latched_, latched_time_ns_);
+      reader.sink->deliver(latched_, latched_time_ns_, key());
     }
   }
   const QosProfile& qos() const { return qos_; }
+  // The writer's identity on the bus: its address.
+  std::uint64_t key() const { return reinterpret_cast<std::uintptr_t>(this); }
 
  private:
   std::shared_ptr<BusTopic> topic_;

@@ -21,7 +21,7 @@ class ReserialisingReader final : public ReaderBackend, private SampleSink {
   int matched_writers() const override { return reader_->matched_writers(); }
 
  private:
-  void deliver(const void* sample, std::int64_t source_time_ns) override {
+  void deliver(const void* sample, std::int64_t source_time_ns, std::uint64_t) override {
     void* data = const_cast<void*>(sample);
     const std::uint32_t size = fast_type_->getSerializedSizeProvider(data)();
     if (payload_.max_size < size) payload_.reserve(size);

@@ -108,7 +108,12 @@ int run_realtime(const GatewayOptions& o, GatewaySetup& setup, common::Participa
                  GatewayMetrics& metrics, common::TickRecorder& recorder, LoopState& state) {
   device::ServoCore core(setup.config, *setup.backend);
   common::Publisher<msg::DevicePose> pose_pub(participant);
-  common::Subscriber<msg::ForceCommand> command_sub(participant);
+  // One haptic service at a time: another writer's commands are refused
+  // while it is alive (50 ms), and a restarted one is followed after that.
+  common::Subscriber<msg::ForceCommand> command_sub(
+      participant, common::Admission<msg::ForceCommand>{.takeover = std::chrono::milliseconds(50),
+                                                        .valid = {},
+                                                        .counts = metrics.command_admission});
   std::unique_ptr<common::Subscriber<msg::DevicePose>> remote_sub;
   if (setup.remote != nullptr) {
     remote_sub = std::make_unique<common::Subscriber<msg::DevicePose>>(

@@ -45,6 +45,7 @@ void GatewayMetrics::fill(std::vector<std::pair<std::string, double>>& metrics) 
   metrics.emplace_back("resumed_events", static_cast<double>(s.safety.resumed_events));
   metrics.emplace_back("catch_up_ticks", static_cast<double>(s.safety.catch_up_ticks));
   metrics.emplace_back("remote_rejected", static_cast<double>(s.remote_rejected));
+  common::append_admission_metrics(*command_admission, "commands", metrics);
 }
 
 std::string GatewayMetrics::summary(std::uint64_t late_periods) {

@@ -50,7 +50,12 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
   out_qos.deadline =
       3 * scene.rates.fem_period();  // a late step is expected now and then; three are not
   common::Publisher<msg::DeformationState> out(participant, out_qos);
-  common::Subscriber<msg::ContactSet> in(participant);
+  // One haptic service at a time: another writer's sets are refused while
+  // it lives (50 ms); a restarted one is followed after that.
+  common::Subscriber<msg::ContactSet> in(
+      participant, common::Admission<msg::ContactSet>{.takeover = std::chrono::milliseconds(50),
+                                                      .valid = {},
+                                                      .counts = fem_step.contact_admission()});
   const auto period = scene.rates.fem_period();
   const auto start = Clock::now();
   auto next = start;

@@ -52,6 +52,13 @@ void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
     have_contacts_ = false;
     return;
   }
+  const std::size_t spheres = setup_.links.size();
+  if (std::any_of(wire.contacts().begin(), wire.contacts().end(),
+                  [&](const msg::Contact& c) { return c.sphere_id() >= spheres; })) {
+    unknown_sphere_sets_.fetch_add(1, std::memory_order_relaxed);
+    have_contacts_ = false;
+    return;
+  }
   if (wire.fem_step() > setup_.body->step_index()) {
     // It answers a state this body has not produced: one of an FEM service
     // before a restart (its steps numbered further). Never applied; the
@@ -137,6 +144,8 @@ void ServiceStep::take_errors(std::vector<std::string>& errors) {
   say(ahead_sets_, ahead_said_,
       "ContactSet refused: it answers an FEM step this service has not reached (a state of an "
       "FEM service before a restart)");
+  say(unknown_sphere_sets_, unknown_said_,
+      "ContactSet refused: it names a sphere this body's layout does not have");
   say(failed_solves_, failed_said_,
       "FEM linear solve failed or gave a non-finite velocity: the step kept the positions with "
       "zero velocity");
@@ -150,6 +159,8 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("layout_refused_sets", static_cast<double>(layout_check_.refused()));
   out.emplace_back("non_finite_contact_sets", static_cast<double>(non_finite_sets()));
   out.emplace_back("ahead_contact_sets", static_cast<double>(ahead_sets()));
+  out.emplace_back("unknown_sphere_sets", static_cast<double>(unknown_sphere_sets()));
+  common::append_admission_metrics(*contact_admission_, "contact_sets", out);
   out.emplace_back("failed_solves", static_cast<double>(failed_solves()));
   out.emplace_back("compliance_reuses", static_cast<double>(contact_step_.compliance_reuses()));
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));

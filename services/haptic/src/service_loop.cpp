@@ -1,7 +1,9 @@
 // The haptic service's run over DDS (see service_loop.h).
 #include "fahr/haptic_service/service_loop.h"
 
+#include <Eigen/Core>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -12,6 +14,7 @@
 #include "fahr/common/realtime.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/common/subscriber.h"
+#include "fahr/common/wire_eigen.h"
 #include "fahr/haptic_service/run_report.h"
 #include "fahr/haptic_service/tissue_snapshot.h"
 
@@ -20,9 +23,30 @@ namespace fahr::haptic_service {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
+bool plausible_device_pose(const msg::DevicePose& pose) {
+  const auto& p = pose.world_from_stylus();
+  const Eigen::Vector3d x = common::to_eigen(p.position_m());
+  const Eigen::Vector3d v = common::to_eigen(pose.linear_velocity_mps());
+  const auto& q = p.orientation();
+  const double q2 = q.w() * q.w() + q.x() * q.x() + q.y() * q.y() + q.z() * q.z();
+  const auto in = [](double value, double low, double high) {
+    return std::isfinite(value) && value >= low && value <= high;
+  };
+  return x.allFinite() && x.norm() <= 2.0 && v.allFinite() && v.norm() <= 100.0 &&
+         in(q2, 0.9, 1.1) && in(pose.renderable_force_n(), 0.0, 1e3) &&
+         in(pose.max_stiffness_npm(), 0.0, 1e6);
+}
+
 void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop& loop,
-                  common::TickRecorder& recorder, double duration_s, const WaitPolicy& wait) {
-  common::Subscriber<msg::DevicePose> poses(participant);
+                  common::TickRecorder& recorder, double duration_s, const WaitPolicy& wait,
+                  std::shared_ptr<common::AdmissionCounts> pose_admission) {
+  // One gateway at a time (another writer refused while it lives, 50 ms),
+  // its poses in order and plausible.
+  common::Subscriber<msg::DevicePose> poses(
+      participant,
+      common::Admission<msg::DevicePose>{.takeover = std::chrono::nanoseconds(kTissueLossTimeoutNs),
+                                         .valid = plausible_device_pose,
+                                         .counts = std::move(pose_admission)});
   common::Publisher<msg::ForceCommand> commands(participant);
   // The ContactSet's write (tens of microseconds: serialisation and send)
   // leaves the tick for a thread of its own, which looks for a new set

@@ -4,13 +4,21 @@
 #include <chrono>
 
 #include "fahr/common/clock.h"
+#include "fahr/haptic_service/haptic_loop.h"
 
 namespace fahr::haptic_service {
 
 TissueFeed::TissueFeed(common::Participant& participant, const HapticSetup& setup)
     : digest_(setup),
       buffer_([this] { return digest_.make_snapshot(); }),
-      states_(participant),
+      // One FEM at a time: another writer refused while it lives; a
+      // restarted FEM followed once the first has been silent for the loss
+      // timeout.
+      states_(participant,
+              common::Admission<msg::DeformationState>{
+                  .takeover = std::chrono::nanoseconds(kTissueLossTimeoutNs),
+                  .valid = {},
+                  .counts = std::make_shared<common::AdmissionCounts>()}),
       thread_([this] { run(); }) {}
 
 TissueFeed::~TissueFeed() {
@@ -52,6 +60,7 @@ void TissueFeed::append_metrics(std::vector<std::pair<std::string, double>>& out
   };
   out.emplace_back("fem_states", get(metrics_.fem_states));
   out.emplace_back("bad_states", get(metrics_.bad_states));
+  common::append_admission_metrics(states_.admission_counts(), "states", out);
   out.emplace_back("obstacle_contacts", get(metrics_.obstacle_contacts));
   out.emplace_back("obstacle_overflows", get(metrics_.obstacle_overflows));
   out.emplace_back("free_centres",

@@ -32,10 +32,14 @@ struct TypeSupport {
 };
 
 // Receives samples on a vendor thread. `sample` is only valid during the call.
+// `source_key` names the DDS writer the sample came from (a hash of its GUID;
+// the writer's address on the in-process bus): unlike the SampleHeader's
+// writer_id, a participant cannot choose it.
 class SampleSink {
  public:
   virtual ~SampleSink() = default;
-  virtual void deliver(const void* sample, std::int64_t source_time_ns) = 0;
+  virtual void deliver(const void* sample, std::int64_t source_time_ns,
+                       std::uint64_t source_key) = 0;
 };
 
 // Receives a sample's serialized bytes (XCDR1, with the 4-byte encapsulation

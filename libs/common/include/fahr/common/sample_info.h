@@ -15,6 +15,9 @@ struct SampleInfo {
   std::int64_t receive_time_ns = 0;
   // Samples of this writer that never arrived before this one (seq gap).
   std::uint64_t missed_before = 0;
+  // The DDS writer it came from (backend.h SampleSink): chosen by the
+  // middleware, not by the writer.
+  std::uint64_t source_key = 0;
 };
 
 }  // namespace fahr::common

@@ -1,7 +1,9 @@
 // A typed reader. Every sample lands in a LatestSample triple buffer (the
 // newest, for loops that poll without blocking or allocating) and, if set,
 // in a handler called on the vendor thread (for consumers that need every
-// sample: loggers, lockstep inputs).
+// sample: loggers, lockstep inputs). An Admission, if given, decides on the
+// vendor thread which samples get in at all (one source, in order, valid),
+// so a refused sample never displaces the newest good one.
 #pragma once
 
 #include <atomic>
@@ -13,6 +15,8 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "fahr/common/clock.h"
 #include "fahr/common/latest_sample.h"
@@ -20,6 +24,35 @@
 #include "fahr/common/topics.h"
 
 namespace fahr::common {
+
+struct AdmissionCounts {
+  std::atomic<std::uint64_t> foreign{0};       // another writer while the source lives
+  std::atomic<std::uint64_t> out_of_order{0};  // the source's sequence did not advance
+  std::atomic<std::uint64_t> invalid{0};       // failed Admission::valid
+  std::atomic<std::uint64_t> source_changes{0};
+};
+
+// "<prefix>_refused_foreign", "_refused_order", "_refused_invalid" for a
+// ServiceStatus.
+void append_admission_metrics(const AdmissionCounts& counts, const std::string& prefix,
+                              std::vector<std::pair<std::string, double>>& out);
+
+// Which samples a Subscriber lets in. The streams of a station have one
+// writer each; anyone else on the domain is refused (docs/design/faults.md,
+// "Hostile samples").
+template <class T>
+struct Admission {
+  // The first writer heard is the source. A sample of another writer is
+  // refused while the source has sent within this time; after it, the next
+  // writer heard becomes the source (a restarted service, a new writer).
+  std::chrono::nanoseconds takeover{std::chrono::milliseconds(50)};
+  // Refuses a sample that fails it (non-finite, out of range, wrong size).
+  // Runs on the vendor thread.
+  std::function<bool(const T&)> valid;
+  // Where the refusals are counted; shared, so a status reporter can read
+  // them after the subscriber is gone.
+  std::shared_ptr<AdmissionCounts> counts = std::make_shared<AdmissionCounts>();
+};
 
 template <class T>
 class Subscriber final : private detail::SampleSink {
@@ -32,6 +65,14 @@ class Subscriber final : private detail::SampleSink {
                       QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole),
                       std::string_view topic_name = TopicTraits<T>::kName, Handler handler = {})
       : handler_(std::move(handler)) {
+    detail::EndpointSpec spec{&detail::type_support<T>(), std::string(topic_name), qos};
+    reader_ = participant.backend().create_reader(spec, this);
+  }
+  // A reader that lets in only what `admission` admits.
+  Subscriber(Participant& participant, Admission<T> admission,
+             QosProfile qos = QosProfile::for_role(TopicTraits<T>::kRole),
+             std::string_view topic_name = TopicTraits<T>::kName)
+      : admission_(std::move(admission)), gated_(true) {
     detail::EndpointSpec spec{&detail::type_support<T>(), std::string(topic_name), qos};
     reader_ = participant.backend().create_reader(spec, this);
   }
@@ -58,9 +99,40 @@ class Subscriber final : private detail::SampleSink {
   std::uint64_t received() const { return latest_.published(); }
   std::uint64_t missed() const { return missed_.load(std::memory_order_relaxed); }
   int matched_writers() const { return reader_->matched_writers(); }
+  // What the Admission refused (all zero without one).
+  const AdmissionCounts& admission_counts() const { return *admission_.counts; }
 
  private:
-  void deliver(const void* sample, std::int64_t source_time_ns) override {
+  // Called with gap_mutex_ held. True if the sample may go in.
+  bool admit(const T& typed, const SampleInfo& info) {
+    if (admission_.valid && !admission_.valid(typed)) {
+      admission_.counts->invalid.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    const std::int64_t now_ns = monotonic_now_ns();
+    if (!has_source_ || (info.source_key != source_key_ &&
+                         now_ns - source_heard_ns_ > admission_.takeover.count())) {
+      if (has_source_) admission_.counts->source_changes.fetch_add(1, std::memory_order_relaxed);
+      has_source_ = true;
+      source_key_ = info.source_key;
+      source_seq_ = info.seq;
+      source_heard_ns_ = now_ns;
+      return true;
+    }
+    if (info.source_key != source_key_) {
+      admission_.counts->foreign.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    if (info.seq <= source_seq_) {
+      admission_.counts->out_of_order.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    source_seq_ = info.seq;
+    source_heard_ns_ = now_ns;
+    return true;
+  }
+
+  void deliver(const void* sample, std::int64_t source_time_ns, std::uint64_t source_key) override {
     const T& typed = *static_cast<const T*>(sample);
     const auto& header = typed.header();
     SampleInfo info;
@@ -68,10 +140,12 @@ class Subscriber final : private detail::SampleSink {
     info.writer_id = header.writer_id();
     info.source_time_ns = source_time_ns;
     info.receive_time_ns = wall_now_ns();
+    info.source_key = source_key;
     {
       // Sequence gaps per writer: tracks the most recent writer only, which
       // is exact for the single-writer topics fahr has.
       std::lock_guard lock(gap_mutex_);
+      if (gated_ && !admit(typed, info)) return;
       if (info.writer_id == last_writer_ && info.seq > last_seq_ + 1) {
         info.missed_before = info.seq - last_seq_ - 1;
         missed_.fetch_add(info.missed_before, std::memory_order_relaxed);
@@ -90,6 +164,12 @@ class Subscriber final : private detail::SampleSink {
   }
 
   Handler handler_;
+  Admission<T> admission_;
+  bool gated_ = false;
+  bool has_source_ = false;
+  std::uint64_t source_key_ = 0;
+  std::uint64_t source_seq_ = 0;
+  std::int64_t source_heard_ns_ = 0;
   LatestSample<T> latest_;
   std::mutex gap_mutex_;
   std::uint32_t last_writer_ = 0;

@@ -7,12 +7,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "fahr/common/latest_sample.h"
+#include "fahr/common/subscriber.h"
 #include "fahr/device/latency_histogram.h"
 #include "fahr/device/safety_gate.h"
 
@@ -40,6 +42,10 @@ class GatewayMetrics {
   void fill(std::vector<std::pair<std::string, double>>& metrics);
   // The last snapshot reported, in one line, for the end of a run.
   std::string summary(std::uint64_t late_periods);
+  // Refusals of the ForceCommand reader: another writer than the haptic
+  // service it follows (common::Admission).
+  const std::shared_ptr<common::AdmissionCounts> command_admission =
+      std::make_shared<common::AdmissionCounts>();
 
  private:
   common::LatestSample<StatusSnapshot> latest_;

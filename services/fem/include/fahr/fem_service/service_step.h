@@ -10,12 +10,14 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "contact_set.h"
 #include "deformation_state.h"
+#include "fahr/common/subscriber.h"
 #include "fahr/fem/contact_set.h"
 #include "fahr/fem/contact_step.h"
 #include "fahr/fem_service/fem_body_setup.h"
@@ -32,8 +34,9 @@ class ServiceStep {
   // next one (a set older than the body's max_contact_age_steps is ignored).
   // A set of another sphere layout than the body's (layout_check.h) is
   // refused: the steps until the next set apply no contacts.
-  // A set with a non-finite number (all_finite) is refused and counted the
-  // same way: nothing of it is used.
+  // A set with a non-finite number (all_finite), or naming a sphere the
+  // layout does not have, is refused and counted the same way: nothing of it
+  // is used.
   void take(const msg::ContactSet& wire, std::uint64_t seq);
 
   // One FEM step and the DeformationState that reports it (the header is
@@ -68,6 +71,14 @@ class ServiceStep {
   // ContactSets refused because they answer a step this body has not
   // reached: sets of the haptic service answering an FEM before a restart.
   std::uint64_t ahead_sets() const { return ahead_sets_.load(std::memory_order_relaxed); }
+  std::uint64_t unknown_sphere_sets() const {
+    return unknown_sphere_sets_.load(std::memory_order_relaxed);
+  }
+  // Refusals of the real-time ContactSet reader: another writer than the
+  // haptic service it follows (common::Admission; fem_loop.cpp).
+  const std::shared_ptr<common::AdmissionCounts>& contact_admission() const {
+    return contact_admission_;
+  }
   std::uint64_t failed_solves() const { return failed_solves_.load(std::memory_order_relaxed); }
   // What went wrong since the last call, one sentence per kind (a layout
   // refused, sets with non-finite numbers, failed solves, resets after
@@ -97,11 +108,15 @@ class ServiceStep {
   std::uint64_t refactorisations_ = 0;
   std::atomic<std::uint64_t> non_finite_sets_{0};
   std::atomic<std::uint64_t> ahead_sets_{0};
+  std::atomic<std::uint64_t> unknown_sphere_sets_{0};
+  std::shared_ptr<common::AdmissionCounts> contact_admission_ =
+      std::make_shared<common::AdmissionCounts>();
   std::atomic<std::uint64_t> failed_solves_{0};
   std::atomic<std::uint64_t> resets_{0};
   // What take_errors() has said so far (its caller's thread only).
   std::uint64_t non_finite_said_ = 0;
   std::uint64_t ahead_said_ = 0;
+  std::uint64_t unknown_said_ = 0;
   std::uint64_t failed_said_ = 0;
   std::uint64_t resets_said_ = 0;
   std::uint64_t anatomy_returned_ = 0;

@@ -4,6 +4,7 @@
 // lines it prints at its start and end (launchers and tests read them).
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "fahr/common/participant.h"
@@ -26,8 +27,11 @@ struct WaitPolicy {
 // Ticks until the duration has passed or a signal asks to stop. Blocks only
 // between ticks, waiting for the next DevicePose; FEM states are digested on
 // the feed's thread. Prints the run's tick figures at the end (RunReport).
+// DevicePoses come from one gateway at a time and must be plausible
+// (plausible_device_pose); refusals are counted in `pose_admission`.
 void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop& loop,
-                  common::TickRecorder& recorder, double duration_s, const WaitPolicy& wait);
+                  common::TickRecorder& recorder, double duration_s, const WaitPolicy& wait,
+                  std::shared_ptr<common::AdmissionCounts> pose_admission);
 
 // Returns the program's exit status.
 int run_lockstep(common::Participant& participant, const HapticSetup& setup, HapticLoop& loop,
@@ -36,5 +40,10 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
 void print_ready_line(const common::Participant& participant, const HapticSetup& setup,
                       const std::string& collision, bool lockstep, double setup_s);
 void print_end_line(const HapticLoop& loop);
+
+// Finite, a unit orientation, inside a 2 m workspace, a renderable force
+// and stiffness no device has (at most 1 kN, 1 MN/m): what the gateway's
+// device model can produce.
+bool plausible_device_pose(const msg::DevicePose& pose);
 
 }  // namespace fahr::haptic_service
