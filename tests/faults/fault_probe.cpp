@@ -3,6 +3,7 @@
 //
 //   P <wall ns> <gateway writer> <servo tick> <safety state> <|F| rendered N> <Fx> <Fy> <Fz>
 //   C <wall ns> <haptic writer> <answered pose seq> <reason> <|F| commanded N>
+//   S <wall ns> <FEM writer> <FEM step>                       (with --states)
 //
 //   fault_probe --duration-s S --out FILE [--dds V] [--domain N]   (SIGINT ends it early)
 //
@@ -11,6 +12,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -48,6 +50,8 @@ int main(int argc, char** argv) {
   app.add_option("--security", security,
                  "DDS Security: the station's folder "
                  "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
+  bool with_states = false;
+  app.add_flag("--states", with_states, "also a line per DeformationState");
   CLI11_PARSE(app, argc, argv);
   common::Participant participant(
       common::transport_config_from(dds, domain, "", "fault_probe", security));
@@ -79,6 +83,17 @@ int main(int argc, char** argv) {
                          static_cast<int>(c.reason()),
                          {f.norm(), 0, 0, 0}});
       });
+  std::unique_ptr<common::Subscriber<msg::DeformationState>> states;
+  if (with_states) {
+    states = std::make_unique<common::Subscriber<msg::DeformationState>>(
+        participant, common::QosProfile::for_role(common::TopicRole::kStateStream),
+        common::TopicTraits<msg::DeformationState>::kName,
+        [&](const msg::DeformationState& s, const common::SampleInfo& info) {
+          std::lock_guard lock(mutex);
+          lines.push_back(
+              {'S', info.receive_time_ns, s.header().writer_id(), s.step(), 0, {0, 0, 0, 0}});
+        });
+  }
   common::install_stop_handlers();
   std::printf("fault_probe: listening for %.1f s (or until SIGINT)\n", duration_s);
   std::fflush(stdout);
@@ -97,6 +112,9 @@ int main(int argc, char** argv) {
                    static_cast<long long>(l.wall_ns), l.writer,
                    static_cast<unsigned long long>(l.count), l.state, l.f[0], l.f[1], l.f[2],
                    l.f[3]);
+    } else if (l.kind == 'S') {
+      std::fprintf(out, "S %lld %u %llu\n", static_cast<long long>(l.wall_ns), l.writer,
+                   static_cast<unsigned long long>(l.count));
     } else {
       std::fprintf(out, "C %lld %u %llu %d %.6f\n", static_cast<long long>(l.wall_ns), l.writer,
                    static_cast<unsigned long long>(l.count), l.state, l.f[0]);

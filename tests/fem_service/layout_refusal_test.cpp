@@ -185,6 +185,33 @@ TEST(NonFiniteRefusal, ASetWithANonFiniteNumberIsNeverUsed) {
   EXPECT_EQ(step.non_finite_sets(), bad.size());
 }
 
+// A set naming a sphere the layout does not have (a hostile or broken
+// writer: the fingerprint alone does not prove the ids) is refused whole and
+// counted, however many of its contacts are good.
+TEST(UnknownSphereRefusal, ASetNamingASphereTheLayoutLacksIsNeverUsed) {
+  StillTongue tongue;
+  FemBodySetup& setup = tongue.setup;
+  ServiceStep step(setup);
+  const std::uint64_t ours = setup.layout_fingerprint;
+  msg::ContactSet set = pressing_set(setup, top_sphere(setup), ours);
+  msg::Contact unknown = set.contacts()[0];
+  unknown.sphere_id(static_cast<std::uint32_t>(setup.links.size()));
+  set.contacts().push_back(unknown);
+  step.take(set, 1);
+  step.step();
+  EXPECT_FALSE(step.last_report().contacts_applied);
+  EXPECT_LT(largest_motion_m(setup), 1e-9) << "a refused set moved the body";
+  EXPECT_EQ(step.unknown_sphere_sets(), 1u);
+  std::vector<std::string> errors;
+  step.take_errors(errors);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("sphere"), std::string::npos) << errors[0];
+  set.contacts().pop_back();
+  step.take(set, 2);
+  step.step();
+  EXPECT_TRUE(step.last_report().contacts_applied);
+}
+
 TEST(LayoutRefusal, TheErrorIsOneSentenceNamingBothInHex) {
   const std::string error =
       LayoutCheck::mismatch_error(0x00000000000000ffULL, 0xfedcba9876543210ULL);

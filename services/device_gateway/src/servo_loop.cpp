@@ -109,11 +109,11 @@ int run_realtime(const GatewayOptions& o, GatewaySetup& setup, common::Participa
   device::ServoCore core(setup.config, *setup.backend);
   common::Publisher<msg::DevicePose> pose_pub(participant);
   // One haptic service at a time: another writer's commands are refused
-  // while it is alive (50 ms), and a restarted one is followed after that.
+  // while it has sent within 1 s, and a restarted one is followed after that.
   common::Subscriber<msg::ForceCommand> command_sub(
-      participant, common::Admission<msg::ForceCommand>{.takeover = std::chrono::milliseconds(50),
-                                                        .valid = {},
-                                                        .counts = metrics.command_admission});
+      participant,
+      common::Admission<msg::ForceCommand>{
+          .takeover = std::chrono::seconds(1), .valid = {}, .counts = metrics.command_admission});
   std::unique_ptr<common::Subscriber<msg::DevicePose>> remote_sub;
   if (setup.remote != nullptr) {
     remote_sub = std::make_unique<common::Subscriber<msg::DevicePose>>(
@@ -186,6 +186,9 @@ int run_realtime(const GatewayOptions& o, GatewaySetup& setup, common::Participa
   }
   fill_snapshot(core, setup, state);
   metrics.offer(state.snapshot);
+  std::printf("device_gateway: refused ForceCommands: %s; non-finite %llu\n",
+              common::admission_summary(command_sub.admission_counts()).c_str(),
+              static_cast<unsigned long long>(core.safety_counters().rejected_non_finite));
   if (state.resyncs > 0) {
     std::printf("device_gateway: %llu times behind by more than %lld periods: %llu ticks skipped\n",
                 static_cast<unsigned long long>(state.resyncs),

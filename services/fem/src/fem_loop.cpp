@@ -51,9 +51,9 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
       3 * scene.rates.fem_period();  // a late step is expected now and then; three are not
   common::Publisher<msg::DeformationState> out(participant, out_qos);
   // One haptic service at a time: another writer's sets are refused while
-  // it lives (50 ms); a restarted one is followed after that.
+  // it has sent within 1 s; a restarted one is followed after that.
   common::Subscriber<msg::ContactSet> in(
-      participant, common::Admission<msg::ContactSet>{.takeover = std::chrono::milliseconds(50),
+      participant, common::Admission<msg::ContactSet>{.takeover = std::chrono::seconds(1),
                                                       .valid = {},
                                                       .counts = fem_step.contact_admission()});
   const auto period = scene.rates.fem_period();
@@ -84,6 +84,13 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
     std::printf("fahr_fem_service: %llu times more than 10 steps behind: started again from now\n",
                 static_cast<unsigned long long>(resyncs));
   }
+  std::printf(
+      "fahr_fem_service: refused ContactSets: %s, non-finite %llu, unknown sphere %llu, "
+      "answering a step not reached %llu\n",
+      common::admission_summary(in.admission_counts()).c_str(),
+      static_cast<unsigned long long>(fem_step.non_finite_sets()),
+      static_cast<unsigned long long>(fem_step.unknown_sphere_sets()),
+      static_cast<unsigned long long>(fem_step.ahead_sets()));
   return 0;
 }
 

@@ -40,13 +40,12 @@ bool plausible_device_pose(const msg::DevicePose& pose) {
 void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop& loop,
                   common::TickRecorder& recorder, double duration_s, const WaitPolicy& wait,
                   std::shared_ptr<common::AdmissionCounts> pose_admission) {
-  // One gateway at a time (another writer refused while it lives, 50 ms),
+  // One gateway at a time (another writer refused while it has sent within 1 s),
   // its poses in order and plausible.
   common::Subscriber<msg::DevicePose> poses(
-      participant,
-      common::Admission<msg::DevicePose>{.takeover = std::chrono::nanoseconds(kTissueLossTimeoutNs),
-                                         .valid = plausible_device_pose,
-                                         .counts = std::move(pose_admission)});
+      participant, common::Admission<msg::DevicePose>{.takeover = std::chrono::seconds(1),
+                                                      .valid = plausible_device_pose,
+                                                      .counts = std::move(pose_admission)});
   common::Publisher<msg::ForceCommand> commands(participant);
   // The ContactSet's write (tens of microseconds: serialisation and send)
   // leaves the tick for a thread of its own, which looks for a new set
@@ -123,6 +122,12 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
   std::printf("fahr_haptic_service: DevicePoses received %llu, lost in transport %llu\n",
               static_cast<unsigned long long>(poses.received()),
               static_cast<unsigned long long>(poses.missed()));
+  std::printf(
+      "fahr_haptic_service: refused DevicePoses: %s; DeformationStates: %s, wrong size or "
+      "non-finite %llu\n",
+      common::admission_summary(poses.admission_counts()).c_str(),
+      common::admission_summary(feed.admission()).c_str(),
+      static_cast<unsigned long long>(feed.metrics().bad_states.load(std::memory_order_relaxed)));
 }
 
 // One tick per granted base step (the haptic rate is the base rate). At

@@ -11,13 +11,14 @@ namespace fahr::haptic_service {
 TissueFeed::TissueFeed(common::Participant& participant, const HapticSetup& setup)
     : digest_(setup),
       buffer_([this] { return digest_.make_snapshot(); }),
-      // One FEM at a time: another writer refused while it lives; a
-      // restarted FEM followed once the first has been silent for the loss
-      // timeout.
+      // One FEM at a time: another writer refused while it has sent within
+      // 1 s (the tongue is already lost after 50 ms); a restarted FEM is
+      // followed once the first has been silent that long. A state that
+      // does not fit the mesh is refused before it can become the source.
       states_(participant,
               common::Admission<msg::DeformationState>{
-                  .takeover = std::chrono::nanoseconds(kTissueLossTimeoutNs),
-                  .valid = {},
+                  .takeover = std::chrono::seconds(1),
+                  .valid = [this](const msg::DeformationState& s) { return digest_.plausible(s); },
                   .counts = std::make_shared<common::AdmissionCounts>()}),
       thread_([this] { run(); }) {}
 

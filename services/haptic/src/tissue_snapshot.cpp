@@ -85,19 +85,21 @@ TissueSnapshot TissueDigest::make_snapshot() {
   return s;
 }
 
-bool TissueDigest::digest(const msg::DeformationState& state, TissueSnapshot& out) {
-  const auto start = std::chrono::steady_clock::now();
-  const auto& x = state.positions_m();
-  if (x.size() != positions_m_.size()) return false;
+bool TissueDigest::plausible(const msg::DeformationState& state) const {
   // A non-finite compliance or free centre is never used: the whole state
   // is refused (counted as a bad state), as for a non-finite position.
   const auto finite = [](const auto& values) {
     return std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); });
   };
-  if (!finite(state.compliance_mpn()) || !finite(state.compliance_normals()) ||
-      !finite(state.compliance_free_centres_m())) {
-    return false;
-  }
+  return state.positions_m().size() == positions_m_.size() && finite(state.positions_m()) &&
+         finite(state.compliance_mpn()) && finite(state.compliance_normals()) &&
+         finite(state.compliance_free_centres_m());
+}
+
+bool TissueDigest::digest(const msg::DeformationState& state, TissueSnapshot& out) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!plausible(state)) return false;
+  const auto& x = state.positions_m();
   for (std::size_t i = 0; i < x.size(); ++i) positions_m_[i] = static_cast<double>(x[i]);
   if (!out.spheres.update(setup_.layout, positions_m_)) return false;  // a NaN from the FEM
   out.tree.refit(out.spheres);

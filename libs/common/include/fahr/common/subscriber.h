@@ -36,6 +36,9 @@ struct AdmissionCounts {
 // ServiceStatus.
 void append_admission_metrics(const AdmissionCounts& counts, const std::string& prefix,
                               std::vector<std::pair<std::string, double>>& out);
+// "foreign N, out of order N, invalid N, source changes N" for a service's
+// last lines.
+std::string admission_summary(const AdmissionCounts& counts);
 
 // Which samples a Subscriber lets in. The streams of a station have one
 // writer each; anyone else on the domain is refused (docs/design/faults.md,
@@ -45,7 +48,10 @@ struct Admission {
   // The first writer heard is the source. A sample of another writer is
   // refused while the source has sent within this time; after it, the next
   // writer heard becomes the source (a restarted service, a new writer).
-  std::chrono::nanoseconds takeover{std::chrono::milliseconds(50)};
+  // A second: longer than any stall of a live service (an intruder must not
+  // take the stream over while the FEM takes a slow step), shorter than a
+  // service's restart.
+  std::chrono::nanoseconds takeover{std::chrono::seconds(1)};
   // Refuses a sample that fails it (non-finite, out of range, wrong size).
   // Runs on the vendor thread.
   std::function<bool(const T&)> valid;

@@ -53,6 +53,8 @@ class TissueFeed {
   std::int64_t last_state_ns() const { return last_state_ns_.load(std::memory_order_acquire); }
 
   const FeedMetrics& metrics() const { return metrics_; }
+  // DeformationStates refused before the digest (another writer, out of order).
+  const common::AdmissionCounts& admission() const { return states_.admission_counts(); }
   // Also resets the per-report maximum (reporter thread).
   void append_metrics(std::vector<std::pair<std::string, double>>& out);
 

@@ -92,6 +92,12 @@ class TissueDigest {
   // position: the caller keeps its previous snapshot.
   bool digest(const msg::DeformationState& state, TissueSnapshot& out);
 
+  // Whether `state` can be digested: positions for every node of the mesh,
+  // every position, compliance entry, normal and free centre finite. Reads
+  // nothing digest() writes (a reader's Admission calls it on the vendor
+  // thread).
+  bool plausible(const msg::DeformationState& state) const;
+
  private:
   void query_obstacles(TissueSnapshot& out);
   void index_compliance(const msg::DeformationState& state, TissueSnapshot& out);
