@@ -6,7 +6,7 @@
 # well-formed foreign samples) as fast as it can from one core held to a
 # 25 % CPU quota, one second on and one second off. Checks:
 #   - each service keeps its rate in the flood windows against the calm ones
-#     in between (hostile_rates.py: the gateway's poses and the haptic
+#     in between (window_rates.py: the gateway's poses and the haptic
 #     service's commands at 99 %, the FEM's states at 90 %);
 #   - no hostile sample is used: the haptic service ticks only on the
 #     gateway's poses and the gateway accepts only the haptic service's
@@ -40,37 +40,14 @@ done
 # the intruder, not about other work on a shared machine.
 nice_level=${FAHR_HOSTILE_NICE:--15}
 
-# The intruder's 25 % of one core: a cgroup of its own, removed afterwards.
-# `ip netns exec` mounts a fresh /sys, so the test mounts the cpu
-# controller itself (cgroup v1 "cpu", else v2 with cpu.max). A machine that
-# has neither fails the test.
-cgroup=""
-cgroup_mount=""
-make_cgroup() {
-  cgroup_mount=$(mktemp -d /tmp/fahr-hostile-cg-XXXXXX)
-  if mount -t cgroup -o cpu cgroup "$cgroup_mount" 2>/dev/null; then
-    cgroup="$cgroup_mount/fahr-hostile-$$"
-    mkdir "$cgroup"
-    echo 100000 >"$cgroup/cpu.cfs_period_us"
-    echo 25000 >"$cgroup/cpu.cfs_quota_us"
-  elif mount -t cgroup2 none "$cgroup_mount" 2>/dev/null && grep -qw cpu "$cgroup_mount/cgroup.controllers"; then
-    echo +cpu >"$cgroup_mount/cgroup.subtree_control" 2>/dev/null || true
-    cgroup="$cgroup_mount/fahr-hostile-$$"
-    mkdir "$cgroup"
-    echo "25000 100000" >"$cgroup/cpu.max"
-  else
-    rmdir "$cgroup_mount"; cgroup_mount=""
-    echo "hostile_test: cannot mount a cgroup cpu controller to hold the intruder to 25 % of a core" >&2
-    exit 1
-  fi
-}
+# The intruder's 25 % of one core: a cgroup of its own (cpu_quota.sh).
+source "$repo/tests/faults/cpu_quota.sh"
 
 pids=()
 cleanup() {
   for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
   wait 2>/dev/null || true
-  [ -z "$cgroup" ] || rmdir "$cgroup" 2>/dev/null || true
-  [ -z "$cgroup_mount" ] || { umount "$cgroup_mount" 2>/dev/null; rmdir "$cgroup_mount" 2>/dev/null; } || true
+  quota_unmount
   [ -n "${FAHR_KEEP_HOSTILE:-}" ] || rm -rf "$out"
 }
 trap cleanup EXIT
@@ -83,7 +60,8 @@ wait_for() {  # wait_for LOG PATTERN TIMEOUT_S
   done
 }
 
-make_cgroup
+quota_mount
+quota_group intruder 25
 echo "hostile_test: $vendor, domain $domain, a ${run_s} s run, files in $out"
 nice -n "$nice_level" "$fem_exe" --scene "$scene" "${flags[@]}" --mode realtime --duration-s "$((run_s + 30))" >"$out/fem.log" 2>&1 &
 fem=$!; pids+=("$fem")
@@ -100,7 +78,7 @@ gateway=$!; pids+=("$gateway")
 sleep 1
 "$hostile_exe" "${flags[@]}" --seconds "$flood_s" --on-off-s 1 >"$out/hostile.log" 2>&1 &
 hostile=$!; pids+=("$hostile")
-echo "$hostile" >"$cgroup/cgroup.procs" 2>/dev/null || echo "$hostile" >"$cgroup/tasks"
+quota_put intruder "$hostile"
 taskset -p -c 0 "$hostile" >/dev/null
 wait "$hostile" || { echo "hostile_test: hostile_peer failed" >&2; cat "$out/hostile.log" >&2; exit 1; }
 wait "$gateway" || { echo "hostile_test: the gateway exited with $?" >&2; exit 1; }
@@ -123,7 +101,12 @@ ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a >= b) }'; }
 grep -h "^hostile: wrote" "$out/hostile.log" | sed 's/^/hostile_test: /'
 grep -h "refused" "$out/gateway.log" "$out/haptic.log" "$out/fem.log" | sed 's/^/hostile_test: /'
 echo "hostile_test: rates, flood windows against the calm ones between them"
-python3 "$repo/tests/faults/hostile_rates.py" "$out/probe.txt" "$out/hostile.log" | tee "$out/rates.md" || status=1
+# The floods from hostile_peer's "hostile: on <ns> <ns>" lines; the calm
+# windows are the rests between them.
+awk '$1 == "hostile:" && $2 == "on" { if (n++) print "calm", last, $3; print "flood", $3, $4; last = $4 }' \
+  "$out/hostile.log" >"$out/windows.txt"
+python3 "$repo/tests/faults/window_rates.py" "$out/probe.txt" "$out/windows.txt" \
+  flood:gateway:0.99 flood:haptic:0.99 flood:fem:0.90 | tee "$out/rates.md" || status=1
 
 echo "hostile_test: checks"
 gw_ticks=$(num "$out/gateway.log" 's/.*device_gateway: ticks \([0-9]*\),.*/\1/p')
