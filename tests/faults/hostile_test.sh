@@ -7,7 +7,10 @@
 # 25 % CPU quota, one second on and one second off. Checks:
 #   - each service keeps its rate in the flood windows against the calm ones
 #     in between (window_rates.py: the gateway's poses and the haptic
-#     service's commands at 99 %, the FEM's states at 90 %);
+#     service's commands at 98 %, the FEM's states at 85 %: the goal is
+#     99 %, the margin is for a shared machine's load, and the FEM's step is
+#     CPU-bound, so what its receive thread spends on the intruder is its
+#     own);
 #   - no hostile sample is used: the haptic service ticks only on the
 #     gateway's poses and the gateway accepts only the haptic service's
 #     commands (its intruder pushes 2 N);
@@ -22,82 +25,30 @@ repo=$(cd "$(dirname "$0")/../.." && pwd)
 build=$(cd "${1:?usage: hostile_test.sh BUILD_DIR VENDOR}" && pwd)
 vendor=${2:?usage: hostile_test.sh BUILD_DIR VENDOR}
 domain=${FAHR_HOSTILE_DOMAIN:-62}
-scene="$repo/deployment/scenes/neonatal_intubation.yaml"
-flags=(--dds "$vendor" --domain "$domain")
 out=${FAHR_KEEP_HOSTILE:-$(mktemp -d /tmp/fahr-hostile-XXXXXX)}
-mkdir -p "$out"
+FAHR_KEEP=${FAHR_KEEP_HOSTILE:-}
+name=hostile_test
 run_s=14
 flood_s=12
-gateway_exe="$build/services/device_gateway/fahr_device_gateway"
-fem_exe="$build/services/fem/fahr_fem_service"
-haptic_exe="$build/services/haptic/fahr_haptic_service"
 hostile_exe="$build/tests/faults/hostile_peer"
-probe_exe="$build/tests/faults/fault_probe"
-for exe in "$gateway_exe" "$fem_exe" "$haptic_exe" "$hostile_exe" "$probe_exe"; do
-  [ -x "$exe" ] || { echo "hostile_test: $exe is missing (build it)" >&2; exit 1; }
-done
-# The station at a high CFS weight, as in fault_test.sh: the test is about
-# the intruder, not about other work on a shared machine.
-nice_level=${FAHR_HOSTILE_NICE:--15}
+[ -x "$hostile_exe" ] || { echo "hostile_test: $hostile_exe is missing (build it)" >&2; exit 1; }
+source "$repo/tests/faults/station.sh"
 
-# The intruder's 25 % of one core: a cgroup of its own (cpu_quota.sh).
-source "$repo/tests/faults/cpu_quota.sh"
-
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  quota_unmount
-  [ -n "${FAHR_KEEP_HOSTILE:-}" ] || rm -rf "$out"
-}
-trap cleanup EXIT
-
-wait_for() {  # wait_for LOG PATTERN TIMEOUT_S
-  local deadline=$(( $(date +%s) + $3 ))
-  until grep -q "$2" "$1" 2>/dev/null; do
-    [ "$(date +%s)" -lt "$deadline" ] || { echo "hostile_test: '$2' not in $1 within $3 s" >&2; tail -n 20 "$1" >&2; return 1; }
-    sleep 0.05
-  done
-}
-
+# The intruder: 25 % of core 0.
 quota_mount
 quota_group intruder 25
-echo "hostile_test: $vendor, domain $domain, a ${run_s} s run, files in $out"
-nice -n "$nice_level" "$fem_exe" --scene "$scene" "${flags[@]}" --mode realtime --duration-s "$((run_s + 30))" >"$out/fem.log" 2>&1 &
-fem=$!; pids+=("$fem")
-nice -n "$nice_level" "$haptic_exe" --scene "$scene" "${flags[@]}" --mode realtime --duration-s "$((run_s + 30))" >"$out/haptic.log" 2>&1 &
-haptic=$!; pids+=("$haptic")
-wait_for "$out/fem.log" "Hz, realtime" 180
-wait_for "$out/haptic.log" "fahr_haptic_service: ready" 180
-nice -n "$nice_level" "$probe_exe" "${flags[@]}" --states --duration-s "$((run_s + 30))" --out "$out/probe.txt" >"$out/probe.log" 2>&1 &
-probe=$!; pids+=("$probe")
-sleep 1  # the probe's readers match before the first DevicePose
-nice -n "$nice_level" "$gateway_exe" "${flags[@]}" --backend simulated --script intubation --duration-s "$run_s" \
-  >"$out/gateway.log" 2>&1 &
-gateway=$!; pids+=("$gateway")
+station_start
 sleep 1
 "$hostile_exe" "${flags[@]}" --seconds "$flood_s" --on-off-s 1 >"$out/hostile.log" 2>&1 &
 hostile=$!; pids+=("$hostile")
 quota_put intruder "$hostile"
 taskset -p -c 0 "$hostile" >/dev/null
 wait "$hostile" || { echo "hostile_test: hostile_peer failed" >&2; cat "$out/hostile.log" >&2; exit 1; }
-wait "$gateway" || { echo "hostile_test: the gateway exited with $?" >&2; exit 1; }
-for p in "$haptic" "$fem" "$probe"; do kill -INT "$p" 2>/dev/null || true; done
-wait "$haptic" || { echo "hostile_test: the haptic service exited with $?" >&2; exit 1; }
-wait "$fem" || { echo "hostile_test: the FEM exited with $?" >&2; exit 1; }
-wait "$probe" || true
-pids=()
+station_stop
 
 num() {  # num FILE SED_EXPRESSION: the last match
   sed -n "$2" "$1" | tail -n 1
 }
-status=0
-check() {  # check DESCRIPTION COMMAND...
-  local what=$1; shift
-  if "$@"; then echo "  ok    $what"; else echo "  FAIL  $what"; status=1; fi
-}
-ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a >= b) }'; }
-
 grep -h "^hostile: wrote" "$out/hostile.log" | sed 's/^/hostile_test: /'
 grep -h "refused" "$out/gateway.log" "$out/haptic.log" "$out/fem.log" | sed 's/^/hostile_test: /'
 echo "hostile_test: rates, flood windows against the calm ones between them"
@@ -106,7 +57,7 @@ echo "hostile_test: rates, flood windows against the calm ones between them"
 awk '$1 == "hostile:" && $2 == "on" { if (n++) print "calm", last, $3; print "flood", $3, $4; last = $4 }' \
   "$out/hostile.log" >"$out/windows.txt"
 python3 "$repo/tests/faults/window_rates.py" "$out/probe.txt" "$out/windows.txt" \
-  flood:gateway:0.99 flood:haptic:0.99 flood:fem:0.90 | tee "$out/rates.md" || status=1
+  flood:gateway:0.98 flood:haptic:0.98 flood:fem:0.85 | tee "$out/rates.md" || status=1
 
 echo "hostile_test: checks"
 gw_ticks=$(num "$out/gateway.log" 's/.*device_gateway: ticks \([0-9]*\),.*/\1/p')

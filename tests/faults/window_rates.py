@@ -13,6 +13,7 @@ writer_id in its header; samples with the intruder's writer_id
 A CHECK is LABEL:STREAM:MIN, STREAM one of gateway, haptic, fem: that
 stream's rate in LABEL's windows must be at least MIN times its calm rate.
 Prints the table (every label, every stream) and exits 1 if a check fails.
+The bounds are the callers' (hostile_test.sh, overload_test.sh).
 """
 import sys
 from collections import defaultdict

@@ -21,7 +21,8 @@ std::string admission_summary(const AdmissionCounts& counts) {
   return "foreign " + std::to_string(counts.foreign.load(std::memory_order_relaxed)) +
          ", out of order " + std::to_string(counts.out_of_order.load(std::memory_order_relaxed)) +
          ", invalid " + std::to_string(counts.invalid.load(std::memory_order_relaxed)) +
-         ", source changes " + std::to_string(counts.source_changes.load(std::memory_order_relaxed));
+         ", source changes " +
+         std::to_string(counts.source_changes.load(std::memory_order_relaxed));
 }
 
 }  // namespace fahr::common

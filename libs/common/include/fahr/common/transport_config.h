@@ -48,9 +48,9 @@ SecurityFiles security_files(const TransportConfig& config);
 // missing or unreadable, profile of the wrong kind for the vendor.
 void validate(const TransportConfig& config);
 
-  // Reads FAHR_DDS, FAHR_DOMAIN_ID, FAHR_DDS_PROFILE, FAHR_PARTITION and FAHR_DDS_SECURITY
-  // (and FAHR_DDS_IDENTITY), overridden by the non-empty command-line values given. Throws
-  // ConfigError on bad values (a missing security file named).
+// Reads FAHR_DDS, FAHR_DOMAIN_ID, FAHR_DDS_PROFILE, FAHR_PARTITION and FAHR_DDS_SECURITY
+// (and FAHR_DDS_IDENTITY), overridden by the non-empty command-line values given. Throws
+// ConfigError on bad values (a missing security file named).
 TransportConfig transport_config_from(std::string_view vendor_flag, std::string_view domain_flag,
                                       std::string_view profile_flag, std::string participant_name,
                                       std::string_view security_flag = {});
