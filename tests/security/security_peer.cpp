@@ -20,6 +20,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -80,15 +81,17 @@ int main(int argc, char** argv) {
     msg::ForceCommand command;
     command.device_id(1);
     std::uint64_t wrote = 0;
-    const auto start = std::chrono::steady_clock::now();
+    // From the first pose it hears (discovery can take a second): zero for
+    // 0.1 s (the gateway's engage rule wants a small force), then up to 2 N
+    // over a second: what a hostile participant that knows the rules would
+    // send.
+    std::optional<std::chrono::steady_clock::time_point> start;
     while (std::chrono::steady_clock::now() < end) {
-      // Zero for 0.1 s (the gateway's engage rule wants a small force), then
-      // up to 2 N over a second: what a hostile participant that knows the
-      // rules would send.
-      const double t =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const auto now = std::chrono::steady_clock::now();
+      const double t = start ? std::chrono::duration<double>(now - *start).count() : 0.0;
       command.force_n().y(std::clamp(2.0 * (t - 0.1), 0.0, 2.0));
       if (poses.fetch_newest()) {
+        if (!start) start = now;
         command.answered_pose_seq(poses.newest().header().seq());
         command.answered_position_m(poses.newest().world_from_stylus().position_m());
       }
