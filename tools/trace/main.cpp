@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "deformation_statePubSubTypes.h"
 #include "device_posePubSubTypes.h"
 #include "fahr/common/cdr_bytes.h"
 #include "fahr/mcap/reader.h"
@@ -53,13 +54,25 @@ struct Service {
 
 struct Pose {
   std::int64_t source_ns = 0;
+  double force[3] = {0, 0, 0};  // rendered at this servo tick, N
 };
 
 struct Command {
   std::uint64_t pose_seq = 0;
   std::int64_t source_ns = 0, log_ns = 0;
   std::uint32_t writer_id = 0;
+  std::uint64_t fem_step = 0;
 };
+
+// A DeformationState the recorder kept (the recorder may keep one in N).
+struct State {
+  std::uint32_t writer_id = 0;
+  std::uint64_t step = 0;
+  std::int64_t source_ns = 0;
+  double step_s = 0;
+};
+
+constexpr double kFeltStepN = 0.1;  // a force step a hand notices, N a servo tick
 
 struct Percentiles {
   std::size_t n = 0;
@@ -121,6 +134,130 @@ std::string quoted(const std::string& s) {
   return q + "\"";
 }
 
+// What the trainee feels, over the whole run: the largest change of the
+// rendered force from one servo tick to the next (DevicePose.rendered_force_n
+// of consecutive poses), and how old the FEM state behind each ForceCommand
+// was when the haptic service used it: the command's write time minus the
+// end of the FEM tick that wrote its DeformationState.step. The FEM's tick
+// spans give every step's time; the DeformationStates the recorder kept
+// tie FEM steps to its ticks. Ages are on the writers' clocks (one clock
+// when the hosts are namespaces of one machine; across machines only within
+// their clock error).
+void print_felt(const std::map<std::uint64_t, Pose>& poses, const std::vector<Command>& commands,
+                const std::vector<State>& states,
+                const std::map<std::uint32_t, Service>& services) {
+  std::vector<double> steps;
+  std::size_t over = 0;
+  for (auto it = poses.begin(); it != poses.end(); ++it) {
+    auto next = std::next(it);
+    if (next == poses.end() || next->first != it->first + 1) continue;
+    double sq = 0;
+    for (int k = 0; k < 3; ++k) sq += std::pow(next->second.force[k] - it->second.force[k], 2);
+    steps.push_back(std::sqrt(sq));
+    if (steps.back() > kFeltStepN + 1e-6) ++over;  // the gate's own 0.1 N steps pass
+  }
+  std::printf("\nwhat the trainee feels:\n");
+  if (!steps.empty()) {
+    const auto p = percentiles(steps);
+    std::printf(
+        "  force step per servo tick:  n %zu  p99 %.4f N  p99.9 %.4f N  max %.4f N  ticks > %.1f N "
+        "%zu (%.3f %%)\n",
+        p.n, p.p99, p.p999, p.max, kFeltStepN, over,
+        100.0 * static_cast<double>(over) / static_cast<double>(p.n));
+  }
+  // The FEM: the service named fem with the most ticks, and its states.
+  const Service* fem = nullptr;
+  std::uint32_t fem_id = 0;
+  for (const auto& [id, s] : services) {
+    if (s.name == "fem" && (fem == nullptr || s.ticks.size() > fem->ticks.size())) {
+      fem = &s;
+      fem_id = id;
+    }
+  }
+  if (fem == nullptr || fem->ticks.empty() || commands.empty()) {
+    std::printf("  FEM state age: no FEM ticks or commands recorded\n");
+    return;
+  }
+  // Tick index -> position; step -> tick from the kept states (the most
+  // common difference: a step is written in the tick that made it).
+  std::map<std::uint64_t, std::size_t> tick_position;
+  for (std::size_t i = 0; i < fem->ticks.size(); ++i) tick_position[fem->ticks[i].tick] = i;
+  std::map<std::int64_t, std::size_t> offsets;
+  double period_s = 0;
+  for (const auto& st : states) {
+    if (st.writer_id != fem_id) continue;
+    period_s = st.step_s;
+    auto after = std::upper_bound(fem->ticks.begin(), fem->ticks.end(), st.source_ns,
+                                  [](std::int64_t v, const Tick& t) { return v < t.start_ns; });
+    if (after == fem->ticks.begin()) continue;
+    const Tick& t = *(after - 1);
+    if (st.source_ns > t.start_ns + t.duration_ns) continue;
+    ++offsets[static_cast<std::int64_t>(t.tick) - static_cast<std::int64_t>(st.step)];
+  }
+  if (offsets.empty() || period_s <= 0) {
+    std::printf("  FEM state age: no DeformationState inside a FEM tick recorded\n");
+    return;
+  }
+  const std::int64_t offset =
+      std::max_element(offsets.begin(), offsets.end(), [](const auto& a, const auto& b) {
+        return a.second < b.second;
+      })->first;
+  std::vector<std::int64_t> ends;
+  ends.reserve(fem->ticks.size());
+  for (const auto& t : fem->ticks) ends.push_back(t.start_ns + t.duration_ns);
+  std::sort(ends.begin(), ends.end());
+  const double limit_ms = 3.0 * period_s * 1e3;
+  std::vector<double> ages_ms, behind;
+  std::size_t old = 0, far_behind = 0, unknown = 0;
+  std::map<std::uint64_t, bool> used;
+  for (const auto& c : commands) {
+    if (c.fem_step == 0) continue;  // before the first state
+    used[c.fem_step] = true;
+    const auto tick = static_cast<std::int64_t>(c.fem_step) + offset;
+    auto at = tick_position.find(static_cast<std::uint64_t>(std::max<std::int64_t>(tick, 0)));
+    if (tick < 0 || at == tick_position.end()) {
+      ++unknown;
+      continue;
+    }
+    const Tick& t = fem->ticks[at->second];
+    const double age_ms = static_cast<double>(c.source_ns - (t.start_ns + t.duration_ns)) * 1e-6;
+    ages_ms.push_back(age_ms);
+    if (age_ms > limit_ms) ++old;
+    // States the FEM had written after this one by the time it was used.
+    const auto newer = std::upper_bound(ends.begin(), ends.end(), c.source_ns) -
+                       std::upper_bound(ends.begin(), ends.end(), t.start_ns + t.duration_ns);
+    behind.push_back(static_cast<double>(std::max<std::ptrdiff_t>(newer, 0)));
+    if (newer > 3) ++far_behind;
+  }
+  if (ages_ms.empty()) {
+    std::printf("  FEM state age: no command used a FEM state with a recorded tick\n");
+    return;
+  }
+  const auto a = percentiles(ages_ms);
+  const auto b = percentiles(behind);
+  const auto n = static_cast<double>(a.n);
+  std::printf(
+      "  FEM state age at use:       n %zu  p50 %.3f ms  p99 %.3f ms  max %.3f ms  "
+      "> 3 periods (%.1f ms) %zu (%.3f %%)\n",
+      a.n, a.p50, a.p99, a.max, limit_ms, old, 100.0 * static_cast<double>(old) / n);
+  std::printf(
+      "  newer FEM states written:   p50 %.0f  p99 %.0f  max %.0f  ticks on a state > 3 behind %zu "
+      "(%.3f %%)\n",
+      b.p50, b.p99, b.max, far_behind, 100.0 * static_cast<double>(far_behind) / n);
+  // States written while the haptic service answered poses.
+  std::int64_t first_ns = INT64_MAX, last_ns = INT64_MIN;
+  for (const auto& c : commands) {
+    first_ns = std::min(first_ns, c.source_ns);
+    last_ns = std::max(last_ns, c.source_ns);
+  }
+  const auto written = std::upper_bound(ends.begin(), ends.end(), last_ns) -
+                       std::lower_bound(ends.begin(), ends.end(), first_ns);
+  std::printf(
+      "  FEM states written while commands were %td, used by a ForceCommand %zu, commands without "
+      "a tick %zu\n",
+      written, used.size(), unknown);
+}
+
 int run(int argc, char** argv) {
   CLI::App app{"fahr_trace: a recording as a Chrome trace, and its latency figures"};
   std::string path, output;
@@ -144,6 +281,8 @@ int run(int argc, char** argv) {
   msg::ServiceStatus status;
   msg::DevicePose pose;
   msg::ForceCommand command;
+  msg::DeformationState state;
+  std::vector<State> states;
   const auto report = mcap::read_file(path, [&](const mcap::Channel& c,
                                                 const mcap::MessageView& m) {
     if (tty && ++seen % 20000 == 0) {
@@ -168,12 +307,18 @@ int run(int argc, char** argv) {
     } else if (c.topic == "fahr/DevicePose") {
       if (!decode<msg::DevicePose, msg::DevicePosePubSubType>(m, pose)) return;
       gateway_id = pose.header().writer_id();
-      poses[pose.header().seq()] = {pose.header().source_time_ns()};
+      const auto& f = pose.rendered_force_n();
+      poses[pose.header().seq()] = {pose.header().source_time_ns(), {f.x(), f.y(), f.z()}};
       pose_times.push_back(pose.header().source_time_ns());
     } else if (c.topic == "fahr/ForceCommand") {
       if (!decode<msg::ForceCommand, msg::ForceCommandPubSubType>(m, command)) return;
       commands.push_back({command.answered_pose_seq(), command.header().source_time_ns(),
-                          static_cast<std::int64_t>(m.log_time), command.header().writer_id()});
+                          static_cast<std::int64_t>(m.log_time), command.header().writer_id(),
+                          command.fem_step()});
+    } else if (c.topic == "fahr/DeformationState") {
+      if (!decode<msg::DeformationState, msg::DeformationStatePubSubType>(m, state)) return;
+      states.push_back({state.header().writer_id(), state.step(), state.header().source_time_ns(),
+                        state.step_s()});
     }
   });
   if (tty)
@@ -310,6 +455,7 @@ int run(int argc, char** argv) {
       "  pose written -> servo tick rendering it:  n %zu  p50 %.3f ms  p99 %.3f ms  "
       "p99.9 %.3f ms  max %.3f ms (approx.)\n",
       m2r.n, m2r.p50, m2r.p99, m2r.p999, m2r.max);
+  print_felt(poses, commands, states, services);
   std::printf("\nper topic: recorder receive time - writer source time (same host: one clock)\n");
   std::printf("  %-24s %9s %9s %9s %9s %9s\n", "topic", "n", "p50 ms", "p99 ms", "p99.9 ms",
               "max ms");

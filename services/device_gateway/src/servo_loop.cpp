@@ -73,6 +73,7 @@ void fill_snapshot(const device::ServoCore& core, const GatewaySetup& setup, Loo
   s.passivity_active_ticks = core.passivity().active_ticks();
   s.remote_rejected = setup.remote != nullptr ? setup.remote->rejected_non_finite() : 0;
   s.motion_to_force = core.latency();
+  s.motion_to_force_run = core.run_latency();
 }
 
 void after_tick(const device::DevicePoseSample& pose, std::uint64_t written_seq, LoopState& state) {
