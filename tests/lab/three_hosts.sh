@@ -14,7 +14,7 @@
 #
 #   tests/lab/three_hosts.sh BUILD_DIR GATEWAY_V HAPTIC_V FEM_V SECONDS [REPORT.md]
 #       [--relay] [--link hA-hB:delay_ms=..,jitter_ms=..,loss=..]... [--gateway-apart]
-#       [--nice N] [--rt]
+#       [--nice N] [--rt] [--clock-offset hN=MS]
 #
 # --relay, --link: fahr_udp_relay (tests/lab/udp_relay.cpp) replaces the
 # bridge and switches every frame between the hosts; a --link impairs one
@@ -24,6 +24,12 @@
 # the gateway does). --nice N runs the stations at nice -N (ahead of other
 # work on a shared machine), --rt gives the gateway's and the haptic
 # service's 1 kHz ticks SCHED_FIFO (the lab file's rt_priority).
+# --clock-offset h2=40: every process of that namespace sees a wall clock
+# 40 ms ahead (FAHR_TEST_CLOCK_OFFSET_MS, the clock's test hook), as an
+# unsynchronised host would; the cross-host figures must stay honest: the
+# recording's latencies from that host, corrected by the offset fahr_lab's
+# clock echoes measured, within their error, and the uncorrected ones
+# visibly off.
 #
 # Needs root (it creates namespaces); anything it cannot do fails the test.
 # Everything it creates is removed on exit; each step is bounded in time.
@@ -35,6 +41,7 @@ shift 5
 report=""
 if [ $# -gt 0 ] && [[ "$1" != --* ]]; then report=$1; shift; fi
 use_relay="" links=() gateway_host=h1 nice_prefix=() rt_gateway=0 rt_haptic=0
+offset_host="" offset_ms=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --relay) use_relay=1; shift ;;
@@ -42,6 +49,7 @@ while [ $# -gt 0 ]; do
     --gateway-apart) gateway_host=h3; shift ;;
     --nice) [ "$2" != 0 ] && nice_prefix=(nice -n "-$2"); shift 2 ;;
     --rt) rt_gateway=40 rt_haptic=39; shift ;;
+    --clock-offset) offset_host=${2%%=*} offset_ms=${2#*=}; shift 2 ;;
     *) echo "three_hosts: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -165,7 +173,12 @@ echo "three_hosts: plan:"
 
 run_root="$work/runs"
 in_ns() { local h=$1; shift; ip netns exec "$tag-$h" env FAHR_RUN_ROOT="$run_root/$h" "$@"; }
-up_ns() { local h=$1; shift; in_ns "$h" "${nice_prefix[@]}" "$@"; }
+up_ns() {
+  local h=$1; shift
+  local offset=0
+  [ "$h" = "$offset_host" ] && offset=$offset_ms
+  in_ns "$h" env FAHR_TEST_CLOCK_OFFSET_MS="$offset" "${nice_prefix[@]}" "$@"
+}
 # For investigating: run a command with the network and the lab file in
 # place ($FAHR_LAB_TEST_DEBUG, given tag, lab and work folder), then clean up.
 if [ -n "${FAHR_LAB_TEST_DEBUG:-}" ]; then
@@ -237,10 +250,14 @@ logger_table=$(grep "^fahr_logger: " "$r3/logger.log" | grep -v "recording to" |
 # writer are discovery, not loss).
 trace=""
 if [ -x "$build/tools/trace/fahr_trace" ]; then
-  trace=$("$build/tools/trace/fahr_trace" "$r3/bed-1.mcap" -o "$work/trace.json" 2>&1 |
+  trace=$("$build/tools/trace/fahr_trace" "$r3/bed-1.mcap" -o "$work/trace.json" --clock "$r3/clock.txt" 2>&1 |
     sed -n '/^motion-to-force/,/^DevicePose period/p;/^loss per writer/,$p' | grep -v "^DevicePose period" || true)
 fi
 
+raw_trace=""
+if [ -n "$offset_host" ] && [ -x "$build/tools/trace/fahr_trace" ]; then
+  raw_trace=$("$build/tools/trace/fahr_trace" "$r3/bed-1.mcap" -o "$work/trace_raw.json" 2>&1 || true)
+fi
 {
   echo "### gateway $gateway_v, haptic $haptic_v, FEM $fem_v: ${seconds} s across three namespaces"
   echo
@@ -254,11 +271,15 @@ fi
   echo "- FEM: ${fem_line#fahr_fem_service: }"
   echo "- haptic: ${haptic_line#fahr_haptic_service: }; ${pose_line#fahr_haptic_service: }"
   echo "- gateway: ${gateway_line#device_gateway: }"
+  echo "- clocks against h3's (fahr_lab's echoes; host, offset ms, error ms): $(awk '/^host/ { printf "%s%s %s +- %s", sep, $2, $5, $7; sep = "; " }' "$r3/clock.txt" 2>/dev/null)"
+  if [ -n "$offset_host" ]; then
+    echo "- $offset_host's clock offset by the test hook: $offset_ms ms; fahr_trace without --clock: $(echo "$raw_trace" | awk '$1 == "fahr/DeformationState" && $3 ~ /[.]/ { print "DeformationState p50 " $3 " ms" }')"
+  fi
   echo
   echo "$summary"
   echo
   if [ -n "$trace" ]; then
-    echo "From the recording (fahr_trace; FEM on h2, gateway and haptic on h1, recorder on h3 on $haptic_v):"
+    echo "From the recording (fahr_trace --clock; FEM on h2, gateway on $gateway_host, haptic on h1, recorder on h3 on $haptic_v):"
     echo
     echo '```'
     echo "$trace"
@@ -286,6 +307,27 @@ used=$(echo "$haptic_line" | sed -n 's/.* on \([0-9]*\) FEM states.*/\1/p')
 [ "${used:-0}" -gt 0 ] || fail "the haptic service used no FEM state from the other namespace"
 poses=$(echo "$summary" | awk -F'|' '/DevicePose samples/ { gsub(/ /, "", $3); print $3 }')
 [ "${poses:-0}" -gt 0 ] || fail "the summary on h3 heard no DevicePose"
+if [ -n "$offset_host" ]; then
+  # The FEM's states from h2 to the recorder on h3: under 10 ms once
+  # corrected (within the measured error), about -offset as stamped.
+  corrected=$(echo "$trace" | awk '$1 == "fahr/DeformationState" && $3 ~ /[.]/ { print $3, $7 }')
+  raw=$(echo "$raw_trace" | awk '$1 == "fahr/DeformationState" && $3 ~ /[.]/ { print $3 }')
+  measured=$(awk -v h="$offset_host" '$1 == "host" && $2 == h { print $5, $7 }' "$r3/clock.txt")
+  echo "three_hosts: clock offset $offset_ms ms on $offset_host; measured (offset, error): ${measured:-none}; DeformationState p50 corrected (p50, +-): ${corrected:-none}, as stamped: ${raw:-none}"
+  awk -v m="${measured:-x}" -v want="$offset_ms" 'BEGIN { split(m, a, " "); exit !(m != "x" && a[2] >= 0 && a[2] < 5 && a[1] - want < a[2] + 0.5 && want - a[1] < a[2] + 0.5) }' ||
+    fail "the echoes measured $offset_host's clock at '${measured:-nothing}' for an offset of $offset_ms ms"
+  awk -v c="${corrected:-x}" 'BEGIN { split(c, a, " "); exit !(c != "x" && a[1] > -a[2] - 0.5 && a[1] < 10) }' ||
+    fail "DeformationState latency printed as '${corrected:-nothing}' (p50, +-) with $offset_host's clock off"
+  awk -v r="${raw:-x}" -v want="$offset_ms" 'BEGIN { exit !(r != "x" && (r + want < 10 && r + want > -10)) }' ||
+    fail "as stamped, the DeformationState latency is '${raw:-nothing}' ms: the test hook did not offset $offset_host's clock by $offset_ms ms"
+  # No state is used before it was written: the youngest age is not below
+  # zero by more than the clocks' error and the few ms the FEM's tick may
+  # run on after its write (the tick's end stands for the write); as
+  # stamped it would be about -offset.
+  age=$(echo "$trace" | sed -n 's/.*FEM state age at use: *n [0-9]*  min \([-0-9.]*\) ms.*clocks: +-\([0-9.]*\) ms.*/\1 \2/p')
+  awk -v a="${age:-x}" 'BEGIN { split(a, v, " "); exit !(a != "x" && v[1] > -v[2] - 5) }' ||
+    fail "FEM state age (youngest, +-) '${age:-not printed}' ms with $offset_host's clock off"
+fi
 grep -q "stopped (the gateway's run" "$rg/fahr_lab.log" 2>/dev/null || grep -q "station bed-1 stopped" "$work/h1.out" ||
   fail "h1's station did not end with the gateway's run"
 echo "three_hosts: wall time $(awk -v a="$started" -v b="$ended" 'BEGIN { printf "%.1f", b - a }') s, status $status"
