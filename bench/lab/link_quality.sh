@@ -96,14 +96,14 @@ for c in "${cases[@]}"; do
   label=${c%%|*}
   args=${c#*|}
   load=$(cut -d' ' -f1 /proc/loadavg)
-  report="$work/run$i.md"
+  report="$work/$vendor-run$i.md"
   echo "link_quality: $label ($vendor, load $load)" >&2
   # shellcheck disable=SC2086
   if ! bash "$repo/tests/lab/three_hosts.sh" "$build" "$vendor" "$vendor" "$vendor" "$seconds" \
-      "$report" $args --nice "$nice_level" --rt >"$work/run$i.out" 2>&1; then
+      "$report" $args --nice "$nice_level" --rt >"$work/$vendor-run$i.out" 2>&1; then
     status=1
     echo "link_quality: the run '$label' failed:" >&2
-    tail -n 8 "$work/run$i.out" >&2
+    tail -n 8 "$work/$vendor-run$i.out" >&2
   fi
   if [ ! -s "$report" ]; then
     echo "| $label | $load | run failed | | | | | | | | | | no |" >>"$table"

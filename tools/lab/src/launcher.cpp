@@ -203,6 +203,10 @@ Child make_child(const Plan& plan, const PlannedParticipant& p, const fs::path& 
       std::snprintf(duration, sizeof duration, "%g", station.duration_s);
       add({program_path("fahr_device_gateway", "services/device_gateway").string(), "--duration-s",
            duration});
+      if (const ServiceSpec* haptic = station.service(ServiceKind::kHaptic);
+          haptic != nullptr && haptic->host != s.host) {
+        add({"--wait-haptic-s", std::to_string(kRemoteHapticWaitS)});
+      }
       if (s.args.empty()) add({"--backend", "simulated", "--script", "intubation"});
       break;
     }
