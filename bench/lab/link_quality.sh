@@ -119,7 +119,7 @@ for c in "${cases[@]}"; do
     END { printf "%s / %s / %s", m["fem"], m["haptic"], m["device_gateway"] }' "$report")
   hz=$(awk -F'|' '$2 ~ /^ haptic / { gsub(/ /, "", $5); print $5 }' "$report")
   pc=$(grep -o "PC removed [0-9.]* mJ" "$report" | awk '{ print $3 }')
-  read -r step_p999 step_max step_n step_pct <<<"${step:-nan nan 0 0}"
+  read -r step_p999 step_max step_n _ <<<"${step:-nan nan 0 0}"
   read -r age_p99 age_pct <<<"${age:-nan nan}"
   read -r used written <<<"${states:-0 0}"
   usable=$(awk -v m="${m2f:-99}" -v s="$step_p999" -v b="${behind:-100}" 'BEGIN {
