@@ -7,6 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
 #include <thread>
 
 #include "fahr/common/background_publisher.h"
@@ -347,6 +350,60 @@ TEST(Config, ShippedProfilesLoad) {
     config.profile_file = std::string(FAHR_DEPLOYMENT_DIR) + "/dds/" + file;
     EXPECT_NO_THROW(Participant p(config)) << file;
   }
+}
+
+// The UDP ports bound in this network namespace.
+std::multiset<int> udp_ports() {
+  std::multiset<int> ports;
+  std::ifstream in("/proc/net/udp");
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string slot, local;
+    words >> slot >> local;
+    const std::size_t colon = local.find(':');
+    if (colon != std::string::npos) ports.insert(std::stoi(local.substr(colon + 1), nullptr, 16));
+  }
+  return ports;
+}
+
+// A Fast DDS profile given to one participant applies to it only: the
+// factory is the process's, and a later participant without a profile
+// used to inherit it.
+TEST(Config, FastDdsProfileStaysWithItsParticipant) {
+  constexpr std::uint32_t kDomain = 211;
+  constexpr int kFixedPort = 47123;
+  const std::string file = ::testing::TempDir() + "fahr_fixed_discovery_port.xml";
+  {
+    std::ofstream out(file);
+    out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+           "<profiles xmlns=\"http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles\">\n"
+           "  <participant profile_name=\"fixed_port\" is_default_profile=\"true\">\n"
+           "    <rtps><builtin><metatrafficUnicastLocatorList><locator><udpv4>\n"
+           "      <address>127.0.0.1</address><port>"
+        << kFixedPort
+        << "</port>\n"
+           "    </udpv4></locator></metatrafficUnicastLocatorList></builtin></rtps>\n"
+           "  </participant>\n"
+           "</profiles>\n";
+  }
+  TransportConfig with_profile;
+  with_profile.vendor = Vendor::kFastDds;
+  with_profile.domain_id = kDomain;
+  with_profile.profile_file = file;
+  TransportConfig plain = with_profile;
+  plain.profile_file.clear();
+  Participant a(with_profile);
+  EXPECT_EQ(udp_ports().count(kFixedPort), 1U) << "the profile did not apply";
+  Participant b(plain);
+  const auto ports = udp_ports();
+  EXPECT_EQ(ports.count(kFixedPort), 1U) << "the second participant took the first's profile";
+  // b's discovery on the domain's RTPS default port (7400 + 250 d + 10 + 2 i).
+  int defaults = 0;
+  for (int i = 0; i < 120; ++i)
+    defaults += static_cast<int>(ports.count(7400 + 250 * kDomain + 10 + 2 * i));
+  EXPECT_GE(defaults, 1) << "the participant without a profile has no default discovery port";
 }
 
 }  // namespace

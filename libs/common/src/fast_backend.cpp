@@ -14,10 +14,13 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "backends.h"
@@ -310,6 +313,40 @@ class FastReader final : public ReaderBackend, private dds::DataReaderListener {
   std::atomic<int> matched_{0};
 };
 
+// The factory's default participant QoS from the vendor's own default file
+// (or built in), read once, before any profile of fahr's is loaded.
+const dds::DomainParticipantQos& vendor_default_participant_qos(
+    dds::DomainParticipantFactory& factory) {
+  static const dds::DomainParticipantQos qos = [&factory] {
+    factory.load_profiles();
+    factory.set_default_participant_qos(dds::PARTICIPANT_QOS_DEFAULT);
+    return factory.get_default_participant_qos();
+  }();
+  return qos;
+}
+
+// profile_name of the <participant is_default_profile="true"> in a Fast DDS
+// XML file, or empty.
+std::string default_participant_profile(const std::string& file) {
+  std::ifstream in(file);
+  std::ostringstream whole;
+  whole << in.rdbuf();
+  const std::string text = whole.str();
+  for (std::size_t at = text.find("<participant"); at != std::string::npos;
+       at = text.find("<participant", at + 1)) {
+    const std::size_t end = text.find('>', at);
+    if (end == std::string::npos) break;
+    const std::string tag = text.substr(at, end - at);
+    if (tag.find("is_default_profile=\"true\"") == std::string::npos) continue;
+    const std::size_t name = tag.find("profile_name=\"");
+    if (name == std::string::npos) continue;
+    const std::size_t first = name + 14;
+    const std::size_t last = tag.find('"', first);
+    if (last != std::string::npos) return tag.substr(first, last - first);
+  }
+  return "";
+}
+
 class FastParticipant final : public ParticipantBackend {
  public:
   FastParticipant(const TransportConfig& config, EventLog& events) : events_(events) {
@@ -328,16 +365,27 @@ class FastParticipant final : public ParticipantBackend {
     // default profile only when it resets that QoS, and loads its own default
     // file once (load_profiles). So: the vendor's file first, then this one,
     // then the reset. Without the reset a profile's transports, peers and
-    // socket buffers were silently ignored.
-    factory->load_profiles();
+    // socket buffers were silently ignored. The factory is the process's:
+    // the QoS is taken from the file's default participant profile by name
+    // (a file parsed before is not parsed again, so the factory's default
+    // may be another file's), and the factory's default goes back to the
+    // vendor's afterwards, so a later participant without a profile does
+    // not inherit this one's.
+    const dds::DomainParticipantQos& vendor_default = vendor_default_participant_qos(*factory);
+    dds::DomainParticipantQos qos = vendor_default;
     if (!profile.empty()) {
       if (factory->load_XML_profiles_file(profile) != ReturnCode_t::RETCODE_OK) {
         throw ConfigError("DDS profile '" + profile +
                           "': Fast DDS could not parse it (malformed XML profile)");
       }
-      factory->set_default_participant_qos(dds::PARTICIPANT_QOS_DEFAULT);
+      const std::string name = default_participant_profile(profile);
+      if (name.empty() ||
+          factory->get_participant_qos_from_profile(name, qos) != ReturnCode_t::RETCODE_OK) {
+        factory->set_default_participant_qos(dds::PARTICIPANT_QOS_DEFAULT);
+        qos = factory->get_default_participant_qos();
+      }
+      factory->set_default_participant_qos(vendor_default);
     }
-    dds::DomainParticipantQos qos = factory->get_default_participant_qos();
     qos.name(config.participant_name);
     // Socket buffers the size of a burst of large samples, unless a profile
     // chose them (docs/design/mixed-vendor-load.md): with the system's

@@ -78,8 +78,10 @@ const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now,
       transition_ = incoming->transition;
       renderer_.set_command(*incoming);
       std::chrono::nanoseconds published{0};
-      if (pose_times_.find(incoming->answered_pose_seq, published))
+      if (pose_times_.find(incoming->answered_pose_seq, published)) {
         latency_.record(now - published);
+        run_latency_.record(now - published);
+      }
     }
   }
 

@@ -164,6 +164,13 @@ std::string joined_args(const ServiceSpec& s, const Station& station) {
     std::snprintf(d, sizeof d, "%g", station.duration_s);
     add("--duration-s");
     add(d);
+    // A haptic service on another host: wait for it as long as a supervisor
+    // waits for a service to be ready (the gateway's host does not see it start).
+    const ServiceSpec* haptic = station.service(ServiceKind::kHaptic);
+    if (haptic != nullptr && haptic->host != s.host) {
+      add("--wait-haptic-s");
+      add(std::to_string(kRemoteHapticWaitS));
+    }
   }
   // The gateway's device: the simulated hand on the intubation script unless
   // the lab file names one (as fahr_lab up does).

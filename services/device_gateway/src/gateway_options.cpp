@@ -16,7 +16,7 @@ constexpr const char* kUsage =
     "         [--mode realtime|lockstep] [--backend simulated|replay|remote|openhaptics]\n"
     "         [--script intubation|overshoot] [--model touch_x|touch] [--duration-s S]\n"
     "         [--replay-file FILE] [--record-file FILE] [--device-id N] [--rt-priority 1-99]\n"
-    "         [--spin-us N] [--status-hz HZ] [--force-input-period N]\n";
+    "         [--spin-us N] [--status-hz HZ] [--force-input-period N] [--wait-haptic-s S]\n";
 
 bool parse_number(std::string_view flag, const char* text, double& out) {
   char* end = nullptr;
@@ -75,6 +75,9 @@ std::optional<GatewayOptions> parse_options(int argc, char** argv) {
       o.record_file = value;
     else if (flag == "--duration-s")
       ok = parse_number(flag, value, o.duration_s) && o.duration_s >= 0.0;
+    else if (flag == "--wait-haptic-s")
+      ok = parse_number(flag, value, o.wait_haptic_s) && o.wait_haptic_s >= 0.0 &&
+           o.wait_haptic_s <= 3600.0;
     else if (flag == "--status-hz")
       ok = parse_number(flag, value, o.status_hz) && o.status_hz > 0.0 && o.status_hz <= 100.0;
     else if (flag == "--device-id" || flag == "--rt-priority" || flag == "--spin-us" ||

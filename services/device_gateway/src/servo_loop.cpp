@@ -73,6 +73,7 @@ void fill_snapshot(const device::ServoCore& core, const GatewaySetup& setup, Loo
   s.passivity_active_ticks = core.passivity().active_ticks();
   s.remote_rejected = setup.remote != nullptr ? setup.remote->rejected_non_finite() : 0;
   s.motion_to_force = core.latency();
+  s.motion_to_force_run = core.run_latency();
 }
 
 void after_tick(const device::DevicePoseSample& pose, std::uint64_t written_seq, LoopState& state) {
@@ -121,19 +122,23 @@ int run_realtime(const GatewayOptions& o, GatewaySetup& setup, common::Participa
         kRemoteInputTopic);
   }
   // A scripted hand (the simulated and replayed devices) waits at its first
-  // tick (at most 5 s) until the haptic side is matched both ways: poses
+  // tick (at most --wait-haptic-s, 5 s) until the haptic side is matched
+  // both ways, which it is once the haptic service is ready: poses
   // sent before that reach nobody, and the script's first second would be
   // lost to discovery. A hand that moves by itself (a Touch X, the remote
   // input) does not wait. Without a match the loop runs anyway; the safety
   // gate keeps the force at zero.
   const bool scripted = o.backend == "simulated" || o.backend == "replay";
-  const auto match_until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  const auto match_until = std::chrono::steady_clock::now() +
+                           std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                               std::chrono::duration<double>(o.wait_haptic_s));
   while (scripted && !common::stop_requested() && std::chrono::steady_clock::now() < match_until &&
          (pose_pub.matched_readers() == 0 || command_sub.matched_writers() == 0)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (scripted && (pose_pub.matched_readers() == 0 || command_sub.matched_writers() == 0)) {
-    std::fprintf(stderr, "fahr_device_gateway: no haptic service matched within 5 s; running\n");
+    std::fprintf(stderr, "fahr_device_gateway: no haptic service matched within %g s; running\n",
+                 o.wait_haptic_s);
   }
   try_realtime(o.rt_priority);
   msg::DevicePose pose_msg;

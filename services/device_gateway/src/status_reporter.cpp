@@ -26,6 +26,11 @@ void GatewayMetrics::fill(std::vector<std::pair<std::string, double>>& metrics) 
   metrics.emplace_back("motion_to_force_p99_ms", ms(latency.percentile(0.99)));
   metrics.emplace_back("motion_to_force_p999_ms", ms(latency.percentile(0.999)));
   metrics.emplace_back("motion_to_force_max_ms", ms(latency.max()));
+  const device::LatencyHistogram& run = s.motion_to_force_run;
+  metrics.emplace_back("motion_to_force_run_count", static_cast<double>(run.count()));
+  metrics.emplace_back("motion_to_force_run_p50_ms", ms(run.percentile(0.5)));
+  metrics.emplace_back("motion_to_force_run_p99_ms", ms(run.percentile(0.99)));
+  metrics.emplace_back("motion_to_force_run_max_ms", ms(run.max()));
   metrics.emplace_back("safety_state", static_cast<double>(s.safety_state));
   metrics.emplace_back("renderable_force_n", s.renderable_force_n);
   metrics.emplace_back("peak_force_n", s.peak_force_n);
@@ -53,17 +58,19 @@ std::string GatewayMetrics::summary(std::uint64_t late_periods) {
   take_newest();
   const StatusSnapshot& s = last_;
   const device::LatencyHistogram& latency = last_latency_;
-  char line[512];
+  const device::LatencyHistogram& run = s.motion_to_force_run;
+  char line[640];
   std::snprintf(
       line, sizeof(line),
       "ticks %llu, late periods %llu, motion-to-force (last window with commands) n=%llu p50 %.3f "
-      "ms p99 %.3f ms, "
+      "ms p99 %.3f ms, whole run n=%llu p50 %.3f ms p99 %.3f ms max %.3f ms, "
       "peak force %.3f N, renderable %.3f N, commands accepted %llu, rejected nan %llu stale %llu, "
       "silences %llu, PC removed %.3f mJ",
       static_cast<unsigned long long>(s.ticks), static_cast<unsigned long long>(late_periods),
       static_cast<unsigned long long>(latency.count()), ms(latency.percentile(0.5)),
-      ms(latency.percentile(0.99)), s.peak_force_n, s.renderable_force_n,
-      static_cast<unsigned long long>(s.safety.accepted),
+      ms(latency.percentile(0.99)), static_cast<unsigned long long>(run.count()),
+      ms(run.percentile(0.5)), ms(run.percentile(0.99)), ms(run.max()), s.peak_force_n,
+      s.renderable_force_n, static_cast<unsigned long long>(s.safety.accepted),
       static_cast<unsigned long long>(s.safety.rejected_non_finite),
       static_cast<unsigned long long>(s.safety.rejected_stale),
       static_cast<unsigned long long>(s.safety.silence_events), s.passivity_dissipated_j * 1e3);

@@ -27,6 +27,7 @@
 #include <thread>
 #include <vector>
 
+#include "clock_check.h"
 #include "fahr/lab_plan/profiles.h"
 
 namespace fahr::lab {
@@ -202,6 +203,10 @@ Child make_child(const Plan& plan, const PlannedParticipant& p, const fs::path& 
       std::snprintf(duration, sizeof duration, "%g", station.duration_s);
       add({program_path("fahr_device_gateway", "services/device_gateway").string(), "--duration-s",
            duration});
+      if (const ServiceSpec* haptic = station.service(ServiceKind::kHaptic);
+          haptic != nullptr && haptic->host != s.host) {
+        add({"--wait-haptic-s", std::to_string(kRemoteHapticWaitS)});
+      }
       if (s.args.empty()) add({"--backend", "simulated", "--script", "intubation"});
       break;
     }
@@ -386,6 +391,8 @@ int station_up(const Plan& plan, const Station& station, const UpOptions& option
   sigaction(SIGTERM, &action, nullptr);
   sigaction(SIGHUP, &action, nullptr);
 
+  // The clocks of the station's hosts against this one's, in clock.txt.
+  ClockCheck clock_check(plan, station, host, run.dir / "clock.txt");
   std::printf("fahr_lab: %s station %s on host %s (%s): %zu services, logs in %s\n",
               now_text().c_str(), station.name.c_str(), host.name.c_str(), host.address.c_str(),
               children.size(), run.dir.c_str());

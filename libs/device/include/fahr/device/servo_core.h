@@ -50,6 +50,8 @@ class ServoCore {
   // answered pose was read to the tick it first shaped the force.
   LatencyHistogram& latency() { return latency_; }
   const LatencyHistogram& latency() const { return latency_; }
+  // The same over the whole run (never reset): what a trainee felt.
+  const LatencyHistogram& run_latency() const { return run_latency_; }
   // Energy the device has delivered to the hand, J (sum of F . v dt; world frame).
   double energy_to_hand_j() const { return energy_to_hand_j_; }
   // Largest rendered force magnitude so far, N.
@@ -65,6 +67,7 @@ class ServoCore {
   PassivityController passivity_;
   SafetyGate safety_;
   LatencyHistogram latency_;
+  LatencyHistogram run_latency_;
   PoseTimeRing pose_times_;
   DevicePoseSample pose_;
   std::uint64_t tick_ = 0;

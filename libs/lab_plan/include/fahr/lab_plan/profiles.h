@@ -16,6 +16,9 @@ namespace fahr::lab {
 // wmem_max): a burst of large DeformationStates must fit
 // (docs/design/mixed-vendor-load.md).
 inline constexpr int kSocketBufferBytes = 4 * 1024 * 1024;
+// How long a station's gateway waits for its haptic service on another host
+// (--wait-haptic-s), s: as long as a supervisor waits for a service's ready line.
+inline constexpr int kRemoteHapticWaitS = 120;
 
 // The Fast DDS XML profile (default participant profile) of a participant.
 std::string fast_profile(const Plan& plan, const PlannedParticipant& p);

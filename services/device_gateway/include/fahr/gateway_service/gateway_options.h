@@ -25,6 +25,11 @@ struct GatewayOptions {
   int rt_priority = 0;          // --rt-priority N (1-99): SCHED_FIFO if permitted, else a warning
   int spin_us = 0;              // --spin-us N: busy-wait the last N us of each period (opt-in)
   double status_hz = 4.0;       // --status-hz HZ, (0, 100]
+  // --wait-haptic-s S: how long a scripted hand waits at its first tick for
+  // the haptic service (a match both ways, which the haptic service offers
+  // only once it is ready). fahr_lab raises it when that service runs on
+  // another host, whose start the gateway's host does not see.
+  double wait_haptic_s = 5.0;
   std::uint64_t force_input_period = 1;  // --force-input-period N: lockstep period of
                                          // ForceCommand's producer in base steps; 0: none
 };

@@ -32,6 +32,7 @@ struct StatusSnapshot {
   std::uint64_t passivity_active_ticks = 0;
   std::uint64_t remote_rejected = 0;
   device::LatencyHistogram motion_to_force;
+  device::LatencyHistogram motion_to_force_run;  // since the gateway started
 };
 
 class GatewayMetrics {
