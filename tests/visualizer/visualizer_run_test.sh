@@ -89,6 +89,12 @@ case "$mode" in
   browser)
     start_visualizer --dds cyclonedds --domain 42
     start_run 30 intubation
+    # The watch begins with the gateway's script: run_local.sh starts the
+    # gateway once the FEM and haptic services are set up (6 s on a calm
+    # machine, 15 s on a loaded one), and the blade reaches the tongue about
+    # 3 s into the script.
+    for _ in $(seq 1200); do [ -s "$out/logs/gateway.log" ] && break; sleep 0.1; done
+    [ -s "$out/logs/gateway.log" ] || { echo "visualizer_run_test: the run's gateway never started" >&2; cat "$out/run.log" >&2; exit 1; }
     node "$js/browser_check.mjs" "$url" "$out" 14 live | tee "$out/browser.json"
     stop_visualizer
     ;;
