@@ -223,3 +223,50 @@ TEST(LayoutRefusal, TheErrorIsOneSentenceNamingBothInHex) {
 
 }  // namespace
 }  // namespace fahr::fem_service
+
+namespace fahr::fem_service {
+namespace {
+
+// After a divergence reset the tongue is at rest; a ContactSet computed on a
+// state before the reset describes the diverged tongue, and its blade, deep
+// in the rested one, would shove nodes far in one step. Such a set is
+// ignored and counted stale; one computed on the rested tongue is applied.
+TEST(ResetRefusal, ASetComputedBeforeADivergenceResetIsNotApplied) {
+  StillTongue tongue;
+  FemBodySetup& setup = tongue.setup;
+  ServiceStep step(setup);
+  const std::uint32_t sphere = top_sphere(setup);
+  const std::uint64_t ours = setup.layout_fingerprint;
+  // A constraint 10 m deep: the projection moves the sphere's nodes farther
+  // than twice the body's size, so the step resets the body.
+  msg::ContactSet flinging = pressing_set(setup, sphere, ours);
+  flinging.contacts()[0].point_m().y(flinging.contacts()[0].point_m().y() - 10.0);
+  flinging.contacts()[0].penetration_m(10.0);
+  const std::uint64_t before_reset = setup.body->step_index();
+  step.take(flinging, 1);
+  step.step();
+  ASSERT_TRUE(step.last_report().diverged_reset);
+  EXPECT_EQ(step.divergence_resets(), 1u);
+  EXPECT_LT(largest_motion_m(setup), 1e-9);
+
+  // A set computed on the last state before the reset (within the age limit).
+  msg::ContactSet stale = pressing_set(setup, sphere, ours);
+  stale.fem_step(before_reset);
+  const std::uint64_t stale_before = step.stale_sets();
+  step.take(stale, 2);
+  step.step();
+  EXPECT_FALSE(step.last_report().contacts_applied);
+  EXPECT_EQ(step.state().applied_contact_seq(), 0u);
+  EXPECT_EQ(step.stale_sets(), stale_before + 1);
+  EXPECT_LT(largest_motion_m(setup), 1e-9) << "a set from before the reset moved the body";
+
+  // A set computed on the rested tongue is applied.
+  step.take(pressing_set(setup, sphere, ours), 3);
+  step.step();
+  EXPECT_TRUE(step.last_report().contacts_applied);
+  EXPECT_EQ(step.state().applied_contact_seq(), 3u);
+  EXPECT_GT(largest_motion_m(setup), 0.5e-3);
+}
+
+}  // namespace
+}  // namespace fahr::fem_service

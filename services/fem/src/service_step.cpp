@@ -79,9 +79,12 @@ void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
 }
 
 void ServiceStep::step() {
-  // A set older than the body allows is ignored and counted (stale).
+  // A set older than the body allows, or computed on the tongue before a
+  // reset, is ignored and counted (stale): applied to the rested tongue, a
+  // blade placed for the diverged one pushed its nodes tens of millimetres
+  // in one step, and the next step flung them.
   const bool usable =
-      have_contacts_ &&
+      have_contacts_ && contacts_.state_step >= reset_step_ &&
       setup_.body->step_index() <= contacts_.state_step + setup_.settings.max_contact_age_steps;
   if (have_contacts_ && !usable) ++stale_sets_;
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
@@ -89,10 +92,17 @@ void ServiceStep::step() {
       inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
   if (last_report_.diverged_reset) {
     ++divergence_resets_;
+    reset_step_ = setup_.body->step_index();
     resets_.fetch_add(1, std::memory_order_relaxed);
   }
   if (last_report_.solve_failed) failed_solves_.fetch_add(1, std::memory_order_relaxed);
   if (last_report_.refactorised) ++refactorisations_;
+  if (setup_.body->settings().solver.kind == fem::LinearSolver::kCholmod &&
+      last_report_.solver_iterations > 0) {
+    ++current_a_steps_;
+    current_a_iterations_ += static_cast<std::uint64_t>(last_report_.solver_iterations);
+  }
+  if (last_report_.factorised_at_once) ++factorised_at_once_;
   anatomy_returned_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_returned);
   anatomy_beyond_steps_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_beyond);
   anatomy_depth_max_m_ = std::max(anatomy_depth_max_m_, last_report_.projection.obstacle_deepest_m);
