@@ -144,13 +144,8 @@ int main(int argc, char** argv) try {
     std::printf("rows without tissue compliance: %llu\n", total(hm.rows_without_compliance));
     std::printf("rows dropped: %llu\n", total(hm.rows_dropped));
     std::printf(
-        "stack_sim: FEM refactorisations %llu (of them at once %llu), steps on the current A "
-        "while a refresh was under way %llu (CG iterations %llu), compliance blocks solved "
-        "%llu, reused %llu\n",
+        "stack_sim: FEM refactorisations %llu, compliance blocks solved %llu, reused %llu\n",
         static_cast<unsigned long long>(sim.fem().refactorisations()),
-        static_cast<unsigned long long>(sim.fem().factorised_at_once()),
-        static_cast<unsigned long long>(sim.fem().current_a_steps()),
-        static_cast<unsigned long long>(sim.fem().current_a_iterations()),
         static_cast<unsigned long long>(sim.fem().contact_step().compliance_solves()),
         static_cast<unsigned long long>(sim.fem().contact_step().compliance_reuses()));
     std::printf("FEM step CPU ms median %.2f p99 %.2f max %.2f\n",

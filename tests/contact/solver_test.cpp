@@ -8,6 +8,7 @@
 
 #include "fahr/contact/contact_solver.h"
 #include "fahr/contact/coupling.h"
+#include "fahr/contact/dense_cholesky.h"
 #include "fahr/contact/pgs.h"
 #include "synthetic.h"
 
@@ -218,6 +219,62 @@ TEST(Coupling, IsClampedToTheDevice) {
                                                  Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   EXPECT_EQ(c.stiffness_npm, 1480.0);
   EXPECT_EQ(c.damping_nspm, settings.max_damping_nspm);
+}
+
+}  // namespace
+}  // namespace fahr::contact
+
+namespace fahr::contact {
+namespace {
+
+// The local stiffness's factorisation on a full set of 64 rows that span
+// three directions only (neighbouring spheres under one blade face), with
+// float-rounding-sized indefiniteness: the dependent rows are dropped, and
+// a right-hand side in the matrix's range is solved to rounding. With the
+// pivot floored at 1e-12 instead, the multipliers of the rows after a
+// floored one grew past the double range (the haptic service sent NaN
+// stiffness about once a second while pressing).
+TEST(DenseCholesky, DependentAndSlightlyIndefiniteRowsGiveAFiniteSolution) {
+  constexpr std::size_t n = 64;
+  std::vector<Eigen::Vector3d> normals(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = 0.01 * static_cast<double>(i);
+    normals[i] = Eigen::Vector3d(std::sin(t), 1.0, 0.3 * std::cos(3.0 * t)).normalized();
+  }
+  for (const double rounding : {0.0, 1e-9}) {
+    // N N^T / k_c (rank 3), and W's float rounding: a symmetric part that
+    // is not positive semidefinite.
+    std::vector<double> s(n * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = 0; j < n; ++j) {
+        s[i * n + j] = normals[i].dot(normals[j]) * 1e-3 +
+                       rounding * std::cos(static_cast<double>(7 * i + 7 * j + i * j));
+      }
+    }
+    std::vector<double> factor = s;
+    EXPECT_GT(cholesky_in_place(factor.data(), n, n, 1e-12), 0);
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      std::vector<double> x(n);
+      for (std::size_t i = 0; i < n; ++i) x[i] = normals[i][c];
+      const std::vector<double> b = x;
+      cholesky_solve(factor.data(), n, n, x.data());
+      Eigen::Vector3d k_column = Eigen::Vector3d::Zero();
+      double residual = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_TRUE(std::isfinite(x[i])) << "rounding " << rounding << " row " << i;
+        k_column += normals[i] * x[i];
+        double sx = 0.0;
+        for (std::size_t j = 0; j < n; ++j) sx += s[i * n + j] * x[j];
+        residual = std::max(residual, std::abs(sx - b[i]));
+      }
+      ASSERT_TRUE(k_column.allFinite()) << "rounding " << rounding;
+      // Without rounding the system is consistent and solved exactly on
+      // its independent rows.
+      if (rounding == 0.0) {
+        EXPECT_LT(residual, 1e-9) << "column " << c;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -6,35 +6,55 @@
 namespace fahr::contact {
 
 int cholesky_in_place(double* a, std::size_t stride, std::size_t n, double min_pivot) {
-  int replaced = 0;
+  int dropped = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = 0; j <= i; ++j) {
-      double sum = a[i * stride + j];
-      for (std::size_t m = 0; m < j; ++m) sum -= a[i * stride + m] * a[j * stride + m];
-      if (i == j) {
-        if (!(sum > min_pivot)) {
-          sum = min_pivot;
-          ++replaced;
-        }
-        a[i * stride + i] = std::sqrt(sum);
-      } else {
-        a[i * stride + j] = sum / a[j * stride + j];
+    double* row = a + i * stride;
+    for (std::size_t j = 0; j < i; ++j) {
+      const double pivot = a[j * stride + j];
+      if (pivot == 0.0) {
+        row[j] = 0.0;  // row j was dropped: it takes no part
+        continue;
       }
+      double sum = row[j];
+      for (std::size_t m = 0; m < j; ++m) sum -= row[m] * a[j * stride + m];
+      row[j] = sum / pivot;
     }
+    double sum = row[i];
+    for (std::size_t m = 0; m < i; ++m) sum -= row[m] * row[m];
+    if (sum > min_pivot) {
+      row[i] = std::sqrt(sum);
+      continue;
+    }
+    // Row i depends on the rows before it (or, with rounding, makes the
+    // matrix slightly indefinite there): it is dropped, not propped up. A
+    // floored pivot turned the next rows' multipliers into sum / 1e-6 and
+    // grew them past the double range within a 64-row set (NaN stiffness).
+    for (std::size_t m = 0; m <= i; ++m) row[m] = 0.0;
+    ++dropped;
   }
-  return replaced;
+  return dropped;
 }
 
 void cholesky_solve(const double* factor, std::size_t stride, std::size_t n, double* rhs) {
   for (std::size_t i = 0; i < n; ++i) {  // L y = rhs
+    const double pivot = factor[i * stride + i];
+    if (pivot == 0.0) {
+      rhs[i] = 0.0;
+      continue;
+    }
     double sum = rhs[i];
     for (std::size_t m = 0; m < i; ++m) sum -= factor[i * stride + m] * rhs[m];
-    rhs[i] = sum / factor[i * stride + i];
+    rhs[i] = sum / pivot;
   }
   for (std::size_t i = n; i-- > 0;) {  // L^T x = y
+    const double pivot = factor[i * stride + i];
+    if (pivot == 0.0) {
+      rhs[i] = 0.0;
+      continue;
+    }
     double sum = rhs[i];
     for (std::size_t m = i + 1; m < n; ++m) sum -= factor[m * stride + i] * rhs[m];
-    rhs[i] = sum / factor[i * stride + i];
+    rhs[i] = sum / pivot;
   }
 }
 

@@ -479,9 +479,9 @@ void Body::prepare_system(StepReport& report) {
   // One background factorisation at a time: a trigger while one is under
   // way waits for it (the triggers then compare against its state).
   const bool begin = factor_due && factor_needed && !factor_pending_;
-  // CG multiplies with the current A; the direct solve needs A when it
-  // refactorises and while a refresh is under way (solve_velocity).
-  if (cg || begin || factor_pending_) assemble_system();
+  // CG multiplies with the current A; the direct solve only needs A when it
+  // refactorises.
+  if (cg || begin) assemble_system();
   if (begin && background_factor()) {
     mark_factor_state();
     factor_pending_ = cholmod_.begin_factorize();
@@ -492,17 +492,6 @@ void Body::prepare_system(StepReport& report) {
     ++steps_since_factor_;
   }
 }
-
-namespace {
-
-// The step's velocity while a refresh is under way (Body::solve_velocity):
-// |b - A v| <= 1 % of |b|, far below what the lagged factor misses where it
-// diverges; 10 preconditioned iterations cost about one factorisation of the
-// tongue, so a factor that needs more is replaced at once.
-constexpr double kVerifyTolerance = 1e-2;
-constexpr int kVerifyIterations = 10;
-
-}  // namespace
 
 void Body::solve_velocity(StepReport& report) {
   for (Eigen::Index k = 0; k < rhs_.size(); ++k) {
@@ -523,32 +512,9 @@ void Body::solve_velocity(StepReport& report) {
     refresh_due_ = solver.preconditioner == CgPreconditioner::kLaggedCholesky &&
                    solver.cg_refresh_iterations > 0 &&
                    (result.iterations > solver.cg_refresh_iterations || !result.converged);
-    return;
+  } else {
+    warp_.solve(cholmod_, rhs_.data(), v_next_.data());
   }
-  warp_.solve(cholmod_, rhs_.data(), v_next_.data());
-  if (!factor_pending_) return;
-  // A refresh is under way: by the triggers' own measure some element's
-  // tangent has left the factor in use. A factor softer than the tissue
-  // lets the step overshoot, and a tongue squeezed between blade and bone
-  // stiffens faster than a factorisation beside the step can follow: in
-  // real time such a step diverged within three steps (docs/design/
-  // fem-step-and-solvers.md). Until the new factor is installed the step
-  // solves the current A: CG from the lagged answer, preconditioned by the
-  // lagged factor, to kVerifyTolerance; where that factor is too far from A
-  // to get there in kVerifyIterations, A is factorised now (the exact step,
-  // at one factorisation's cost) and the refresh under way is dropped.
-  const CgResult result = cg_.solve(
-      assembly_.matrix(), assembly_.diagonal_index(), {rhs_.data(), dofs}, {v_next_.data(), dofs},
-      kVerifyTolerance, kVerifyIterations, CgPreconditioner::kLaggedCholesky, &cholmod_, &warp_);
-  report.solver_iterations = result.iterations;
-  report.solver_relative_residual = result.relative_residual;
-  if (result.converged) return;
-  cancel_background_factor();
-  if (!refactorise()) return;  // A not positive definite: the CG answer stands
-  report.refactorised = true;
-  report.factorised_at_once = true;
-  report.solver_relative_residual = 0.0;
-  warp_.solve(cholmod_, rhs_.data(), v_next_.data());
 }
 
 void Body::integrate_and_project(const ContactSet* contacts, const SphereLinks* links,

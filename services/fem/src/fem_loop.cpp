@@ -144,18 +144,12 @@ void print_start_line(const common::Participant& participant, const FemBodySetup
 void print_end_line(const ServiceStep& fem_step) {
   std::printf(
       "fahr_fem_service: %llu steps, stale contact sets %llu, refused (another sphere layout) "
-      "%llu, max inverted elements %llu, resets after divergence %llu; refactorisations %llu, "
-      "steps on the current A while a refresh was under way %llu (CG iterations %llu), A "
-      "factorised at once %llu\n",
+      "%llu, max inverted elements %llu, resets after divergence %llu\n",
       static_cast<unsigned long long>(fem_step.setup().body->step_index()),
       static_cast<unsigned long long>(fem_step.stale_sets()),
       static_cast<unsigned long long>(fem_step.layout_check().refused()),
       static_cast<unsigned long long>(fem_step.inverted_max()),
-      static_cast<unsigned long long>(fem_step.divergence_resets()),
-      static_cast<unsigned long long>(fem_step.refactorisations()),
-      static_cast<unsigned long long>(fem_step.current_a_steps()),
-      static_cast<unsigned long long>(fem_step.current_a_iterations()),
-      static_cast<unsigned long long>(fem_step.factorised_at_once()));
+      static_cast<unsigned long long>(fem_step.divergence_resets()));
 }
 
 }  // namespace fahr::fem_service

@@ -97,12 +97,6 @@ void ServiceStep::step() {
   }
   if (last_report_.solve_failed) failed_solves_.fetch_add(1, std::memory_order_relaxed);
   if (last_report_.refactorised) ++refactorisations_;
-  if (setup_.body->settings().solver.kind == fem::LinearSolver::kCholmod &&
-      last_report_.solver_iterations > 0) {
-    ++current_a_steps_;
-    current_a_iterations_ += static_cast<std::uint64_t>(last_report_.solver_iterations);
-  }
-  if (last_report_.factorised_at_once) ++factorised_at_once_;
   anatomy_returned_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_returned);
   anatomy_beyond_steps_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_beyond);
   anatomy_depth_max_m_ = std::max(anatomy_depth_max_m_, last_report_.projection.obstacle_deepest_m);

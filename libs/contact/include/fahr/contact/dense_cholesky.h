@@ -8,13 +8,16 @@
 namespace fahr::contact {
 
 // Factorises the leading n x n block of `a` (row stride `stride`) into its
-// lower triangle L with A = L L^T. A pivot below `min_pivot` (the matrix is
-// singular along some direction: redundant rigid rows) is replaced by it, so
-// that direction gets a huge but finite stiffness instead of a NaN. Returns
-// the number of pivots replaced.
+// lower triangle L with A = L L^T, for a symmetric positive semidefinite A.
+// A row whose pivot is not above `min_pivot` depends on the rows before it
+// (redundant rows: neighbouring spheres under one blade face) and is
+// dropped: its row and column of L are zero, and the solve below gives it
+// x = 0, so a consistent system is solved on the independent rows. Returns
+// the number of rows dropped.
 int cholesky_in_place(double* a, std::size_t stride, std::size_t n, double min_pivot);
 
-// Solves L L^T x = rhs in place of `rhs` with the factor from above.
+// Solves L L^T x = rhs in place of `rhs` with the factor from above (x = 0
+// on dropped rows).
 void cholesky_solve(const double* factor, std::size_t stride, std::size_t n, double* rhs);
 
 }  // namespace fahr::contact

@@ -68,13 +68,7 @@ struct StepReport {
   bool asleep = false;        // no solve was done
   bool refactorised = false;  // a numeric factorisation happened this step
   bool solve_failed = false;  // non-finite or failed solve: state kept, v = 0
-  // CG iterations: every step of kConjugateGradient; with kCholmod, those
-  // of a step solved on the current A while a refresh was under way (0
-  // otherwise; Body::solve_velocity).
-  int solver_iterations = 0;
-  // kCholmod: that CG did not reach its tolerance in its budget, so A was
-  // factorised inside the step and the refresh under way dropped.
-  bool factorised_at_once = false;
+  int solver_iterations = 0;  // CG iterations (0 for a direct solve)
   double solver_relative_residual = 0.0;
   int inverted_elements = 0;  // det F <= 0 at the start of the step
   bool contacts_applied = false;

@@ -59,12 +59,6 @@ class ServiceStep {
   std::uint64_t divergence_resets() const { return divergence_resets_; }
   // Steps that refactorised the system matrix (fem::StepReport::refactorised).
   std::uint64_t refactorisations() const { return refactorisations_; }
-  // Direct solve: steps solved on the current A while a refresh was under
-  // way, their CG iterations in all, and those that factorised A at once
-  // (fem::StepReport::solver_iterations, factorised_at_once).
-  std::uint64_t current_a_steps() const { return current_a_steps_; }
-  std::uint64_t current_a_iterations() const { return current_a_iterations_; }
-  std::uint64_t factorised_at_once() const { return factorised_at_once_; }
   // Nodes let back through a bone on their way home, and node-steps a node
   // spent beyond a bone, left alone by it (fem obstacle_projection.h).
   std::uint64_t anatomy_returned() const { return anatomy_returned_; }
@@ -111,9 +105,6 @@ class ServiceStep {
   fem::StepReport last_report_;
   std::uint64_t inverted_max_ = 0;
   std::uint64_t divergence_resets_ = 0;
-  std::uint64_t current_a_steps_ = 0;
-  std::uint64_t current_a_iterations_ = 0;
-  std::uint64_t factorised_at_once_ = 0;
   // The body's step at its last reset: a ContactSet computed on an earlier
   // state describes a tongue that no longer exists.
   std::uint64_t reset_step_ = 0;
