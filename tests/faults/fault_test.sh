@@ -11,8 +11,9 @@
 #
 #   fault_test.sh BUILD_DIR VENDOR [SERVICE:SIGNAL ...]
 #
-# SERVICE: fem, haptic, gateway, logger; SIGNAL: KILL or STOP. Default: all
-# eight. Runs inside a loopback-only network namespace (tests/run_in_netns.sh)
+# SERVICE: fem, haptic, gateway, logger; SIGNAL: KILL or STOP; none:NONE is
+# the control, the same script with no fault (what the station does in that
+# window anyway). Default: the control and all eight. Runs inside a loopback-only network namespace (tests/run_in_netns.sh)
 # or with FAHR_FAULTS_NO_NETNS=1 on a machine where that is fine.
 # FAHR_KEEP_FAULTS=DIR keeps logs, probe files and the table there.
 set -euo pipefail
@@ -21,8 +22,8 @@ build=$(cd "${1:?usage: fault_test.sh BUILD_DIR VENDOR [SERVICE:SIGNAL ...]}" &&
 vendor=${2:?usage: fault_test.sh BUILD_DIR VENDOR [SERVICE:SIGNAL ...]}
 shift 2
 cases=("$@")
-[ ${#cases[@]} -gt 0 ] || cases=(fem:KILL fem:STOP haptic:KILL haptic:STOP gateway:KILL gateway:STOP
-  logger:KILL logger:STOP)
+[ ${#cases[@]} -gt 0 ] || cases=(none:NONE fem:KILL fem:STOP haptic:KILL haptic:STOP gateway:KILL
+  gateway:STOP logger:KILL logger:STOP)
 
 domain=${FAHR_FAULTS_DOMAIN:-61}
 scene="$repo/deployment/scenes/neonatal_intubation.yaml"
@@ -109,8 +110,10 @@ for c in "${cases[@]}"; do
   n=$((n + 1))
   service=${c%%:*}
   signal=${c##*:}
-  case "$service" in fem|haptic|gateway|logger) ;; *) echo "fault_test: unknown service '$service'" >&2; exit 2 ;; esac
-  case "$signal" in KILL|STOP) ;; *) echo "fault_test: signal must be KILL or STOP, not '$signal'" >&2; exit 2 ;; esac
+  case "$service:$signal" in
+    fem:KILL|fem:STOP|haptic:KILL|haptic:STOP|gateway:KILL|gateway:STOP|logger:KILL|logger:STOP|none:NONE) ;;
+    *) echo "fault_test: unknown case '$c' (SERVICE:KILL|STOP, or none:NONE)" >&2; exit 2 ;;
+  esac
   nice -n "$nice_level" "$probe_exe" "${flags[@]}" --duration-s 600 --out "$out/probe-$n.txt" >"$out/probe-$n.log" 2>&1 &
   probe_pid=$!; pids+=("$probe_pid")
   sleep 1  # the probe's readers match before the first DevicePose
@@ -119,12 +122,14 @@ for c in "${cases[@]}"; do
   wait_count "$out/gateway.log" "$gateway_ready" $((gateways_before + 1)) 30
   start_ns=$(now_ns)
   sleep "$fault_at_s"
-  pid_var="${service}_pid"
-  victim=${!pid_var}
   fault_ns=$(now_ns)
-  kill -s "$signal" "$victim"
   back_ns=0
-  if [ "$signal" = KILL ]; then
+  if [ "$signal" = NONE ]; then
+    back_ns=$fault_ns  # the control: the same script, no fault
+  elif [ "$signal" = KILL ]; then
+    pid_var="${service}_pid"
+    victim=${!pid_var}
+    kill -s KILL "$victim"
     wait "$victim" 2>/dev/null || true
     sleep "$restart_after_s"
     ready_var="${service}_ready"
@@ -135,6 +140,9 @@ for c in "${cases[@]}"; do
     # The restarted service must be back within the test's bound.
     wait_count "$log" "${!ready_var}" $((before + 1)) 180
   else
+    pid_var="${service}_pid"
+    victim=${!pid_var}
+    kill -s STOP "$victim"
     sleep "$stop_for_s"
     back_ns=$(now_ns)
     kill -CONT "$victim"
