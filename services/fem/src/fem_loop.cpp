@@ -150,6 +150,14 @@ void print_end_line(const ServiceStep& fem_step) {
       static_cast<unsigned long long>(fem_step.layout_check().refused()),
       static_cast<unsigned long long>(fem_step.inverted_max()),
       static_cast<unsigned long long>(fem_step.divergence_resets()));
+  const ServiceStep::SlowestStep& slow = fem_step.slowest_step();
+  std::printf(
+      "fahr_fem_service: slowest step %.1f ms (step %llu): refactorised %s, W block solved %s, "
+      "tool contacts %zu, projection sweeps %d, anatomy rounds %d, nodes moved out of the "
+      "anatomy %d, inverted tets %d\n",
+      1e-6 * static_cast<double>(slow.wall_ns), static_cast<unsigned long long>(slow.step),
+      slow.refactorised ? "yes" : "no", slow.compliance_solved ? "yes" : "no", slow.tool_contacts,
+      slow.projection_sweeps, slow.anatomy_rounds, slow.anatomy_nodes, slow.inverted_elements);
 }
 
 }  // namespace fahr::fem_service

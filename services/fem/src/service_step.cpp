@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "fahr/common/clock.h"
 #include "fahr/fem_service/contact_conversion.h"
 
 namespace fahr::fem_service {
@@ -87,7 +88,21 @@ void ServiceStep::step() {
       have_contacts_ && contacts_.state_step >= reset_step_ &&
       setup_.body->step_index() <= contacts_.state_step + setup_.settings.max_contact_age_steps;
   if (have_contacts_ && !usable) ++stale_sets_;
+  const std::int64_t start_ns = common::monotonic_now_ns();
+  const std::uint64_t solves_before = contact_step_.compliance_solves();
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
+  const std::int64_t wall_ns = common::monotonic_now_ns() - start_ns;
+  if (wall_ns > slowest_.wall_ns) {
+    slowest_ = {.wall_ns = wall_ns,
+                .step = setup_.body->step_index(),
+                .refactorised = last_report_.refactorised,
+                .compliance_solved = contact_step_.compliance_solves() != solves_before,
+                .tool_contacts = usable ? contacts_.contacts.size() : 0,
+                .projection_sweeps = last_report_.projection.sweeps,
+                .anatomy_rounds = last_report_.projection.obstacle_rounds,
+                .anatomy_nodes = last_report_.projection.obstacle_nodes,
+                .inverted_elements = last_report_.inverted_elements};
+  }
   inverted_max_ = std::max<std::uint64_t>(
       inverted_max_, static_cast<std::uint64_t>(last_report_.inverted_elements));
   if (last_report_.diverged_reset) {

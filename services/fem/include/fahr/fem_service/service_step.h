@@ -59,6 +59,20 @@ class ServiceStep {
   std::uint64_t divergence_resets() const { return divergence_resets_; }
   // Steps that refactorised the system matrix (fem::StepReport::refactorised).
   std::uint64_t refactorisations() const { return refactorisations_; }
+  // The run's slowest step (wall time of ServiceStep::step) and what it
+  // did: where a step past the haptic side's 50 ms loss timeout went.
+  struct SlowestStep {
+    std::int64_t wall_ns = 0;
+    std::uint64_t step = 0;
+    bool refactorised = false;
+    bool compliance_solved = false;  // W's block solved (not reused)
+    std::size_t tool_contacts = 0;   // contacts of the set applied (0: none)
+    int projection_sweeps = 0;
+    int anatomy_rounds = 0;
+    int anatomy_nodes = 0;
+    int inverted_elements = 0;
+  };
+  const SlowestStep& slowest_step() const { return slowest_; }
   // Nodes let back through a bone on their way home, and node-steps a node
   // spent beyond a bone, left alone by it (fem obstacle_projection.h).
   std::uint64_t anatomy_returned() const { return anatomy_returned_; }
@@ -105,6 +119,7 @@ class ServiceStep {
   fem::StepReport last_report_;
   std::uint64_t inverted_max_ = 0;
   std::uint64_t divergence_resets_ = 0;
+  SlowestStep slowest_;
   // The body's step at its last reset: a ContactSet computed on an earlier
   // state describes a tongue that no longer exists.
   std::uint64_t reset_step_ = 0;
