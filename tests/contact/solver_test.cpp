@@ -221,11 +221,6 @@ TEST(Coupling, IsClampedToTheDevice) {
   EXPECT_EQ(c.damping_nspm, settings.max_damping_nspm);
 }
 
-}  // namespace
-}  // namespace fahr::contact
-
-namespace fahr::contact {
-namespace {
 
 // The local stiffness's factorisation on a full set of 64 rows that span
 // three directions only (neighbouring spheres under one blade face), with

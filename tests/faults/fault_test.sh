@@ -13,7 +13,8 @@
 #
 # SERVICE: fem, haptic, gateway, logger; SIGNAL: KILL or STOP; none:NONE is
 # the control, the same script with no fault (what the station does in that
-# window anyway). Default: the control and all eight. Runs inside a loopback-only network namespace (tests/run_in_netns.sh)
+# window anyway). Default: the control and all eight. Runs inside a
+# loopback-only network namespace (tests/run_in_netns.sh)
 # or with FAHR_FAULTS_NO_NETNS=1 on a machine where that is fine.
 # FAHR_KEEP_FAULTS=DIR keeps logs, probe files and the table there.
 set -euo pipefail
@@ -123,13 +124,13 @@ for c in "${cases[@]}"; do
   start_ns=$(now_ns)
   sleep "$fault_at_s"
   fault_ns=$(now_ns)
-  back_ns=0
-  if [ "$signal" = NONE ]; then
-    back_ns=$fault_ns  # the control: the same script, no fault
-  elif [ "$signal" = KILL ]; then
+  back_ns=$fault_ns  # the control (NONE): the same script, no fault
+  if [ "$signal" != NONE ]; then
     pid_var="${service}_pid"
     victim=${!pid_var}
-    kill -s KILL "$victim"
+    kill -s "$signal" "$victim"
+  fi
+  if [ "$signal" = KILL ]; then
     wait "$victim" 2>/dev/null || true
     sleep "$restart_after_s"
     ready_var="${service}_ready"
@@ -139,10 +140,7 @@ for c in "${cases[@]}"; do
     "start_$service"
     # The restarted service must be back within the test's bound.
     wait_count "$log" "${!ready_var}" $((before + 1)) 180
-  else
-    pid_var="${service}_pid"
-    victim=${!pid_var}
-    kill -s STOP "$victim"
+  elif [ "$signal" = STOP ]; then
     sleep "$stop_for_s"
     back_ns=$(now_ns)
     kill -CONT "$victim"
