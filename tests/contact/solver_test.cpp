@@ -221,7 +221,6 @@ TEST(Coupling, IsClampedToTheDevice) {
   EXPECT_EQ(c.damping_nspm, settings.max_damping_nspm);
 }
 
-
 // The local stiffness's factorisation on a full set of 64 rows that span
 // three directions only (neighbouring spheres under one blade face), with
 // float-rounding-sized indefiniteness: the dependent rows are dropped, and
