@@ -41,6 +41,39 @@ TEST(SceneErrors, UnknownNestedKeyNamesTheKeyPath) {
                             "youngs_modulus_pa, poisson_ratio, density_kg_per_m3"});
 }
 
+TEST(SceneErrors, GlotticViewNeedsItsKeysAUnitNormalAndATool) {
+  const std::string section =
+      "glottic_view:\n"
+      "  opening_centre_m: [-0.06, -0.03, 0]\n"
+      "  opening_normal: [0, 0.9, 0]\n"
+      "  eye_in_tool_m: [0.3, 0.05, 0]\n";
+  expect_contains(
+      error_of(std::string(kMinimalScene) + section),
+      {"glottic_view.opening_radius_m: missing required key 'opening_radius_m'",
+       "test.yaml:24:19: glottic_view.opening_normal: the normal must have unit length"});
+  expect_contains(error_of(std::string(kMinimalScene) + section + "  opening_radius_m: 0.004\n" +
+                           "  rate_hz: 0\n"),
+                  {"glottic_view.rate_hz: value 0 is out of range; valid: (0, 100]"});
+  const std::string no_tool =
+      replaced("  - name: blade\n    role: tool\n    mesh: blade.obj\n    unit: mm\n", "") +
+      "glottic_view:\n  opening_centre_m: [-0.06, -0.03, 0]\n  opening_normal: [0, 1, 0]\n"
+      "  opening_radius_m: 0.004\n  eye_in_tool_m: [0.3, 0.05, 0]\n";
+  const std::string message = error_of(no_tool);
+  expect_contains(message, {"glottic_view: the eye rides on the tool: the scene has no tool"});
+}
+
+TEST(SceneErrors, GlotticViewLoads) {
+  const auto scene = parse(std::string(kMinimalScene) +
+                           "glottic_view:\n  opening_centre_m: [-0.06, -0.03, 0]\n"
+                           "  opening_normal: [0, 1, 0]\n  opening_radius_m: 0.004\n"
+                           "  eye_in_tool_m: [0.3, 0.05, 0]\n");
+  ASSERT_TRUE(scene->glottic_view.has_value());
+  EXPECT_DOUBLE_EQ(scene->glottic_view->opening_radius_m, 0.004);
+  EXPECT_DOUBLE_EQ(scene->glottic_view->eye_in_tool_m.y(), 0.05);
+  EXPECT_DOUBLE_EQ(scene->glottic_view->rate_hz, 10.0);
+  EXPECT_FALSE(parse(kMinimalScene)->glottic_view.has_value());
+}
+
 TEST(SceneErrors, UnrelatedUnknownKeyGetsNoSuggestion) {
   const std::string message = error_of(replaced("  backend: simulated", "  colour: blue"));
   expect_contains(message, {"device.colour: unknown key 'colour'. Valid keys here: backend"});

@@ -1,11 +1,14 @@
 // TriangleBvh: median-split AABB tree and its allocation-free closest-point walk.
 #include "fahr/geometry/triangle_bvh.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <string>
 
 namespace fahr::geometry {
 namespace {
@@ -17,15 +20,69 @@ double box_distance_squared(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
   return (below + above).squaredNorm();
 }
 
+// The segment a + t (b - a), t in [0, 1], against a box (slab test).
+bool segment_meets_box(const Eigen::Vector3d& a, const Eigen::Vector3d& inverse_d,
+                       const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  double t0 = 0.0;
+  double t1 = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    // inverse_d is +-inf on an axis the segment does not move along: the
+    // products are then +-inf (outside the slab) or NaN (on its face), and
+    // NaN comparisons leave t0 and t1 as they are.
+    double near = (lo[k] - a[k]) * inverse_d[k];
+    double far = (hi[k] - a[k]) * inverse_d[k];
+    if (near > far) std::swap(near, far);
+    if (near > t0) t0 = near;
+    if (far < t1) t1 = far;
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// Moller-Trumbore: the segment a + t d crosses the triangle at t in
+// (kEnd, 1 - kEnd). Triangles seen edge-on (|det| tiny against the sizes
+// involved) do not block.
+constexpr double kSegmentEnd = 1e-9;
+
+bool segment_crosses_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d,
+                              const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                              const Eigen::Vector3d& p2) {
+  const Eigen::Vector3d e1 = p1 - p0;
+  const Eigen::Vector3d e2 = p2 - p0;
+  const Eigen::Vector3d h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) <= 1e-14 * e1.norm() * e2.norm() * d.norm()) return false;
+  const double inv = 1.0 / det;
+  const Eigen::Vector3d s = a - p0;
+  const double u = inv * s.dot(h);
+  if (u < 0.0 || u > 1.0) return false;
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = inv * d.dot(q);
+  if (v < 0.0 || u + v > 1.0) return false;
+  const double t = inv * e2.dot(q);
+  return t > kSegmentEnd && t < 1.0 - kSegmentEnd;
+}
+
 }  // namespace
 
-TriangleBvh::TriangleBvh(const SurfaceMesh& mesh) {
-  const std::size_t count = mesh.triangle_count();
+TriangleBvh::TriangleBvh(const SurfaceMesh& mesh)
+    : TriangleBvh(std::span<const Eigen::Vector3d>(mesh.vertices()),
+                  std::span<const Triangle>(mesh.triangles())) {}
+
+TriangleBvh::TriangleBvh(std::span<const Eigen::Vector3d> vertices,
+                         std::span<const Triangle> triangles) {
+  const std::size_t count = triangles.size();
   if (count == 0) {
     return;
   }
-  const auto& vertices = mesh.vertices();
-  const auto& triangles = mesh.triangles();
+  for (const Triangle& t : triangles) {
+    for (const Index i : t) {
+      if (i < 0 || static_cast<std::size_t>(i) >= vertices.size()) {
+        throw std::out_of_range("triangle BVH: vertex index " + std::to_string(i) + " of " +
+                                std::to_string(vertices.size()) + " vertices");
+      }
+    }
+  }
   order_.resize(count);
   std::iota(order_.begin(), order_.end(), Index{0});
   std::vector<Eigen::Vector3d> centroids(count);
@@ -146,6 +203,42 @@ BvhClosestPoint TriangleBvh::closest_point_brute_force(const Eigen::Vector3d& p)
     }
   }
   return best;
+}
+
+bool TriangleBvh::segment_hits(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const noexcept {
+  if (nodes_.empty()) {
+    return false;
+  }
+  const Eigen::Vector3d d = b - a;
+  const Eigen::Vector3d inverse_d = d.cwiseInverse();
+  std::array<std::int32_t, kMaxDepth + 2> stack{};
+  int top = 0;
+  stack[static_cast<std::size_t>(top++)] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[static_cast<std::size_t>(stack[static_cast<std::size_t>(--top)])];
+    if (!segment_meets_box(a, inverse_d, node.box_min, node.box_max)) {
+      continue;
+    }
+    if (node.count > 0) {
+      for (std::int32_t i = node.first; i < node.first + node.count; ++i) {
+        const TriangleCorners& t = corners_[static_cast<std::size_t>(i)];
+        if (segment_crosses_triangle(a, d, t.a, t.b, t.c)) return true;
+      }
+      continue;
+    }
+    stack[static_cast<std::size_t>(top++)] = node.first;
+    stack[static_cast<std::size_t>(top++)] = node.first + 1;
+  }
+  return false;
+}
+
+bool TriangleBvh::segment_hits_brute_force(const Eigen::Vector3d& a,
+                                           const Eigen::Vector3d& b) const noexcept {
+  const Eigen::Vector3d d = b - a;
+  for (const TriangleCorners& t : corners_) {
+    if (segment_crosses_triangle(a, d, t.a, t.b, t.c)) return true;
+  }
+  return false;
 }
 
 }  // namespace fahr::geometry

@@ -49,9 +49,10 @@ std::shared_ptr<const Scene> parse_checked(std::string_view text, std::string_vi
                 std::to_string(kMaxSceneTextBytes));
   }
   const detail::ParseContext ctx{log, base_dir, options};
-  const MapReader top(log, root, "",
-                      {"format_version", "name", "description", "run", "dds", "rates",
-                       "gravity_mps2", "bodies", "device", "solver", "contact", "qos"});
+  const MapReader top(
+      log, root, "",
+      {"format_version", "name", "description", "run", "dds", "rates", "gravity_mps2", "bodies",
+       "device", "solver", "contact", "qos", "glottic_view"});
   if (top.is_map()) {
     parse_header(top, *scene);
     scene->rates = detail::parse_rates(ctx, top);
@@ -62,6 +63,7 @@ std::shared_ptr<const Scene> parse_checked(std::string_view text, std::string_vi
     scene->solver = detail::parse_solver(ctx, top);
     scene->contact = detail::parse_contact(ctx, top, scene->bodies);
     scene->qos = detail::parse_qos(ctx, top);
+    scene->glottic_view = detail::parse_glottic_view(ctx, top, scene->bodies);
   }
   log.throw_if_any();
   return scene;

@@ -291,6 +291,36 @@ ContactSettings parse_contact(const ParseContext& ctx, const MapReader& top,
   return c;
 }
 
+std::optional<GlotticViewSettings> parse_glottic_view(const ParseContext& ctx, const MapReader& top,
+                                                      const std::vector<Body>& bodies) {
+  if (!top.has("glottic_view")) return std::nullopt;
+  const MapReader map(
+      ctx.log, top.value("glottic_view"), "glottic_view",
+      {"opening_centre_m", "opening_normal", "opening_radius_m", "eye_in_tool_m", "rate_hz"});
+  GlotticViewSettings g;
+  for (const std::string_view key :
+       {"opening_centre_m", "opening_normal", "opening_radius_m", "eye_in_tool_m"}) {
+    map.require(key);
+  }
+  map.read("opening_centre_m", closed(-1000.0, 1000.0), g.opening_centre_m);
+  if (map.read("opening_normal", closed(-1.0, 1.0), g.opening_normal)) {
+    if (std::abs(g.opening_normal.norm() - 1.0) > 1e-3) {
+      ctx.log.add(map.value("opening_normal").Mark(), map.child_path("opening_normal"),
+                  "the normal must have unit length (within 1e-3)");
+    }
+    g.opening_normal.normalize();
+  }
+  map.read("opening_radius_m", open_closed(0.0, 0.1), g.opening_radius_m);
+  map.read("eye_in_tool_m", closed(-10.0, 10.0), g.eye_in_tool_m);
+  map.read("rate_hz", open_closed(0.0, 100.0), g.rate_hz);
+  const bool has_tool = std::any_of(bodies.begin(), bodies.end(),
+                                    [](const Body& b) { return b.role == BodyRole::kTool; });
+  if (!has_tool) {
+    ctx.log.add(map.mark(), "glottic_view", "the eye rides on the tool: the scene has no tool");
+  }
+  return g;
+}
+
 std::map<std::string, QosOverride, std::less<>> parse_qos(const ParseContext& ctx,
                                                           const MapReader& top) {
   std::map<std::string, QosOverride, std::less<>> qos;

@@ -35,6 +35,8 @@ std::optional<DeviceSettings> parse_device(const ParseContext& ctx, const MapRea
 FemSolverSettings parse_solver(const ParseContext& ctx, const MapReader& top);
 ContactSettings parse_contact(const ParseContext& ctx, const MapReader& top,
                               const std::vector<Body>& bodies);
+std::optional<GlotticViewSettings> parse_glottic_view(const ParseContext& ctx, const MapReader& top,
+                                                      const std::vector<Body>& bodies);
 std::map<std::string, QosOverride, std::less<>> parse_qos(const ParseContext& ctx,
                                                           const MapReader& top);
 // A pose mapping: position_m and one of orientation_rpy_deg / orientation_quat_wxyz.

@@ -1,10 +1,11 @@
 // Axis-aligned bounding-box tree over the triangles of a surface for exact
-// closest-point queries. Built once; queries walk a fixed-size stack and
-// never allocate, so they can run in a 1 kHz loop.
+// closest-point and segment-occlusion queries. Built once; queries walk a
+// fixed-size stack and never allocate, so they can run in a 1 kHz loop.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "fahr/geometry/closest_point.h"
@@ -28,6 +29,10 @@ class TriangleBvh {
 
   TriangleBvh() = default;
   explicit TriangleBvh(const SurfaceMesh& mesh);
+  // The same over triangles of `vertices` (m) that need not form a checked
+  // surface, e.g. a deformed body's boundary. Throws std::out_of_range on an
+  // index outside `vertices`.
+  TriangleBvh(std::span<const Eigen::Vector3d> vertices, std::span<const Triangle> triangles);
 
   // The closest surface point to p among points closer than sqrt(bound_squared)
   // (m^2; infinity to search everything). triangle == -1 when none is.
@@ -35,6 +40,14 @@ class TriangleBvh {
 
   // The same by testing every triangle: the reference for tests and benchmarks.
   BvhClosestPoint closest_point_brute_force(const Eigen::Vector3d& p) const noexcept;
+
+  // Whether any triangle crosses the segment from a to b (m), ends excluded
+  // (a crossing within 1e-9 of the segment's length from either end does not
+  // count): a line of sight between two points is blocked.
+  bool segment_hits(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const noexcept;
+
+  // The same by testing every triangle: the reference for tests.
+  bool segment_hits_brute_force(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const noexcept;
 
   int depth() const { return depth_; }
 

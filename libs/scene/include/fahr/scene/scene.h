@@ -14,6 +14,7 @@
 #include "fahr/scene/body.h"
 #include "fahr/scene/contact_settings.h"
 #include "fahr/scene/device_settings.h"
+#include "fahr/scene/glottic_view_settings.h"
 #include "fahr/scene/qos_override.h"
 #include "fahr/scene/run_settings.h"
 #include "fahr/scene/solver_settings.h"
@@ -41,6 +42,8 @@ struct Scene {
   FemSolverSettings solver;
   ContactSettings contact;
   std::map<std::string, QosOverride, std::less<>> qos;  // by topic name
+  // The glottic view score (absent: not scored).
+  std::optional<GlotticViewSettings> glottic_view;
 
   // Index of the body with this name, or nullopt.
   std::optional<std::size_t> find_body(std::string_view body_name) const;
