@@ -10,7 +10,9 @@
 // no DDS; the recording is streamed with indexed seeks. The server listens on
 // 127.0.0.1 unless --address says otherwise. --allow-remote-input lets the
 // page's mouse device (and Foxglove clients) publish DevicePose on
-// fahr/RemoteInput, which the gateway reads with --backend remote.
+// fahr/RemoteInput, which the gateway reads with --backend remote. With the
+// scene's glottic_view section it scores the glottic view (POGO) and
+// publishes fahr/GlotticView.
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -22,6 +24,7 @@
 #include "fahr/common/clock.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/scene/load_scene.h"
+#include "fahr/visualizer_service/glottic_view_service.h"
 #include "fahr/visualizer_service/server.h"
 #include "fahr/visualizer_service/sources.h"
 
@@ -99,9 +102,21 @@ int run(int argc, char** argv) {
       };
     }
   }
+  // The glottic view: scored from the scene's eye on the blade, published
+  // (live) and shown; a scene without the section, or whose meshes cannot
+  // be read, runs without it.
+  std::unique_ptr<GlotticViewService> glottic;
+  if (scene && scene->glottic_view) {
+    try {
+      glottic = std::make_unique<GlotticViewService>(*scene, live, participant.get());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "fahr_visualizer: no glottic view: %s\n", e.what());
+    }
+  }
   Server server(options, live, scene, hooks);
   server.start();
   if (replay) replay->start();
+  if (glottic) glottic->start();
   std::printf(
       "fahr_visualizer: %s on http://%s:%u/ (Foxglove WebSocket: ws://%s:%u), %.0f Hz%s%s\n",
       options.mode.c_str(), options.address.c_str(), server.port(), options.address.c_str(),
@@ -116,8 +131,17 @@ int run(int argc, char** argv) {
       break;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
+  if (glottic) glottic->stop();
   if (replay) replay->stop();
   server.stop();
+  if (glottic) {
+    const auto g = glottic->stats();
+    std::printf(
+        "fahr_visualizer: glottic view %llu scored, %llu refused, last %.1f %%, peak tool force "
+        "%.2f N\n",
+        static_cast<unsigned long long>(g.scored), static_cast<unsigned long long>(g.refused),
+        g.last_percent, g.peak_force_n);
+  }
   std::printf("fahr_visualizer: %s\n", server.stats_json().c_str());
   return 0;
 }

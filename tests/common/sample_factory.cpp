@@ -9,6 +9,7 @@
 #include "device_posePubSubTypes.h"
 #include "fahr/common/backend.h"
 #include "force_commandPubSubTypes.h"
+#include "glottic_viewPubSubTypes.h"
 #include "scene_descriptionPubSubTypes.h"
 #include "service_statusPubSubTypes.h"
 #include "sim_clockPubSubTypes.h"
@@ -259,6 +260,21 @@ void fill(msg::StepAck& s, std::uint64_t seed, std::size_t) {
   s.output_hash(v.u64());
 }
 
+void fill(msg::GlotticView& s, std::uint64_t seed, std::size_t) {
+  Values v(seed);
+  s.header(v.header());
+  s.tool_body_id(v.u32());
+  s.fem_step(v.u64());
+  s.haptic_tick(v.u64());
+  s.visible_percent(v.real());
+  s.samples_facing(v.u32());
+  s.samples_seen(v.u32());
+  s.eye_m(v.vec3());
+  s.opening_centre_m(v.vec3());
+  s.tool_force_n(v.real());
+  s.peak_tool_force_n(v.real());
+}
+
 template <class T>
 std::vector<std::uint8_t> cdr_bytes(const T& sample) {
   auto* type = static_cast<eprosima::fastdds::dds::TopicDataType*>(
@@ -280,5 +296,6 @@ template std::vector<std::uint8_t> cdr_bytes(const msg::ServiceStatus&);
 template std::vector<std::uint8_t> cdr_bytes(const msg::ServiceEvents&);
 template std::vector<std::uint8_t> cdr_bytes(const msg::SimClock&);
 template std::vector<std::uint8_t> cdr_bytes(const msg::StepAck&);
+template std::vector<std::uint8_t> cdr_bytes(const msg::GlotticView&);
 
 }  // namespace fahr::test

@@ -22,6 +22,7 @@ void fill(msg::ServiceStatus& s, std::uint64_t seed, std::size_t sequence_length
 void fill(msg::ServiceEvents& s, std::uint64_t seed, std::size_t sequence_length);
 void fill(msg::SimClock& s, std::uint64_t seed, std::size_t sequence_length);
 void fill(msg::StepAck& s, std::uint64_t seed, std::size_t sequence_length);
+void fill(msg::GlotticView& s, std::uint64_t seed, std::size_t sequence_length);
 
 // The CDR bytes of a sample (fastddsgen serialisation, with encapsulation).
 template <class T>

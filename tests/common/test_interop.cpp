@@ -82,6 +82,7 @@ TEST_P(Interop, EveryTopicTypeCrossesIntact) {
   expect_round_trip<msg::ServiceEvents>(participant, 200);
   expect_round_trip<msg::SimClock>(participant, 0);
   expect_round_trip<msg::StepAck>(participant, 0);
+  expect_round_trip<msg::GlotticView>(participant, 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Vendors, Interop,

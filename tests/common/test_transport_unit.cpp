@@ -59,6 +59,7 @@ TEST(InProcess, EveryTypeRoundTrips) {
   expect_in_process_round_trip<msg::ServiceEvents>(8);
   expect_in_process_round_trip<msg::SimClock>(0);
   expect_in_process_round_trip<msg::StepAck>(0);
+  expect_in_process_round_trip<msg::GlotticView>(0);
 }
 
 TEST(InProcess, NewestWinsAndSequenceGapsAreCounted) {

@@ -52,6 +52,7 @@ int run_echo(Participant& participant, int seconds) {
   echoes.push_back(std::make_unique<Echo<msg::ServiceEvents>>(participant));
   echoes.push_back(std::make_unique<Echo<msg::SimClock>>(participant));
   echoes.push_back(std::make_unique<Echo<msg::StepAck>>(participant));
+  echoes.push_back(std::make_unique<Echo<msg::GlotticView>>(participant));
   std::this_thread::sleep_for(std::chrono::seconds(seconds));
   return 0;
 }

@@ -150,7 +150,7 @@ TEST(Recorder, OneChannelPerTopicAndKeyWithTheBytesTimesAndSequences) {
   EXPECT_EQ(per_key["fahr/DevicePose device_id=0"], 50U);
   EXPECT_EQ(per_key["fahr/DevicePose device_id=1"], 50U);
   EXPECT_EQ(per_key["fahr/DeformationState body_id=3"], 2U);
-  EXPECT_EQ(r.schemas.size(), 9U);
+  EXPECT_EQ(r.schemas.size(), 10U);
   for (const auto& [id, s] : r.schemas) {
     EXPECT_EQ(s.encoding, "omgidl");
     EXPECT_EQ(s.name.rfind("fahr::msg::", 0), 0U);

@@ -83,7 +83,7 @@ case "$mode" in
     start_visualizer --dds cyclonedds --domain 42
     start_run 20 intubation
     node "$js/foxglove_check.mjs" "ws://127.0.0.1:$port" 60 \
-      DevicePose,ForceCommand,ContactSet,DeformationState,SceneDescription,ServiceStatus | tee "$out/foxglove.json"
+      DevicePose,ForceCommand,ContactSet,DeformationState,SceneDescription,ServiceStatus,GlotticView | tee "$out/foxglove.json"
     stop_visualizer
     ;;
   browser)

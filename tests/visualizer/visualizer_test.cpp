@@ -12,14 +12,22 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 
+#include "fahr/common/cdr_bytes.h"
 #include "fahr/common/clock.h"
+#include "fahr/glottic_view/scene_view.h"
+#include "fahr/scene/load_scene.h"
+#include "fahr/visualizer_service/glottic_view_service.h"
 #include "fahr/visualizer_service/live_state.h"
 #include "fahr/visualizer_service/page_model.h"
 #include "fahr/visualizer_service/server.h"
+#include "glottic_viewPubSubTypes.h"
 #include "sample_factory.h"
 
 namespace fahr::visualizer_service {
@@ -98,6 +106,93 @@ TEST(PageModel, TheRestStateHasNoStrainAndAStretchHasSome) {
   const auto& state = *model.frames().at(kStateStream);
   EXPECT_FALSE(state.binary);
   EXPECT_TRUE(json::parse(state.data)["op"] == "state");
+}
+
+// The newest GlotticView in the store.
+std::optional<msg::GlotticView> newest_view(LiveState& live, std::vector<Slot>& slots) {
+  live.collect(slots);
+  for (const Slot& slot : slots) {
+    if (slot.topic != kGlotticView || slot.bytes.empty()) continue;
+    msg::GlotticView v;
+    if (common::decode_cdr<msg::GlotticViewPubSubType>(slot.bytes, v)) return v;
+  }
+  return std::nullopt;
+}
+
+msg::Contact contact(msg::ContactKind kind, double force_n, double nx, double ny) {
+  msg::Contact c;
+  c.kind(kind);
+  c.force_n(force_n);
+  c.normal().x(nx);
+  c.normal().y(ny);
+  return c;
+}
+
+TEST(GlotticViewService, ScoresTheNewestStateFromTheEyeOnTheBladeAndRefusesBadStates) {
+  const auto scene = scene::load_scene(FAHR_NEONATAL_SCENE);
+  const auto reference = glottic_view::glottic_view_from_scene(*scene);
+  LiveState live;
+  GlotticViewService service(*scene, live, nullptr);
+  std::vector<Slot> slots;
+  EXPECT_FALSE(service.update());  // no FEM state yet
+
+  msg::DeformationState state;
+  state.body_id(reference.deformable_body_ids.at(0));
+  std::vector<float> xyz;
+  for (const auto& p : reference.deformable_rest_m.at(0)) {
+    for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(p[k]));
+  }
+  state.positions_m(xyz);
+  put(live, kDeformationState, state);
+  // The blade placed so that the eye sits 30 mm above the opening, on its
+  // axis: the whole opening is in view. Three contacts: two of the tool
+  // (1 N and 2 N, one along +y, one at 90 deg) and one of the anatomy,
+  // which is not the blade's force.
+  const Eigen::Vector3d eye =
+      reference.view.opening().centre_m + 0.03 * reference.view.opening().normal;
+  const Eigen::Vector3d tip = eye - reference.eye_in_tool_m;
+  msg::ContactSet set;
+  set.body_id(state.body_id());
+  set.world_from_tool().orientation().w(1.0);
+  set.world_from_tool().position_m().x(tip.x());
+  set.world_from_tool().position_m().y(tip.y());
+  set.world_from_tool().position_m().z(tip.z());
+  set.contacts({contact(msg::CONTACT_TOOL, 1.0, 0.0, 1.0),
+                contact(msg::CONTACT_TOOL, 2.0, 1.0, 0.0),
+                contact(msg::CONTACT_OBSTACLE, 5.0, 0.0, 1.0)});
+  put(live, kContactSet, set);
+  ASSERT_TRUE(service.update());
+  auto view = newest_view(live, slots);
+  ASSERT_TRUE(view);
+  EXPECT_GT(view->visible_percent(), 95.0);
+  EXPECT_NEAR(view->eye_m().y(), eye.y(), 1e-9);
+  EXPECT_NEAR(view->tool_force_n(), std::sqrt(5.0), 1e-9);  // |(2, 1, 0)| N
+  EXPECT_NEAR(view->peak_tool_force_n(), std::sqrt(5.0), 1e-9);
+
+  // The blade where the scene starts it: the eye behind the lips sees none
+  // of the opening; a smaller force keeps the peak.
+  set.world_from_tool().position_m().x(scene->bodies[*scene->tool_index()].pose.position_m.x());
+  set.world_from_tool().position_m().y(scene->bodies[*scene->tool_index()].pose.position_m.y());
+  set.world_from_tool().position_m().z(0.0);
+  set.contacts({contact(msg::CONTACT_TOOL, 0.5, 0.0, 1.0)});
+  put(live, kContactSet, set);
+  ASSERT_TRUE(service.update());
+  view = newest_view(live, slots);
+  ASSERT_TRUE(view);
+  EXPECT_EQ(view->visible_percent(), 0.0);
+  EXPECT_NEAR(view->tool_force_n(), 0.5, 1e-9);
+  EXPECT_NEAR(view->peak_tool_force_n(), std::sqrt(5.0), 1e-9);
+
+  // A state with a NaN, and one of the wrong size, are refused and counted.
+  xyz[7] = std::numeric_limits<float>::quiet_NaN();
+  state.positions_m(xyz);
+  put(live, kDeformationState, state);
+  service.update();
+  xyz.resize(xyz.size() - 3);
+  state.positions_m(xyz);
+  put(live, kDeformationState, state);
+  service.update();
+  EXPECT_EQ(service.stats().refused, 2U);
 }
 
 // A synchronous Beast client.

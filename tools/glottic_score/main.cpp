@@ -13,7 +13,7 @@
 // tool. --recording: the tongue and the tool pose of each FEM state in the
 // file, scored every --every-ms of the run; prints the rest, the largest
 // and the last score, each by both methods; --png-prefix P writes
-// P_rest.png and P_best.png.
+// P_rest.png, P_best.png and P_last.png.
 //
 // A line per view: "view <label>: rays R % (seen/facing samples), pixels
 // P % (seen/drawn), difference D points". Exit 0, or 1 on an error (named).
@@ -133,13 +133,17 @@ struct Moment {
 };
 
 int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshes,
-                  const std::string& path, double every_ms, const std::string& png_prefix) {
+                  const std::string& path, double every_ms, const std::string& png_prefix,
+                  const Eigen::Isometry3d& scene_tool_pose) {
   if (view.deformable_body_ids.empty()) throw std::runtime_error("the scene has no soft body");
   const std::uint32_t body = view.deformable_body_ids.front();
   const std::size_t nodes = view.deformable_node_counts.front();
   msg::DeformationState state;
   msg::ContactSet contacts;
   Moment current, rest, best, last;
+  // Until a ContactSet says where the blade is, it is where the scene puts it.
+  current.world_from_tool = scene_tool_pose;
+  current.has_tool = true;
   bool have_rest = false;
   std::int64_t t0 = -1, next = 0;
   std::size_t scored = 0, refused = 0;
@@ -212,7 +216,7 @@ int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshe
     char name[64];
     std::snprintf(name, sizeof name, "%s (t %.2f s)", label, moment->t_s);
     print(name, compare(view, meshes, in), in);
-    if (!png_prefix.empty() && std::string(label) != "last") {
+    if (!png_prefix.empty()) {
       write_png(meshes, view.view.opening(), in, png_prefix + "_" + label + ".png");
     }
   }
@@ -232,13 +236,15 @@ int run(int argc, char** argv) {
   app.add_option("--recording", recording, "score the FEM states of this MCAP recording");
   app.add_option("--every-ms", every_ms, "score a recording this often")
       ->check(CLI::Range(1.0, 1e6));
-  app.add_option("--png-prefix", png_prefix, "a recording's pictures: PREFIX_rest/_best.png");
+  app.add_option("--png-prefix", png_prefix, "a recording's pictures: PREFIX_rest/_best/_last.png");
   CLI11_PARSE(app, argc, argv);
 
   const auto scene = scene::load_scene(scene_path);
   glottic_view::SceneGlotticView view = glottic_view::glottic_view_from_scene(*scene, samples);
   const SceneMeshes meshes = load_scene_meshes(*scene);
-  if (!recording.empty()) return run_recording(view, meshes, recording, every_ms, png_prefix);
+  if (!recording.empty()) {
+    return run_recording(view, meshes, recording, every_ms, png_prefix, pose_from("", *scene));
+  }
 
   ViewInput in;
   in.world_from_tool = pose_from(pose_text, *scene);

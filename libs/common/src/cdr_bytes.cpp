@@ -1,4 +1,4 @@
-// Borrowed CDR bytes decoded by Fast DDS's type support (see cdr_bytes.h).
+// CDR bytes decoded and encoded by Fast DDS's type support (see cdr_bytes.h).
 #include "fahr/common/cdr_bytes.h"
 
 #include <fastdds/dds/topic/TopicDataType.hpp>
@@ -16,6 +16,15 @@ bool decode_cdr(eprosima::fastdds::dds::TopicDataType& type, std::span<const std
   const bool ok = type.deserialize(&payload, sample);
   payload.data = nullptr;
   return ok;
+}
+
+bool encode_cdr(eprosima::fastdds::dds::TopicDataType& type, const void* sample,
+                std::vector<std::uint8_t>& out) {
+  void* data = const_cast<void*>(sample);  // the serialiser only reads
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(data)());
+  if (!type.serialize(data, &payload)) return false;
+  out.assign(payload.data, payload.data + payload.length);
+  return true;
 }
 
 }  // namespace fahr::common

@@ -7,6 +7,7 @@
 #include "fahr/common/backend.h"
 #include "fahr/common/topics.h"
 #include "force_commandPubSubTypes.h"
+#include "glottic_viewPubSubTypes.h"
 #include "scene_descriptionPubSubTypes.h"
 #include "service_statusPubSubTypes.h"
 #include "sim_clockPubSubTypes.h"
@@ -26,6 +27,7 @@ extern const dds_topic_descriptor_t fahr_msg_ServiceStatus_desc;
 extern const dds_topic_descriptor_t fahr_msg_ServiceEvents_desc;
 extern const dds_topic_descriptor_t fahr_msg_SimClock_desc;
 extern const dds_topic_descriptor_t fahr_msg_StepAck_desc;
+extern const dds_topic_descriptor_t fahr_msg_GlotticView_desc;
 }
 
 namespace fahr::common::detail {
@@ -64,6 +66,7 @@ FAHR_TYPE_SUPPORT(ServiceStatus)
 FAHR_TYPE_SUPPORT(ServiceEvents)
 FAHR_TYPE_SUPPORT(SimClock)
 FAHR_TYPE_SUPPORT(StepAck)
+FAHR_TYPE_SUPPORT(GlotticView)
 
 #undef FAHR_TYPE_SUPPORT
 

@@ -96,7 +96,7 @@ Recorder::Recorder(common::Participant& participant, RecorderOptions options)
       topic_of<msg::ContactSet>("body_id"),       topic_of<msg::DeformationState>("body_id"),
       topic_of<msg::SceneDescription>("body_id"), topic_of<msg::ServiceStatus>("service_id"),
       topic_of<msg::ServiceEvents>("service_id"), topic_of<msg::SimClock>(nullptr),
-      topic_of<msg::StepAck>("participant_id"),
+      topic_of<msg::StepAck>("participant_id"),   topic_of<msg::GlotticView>("tool_body_id"),
   };
   writer_.open(options_.path);
   for (std::size_t i = 0; i < topics_.size(); ++i) {
@@ -144,6 +144,8 @@ Recorder::Recorder(common::Participant& participant, RecorderOptions options)
       RawSubscriber::create<msg::SimClock>(participant, topics_[7].qos, handler(7)));
   subscribers_.push_back(
       RawSubscriber::create<msg::StepAck>(participant, topics_[8].qos, handler(8)));
+  subscribers_.push_back(
+      RawSubscriber::create<msg::GlotticView>(participant, topics_[9].qos, handler(9)));
 }
 
 Recorder::~Recorder() {

@@ -15,6 +15,7 @@ const std::array<TopicInfo, kTopicCount>& topic_table() {
       {"fahr/DeformationState", "fahr::msg::DeformationState", true},
       {"fahr/SceneDescription", "fahr::msg::SceneDescription", true},
       {"fahr/ServiceStatus", "fahr::msg::ServiceStatus", true},
+      {"fahr/GlotticView", "fahr::msg::GlotticView", true},
   }};
   return table;
 }

@@ -15,6 +15,7 @@
 #include "fahr/geometry/surface_loader.h"
 #include "fahr/geometry/tet_deformation.h"
 #include "force_commandPubSubTypes.h"
+#include "glottic_viewPubSubTypes.h"
 #include "scene_descriptionPubSubTypes.h"
 #include "service_statusPubSubTypes.h"
 
@@ -277,6 +278,15 @@ void PageModel::update(const std::vector<Slot>& slots, const std::string& mode) 
              {"metrics", std::move(metrics)}};
         break;
       }
+      case kGlotticView: {
+        msg::GlotticView m;
+        if (!common::decode_cdr<msg::GlotticViewPubSubType>(slot.bytes, m)) break;
+        j = {{"tool", m.tool_body_id()},    {"percent", m.visible_percent()},
+             {"eye", vec(m.eye_m())},       {"target", vec(m.opening_centre_m())},
+             {"force_n", m.tool_force_n()}, {"peak_force_n", m.peak_tool_force_n()},
+             {"fem_step", m.fem_step()}};
+        break;
+      }
       default:
         break;
     }
@@ -291,9 +301,10 @@ void PageModel::update(const std::vector<Slot>& slots, const std::string& mode) 
 void PageModel::build_state(const std::string& mode) {
   state_dirty_ = false;
   // The pieces are JSON already: the state frame is assembled from them,
-  // one array per topic ("device", "command", "contacts", "services").
-  static constexpr const char* kNames[kTopicCount] = {"device", "command", "contacts",
-                                                      nullptr,  nullptr,   "services"};
+  // one array per topic ("device", "command", "contacts", "services",
+  // "glottic").
+  static constexpr const char* kNames[kTopicCount] = {"device", "command",  "contacts", nullptr,
+                                                      nullptr,  "services", "glottic"};
   std::string s = "{\"op\":\"state\",\"mode\":\"" + mode + "\"";
   for (std::size_t topic = 0; topic < kTopicCount; ++topic) {
     if (kNames[topic] == nullptr) continue;

@@ -130,7 +130,9 @@ std::string ReplaySource::position_json() const {
 void ReplaySource::fill(std::uint64_t begin, std::uint64_t end) {
   reader_.read(begin, end, [&](const mcap::Channel& c, const mcap::MessageView& m) {
     const std::size_t topic = topic_index(c.topic);
-    if (topic == kTopicCount || topic == kSceneDescription) return;
+    // The glottic view is recomputed from the recorded geometry (the
+    // replay's GlotticViewService), so a recording without it shows it too.
+    if (topic == kTopicCount || topic == kSceneDescription || topic == kGlotticView) return;
     live_.put(topic, m.data, static_cast<std::int64_t>(m.log_time));
   });
   chunks_read_ = reader_.chunks_read();

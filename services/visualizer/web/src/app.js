@@ -32,6 +32,8 @@ const stats = {
   refusals: [],
   tongueRect: null,
   bodies: [],
+  glottic: null, // the newest GlotticView: percent, force_n, peak_force_n, eye, target
+  camera: "overview",
 };
 window.fahrStats = stats;
 
@@ -63,7 +65,7 @@ window.addEventListener("resize", resize);
 resize();
 
 const bodies = new Map(); // body id -> { role, mesh, geometry, ... }
-let tool = null; // { proxy, ghost, axis }
+let tool = null; // { proxy, ghost }
 const contactGroup = new THREE.Group();
 scene.add(contactGroup);
 const sphereGroup = new THREE.Group();
@@ -150,8 +152,7 @@ function addBody(b) {
     geometry.computeBoundingBox();
     const size = new THREE.Vector3();
     geometry.boundingBox.getSize(size);
-    const axis = new THREE.Vector3(size.x >= size.y && size.x >= size.z ? 1 : 0, size.y > size.x && size.y >= size.z ? 1 : 0, size.z > size.x && size.z > size.y ? 1 : 0);
-    tool = { proxy, ghost, axis, box: geometry.boundingBox.clone() };
+    tool = { proxy, ghost };
   } else {
     const mesh = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({ color: 0xd8b0a0, transparent: true, opacity: 0.45, side: THREE.DoubleSide, depthWrite: false }));
     mesh.visible = show.anatomy;
@@ -295,6 +296,13 @@ function applyState(s) {
     if (gateway && gateway.metrics) pushPoint(plots.latency, [gateway.metrics.motion_to_force_p50_ms ?? 0, gateway.metrics.motion_to_force_p99_ms ?? 0]);
     plotDirty = true;
   }
+  const glottic = s.glottic && s.glottic[0];
+  stats.glottic = glottic ?? null;
+  if (glottic) {
+    document.getElementById("pogo").textContent =
+      `${glottic.percent.toFixed(0)} % of the glottic opening seen | blade on tissue ${glottic.force_n.toFixed(2)} N (peak ${glottic.peak_force_n.toFixed(2)} N)`;
+    if (stats.camera === "blade") setCamera("blade");
+  }
   const lines = [
     `${stats.hello ? stats.hello.mode : "?"} | frames: ${stats.deformFrames} deform, ${stats.stateFrames} state`,
     `|F| ${stats.forceN.toFixed(2)} N of ${limit.toFixed(1)} N${cmd && cmd.lost_track ? "  LOST TRACK" : ""}`,
@@ -309,18 +317,13 @@ const frozenMat = new THREE.MeshBasicMaterial({ color: 0x30a0ff });
 
 // --- camera presets --------------------------------------------------------
 function setCamera(name) {
-  if (name === "blade" && tool) {
-    // The laryngoscopist's view: from behind the handle, along the blade.
-    const m = tool.proxy.matrix;
-    const origin = new THREE.Vector3().setFromMatrixPosition(m);
-    const axis = tool.axis.clone().transformDirection(m);
-    const len = tool.box.max.clone().sub(tool.box.min).dot(tool.axis);
-    const centre = tool.box.getCenter(new THREE.Vector3()).applyMatrix4(m);
-    // The eye sits past the end of the blade farther from the mouth (+x is out).
-    const sign = axis.x >= 0 ? 1 : -1;
-    camera.position.copy(centre).addScaledVector(axis, sign * 0.8 * len).add(new THREE.Vector3(0, 0.01, 0));
-    controls.target.copy(centre).addScaledVector(axis, -sign * 0.5 * len);
-    void origin;
+  stats.camera = name;
+  if (name === "blade" && stats.glottic) {
+    // The laryngoscopist's view: from the scene's eye point on the blade
+    // (glottic_view.eye_in_tool_m) towards the glottic opening, the eye the
+    // glottic view score is computed from; it follows the blade.
+    camera.position.set(...stats.glottic.eye);
+    controls.target.set(...stats.glottic.target);
   } else {
     const presets = {
       overview: [[0.06, 0.05, 0.16], [-0.03, 0, 0]],
@@ -328,7 +331,8 @@ function setCamera(name) {
       top: [[-0.03, 0.16, 0.001], [-0.03, 0, 0]],
       front: [[0.14, 0.02, 0.0], [-0.03, 0, 0]],
     };
-    const [p, t] = presets[name] ?? presets.overview;
+    // "blade" without a glottic view (the scene defines no eye): the front view.
+    const [p, t] = presets[name] ?? presets.front;
     camera.position.set(...p);
     controls.target.set(...t);
   }

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 namespace eprosima::fastdds::dds {
 class TopicDataType;
@@ -23,6 +24,18 @@ template <class PubSub, class Sample>
 bool decode_cdr(std::span<const std::uint8_t> bytes, Sample& sample) {
   PubSub type;
   return decode_cdr(type, bytes, &sample);
+}
+
+// The reverse: *sample (of the type `type` describes) as CDR bytes with
+// their encapsulation header, into `out` (resized). False if it does not
+// serialise.
+bool encode_cdr(eprosima::fastdds::dds::TopicDataType& type, const void* sample,
+                std::vector<std::uint8_t>& out);
+
+template <class PubSub, class Sample>
+bool encode_cdr(const Sample& sample, std::vector<std::uint8_t>& out) {
+  PubSub type;
+  return encode_cdr(type, &sample, out);
 }
 
 }  // namespace fahr::common

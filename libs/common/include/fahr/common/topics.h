@@ -9,6 +9,7 @@
 #include "device_pose.h"
 #include "fahr/common/qos_profile.h"
 #include "force_command.h"
+#include "glottic_view.h"
 #include "scene_description.h"
 #include "service_status.h"
 #include "sim_clock.h"
@@ -35,6 +36,7 @@ FAHR_TOPIC(ServiceStatus, kReport);
 FAHR_TOPIC(ServiceEvents, kReport);
 FAHR_TOPIC(SimClock, kLockstep);
 FAHR_TOPIC(StepAck, kLockstep);
+FAHR_TOPIC(GlotticView, kReport);
 
 #undef FAHR_TOPIC
 

@@ -24,6 +24,7 @@ enum TopicIndex : std::size_t {
   kDeformationState,
   kSceneDescription,
   kServiceStatus,
+  kGlotticView,
   kTopicCount
 };
 
