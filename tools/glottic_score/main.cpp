@@ -15,9 +15,11 @@
 // and the last score, each by both methods; --png-prefix P writes
 // P_rest.png, P_best.png and P_last.png.
 //
-// A line per view: "view <label>: rays R % (seen/facing samples), pixels
-// P % (seen/drawn), difference D points". Exit 0, or 1 on an error (named).
+// A line per view: "view <label>: rays R % (seen/facing samples, its wall
+// time), pixels P % (seen/drawn), difference D points". Exit 0, or 1 on an
+// error (named).
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -93,6 +95,7 @@ Eigen::Isometry3d pose_from(const std::string& text, const scene::Scene& scene) 
 
 struct Compared {
   glottic_view::ViewScore rays;
+  double rays_ms = 0.0;  // wall time of the ray-cast score
   PixelShare pixels;
 };
 
@@ -101,16 +104,19 @@ Compared compare(glottic_view::SceneGlotticView& view, const SceneMeshes& meshes
   std::vector<std::span<const Eigen::Vector3d>> spans(in.deformable_positions.begin(),
                                                       in.deformable_positions.end());
   Compared c;
+  const auto t0 = std::chrono::steady_clock::now();
   c.rays = view.view.score(in.eye_m, in.world_from_tool, spans);
+  c.rays_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   c.pixels = pixel_share(meshes, view.view.opening(), in);
   return c;
 }
 
 void print(const std::string& label, const Compared& c, const ViewInput& in) {
   std::printf(
-      "view %s: rays %.1f %% (%zu/%zu samples), pixels %.1f %% (%zu/%zu), difference %.1f "
-      "points; eye (%.1f, %.1f, %.1f) mm\n",
-      label.c_str(), 100.0 * c.rays.visible_share, c.rays.visible, c.rays.samples,
+      "view %s: rays %.1f %% (%zu/%zu samples, %.2f ms), pixels %.1f %% (%zu/%zu), difference "
+      "%.1f points; eye (%.1f, %.1f, %.1f) mm\n",
+      label.c_str(), 100.0 * c.rays.visible_share, c.rays.visible, c.rays.samples, c.rays_ms,
       100.0 * c.pixels.visible_share, c.pixels.visible, c.pixels.total,
       100.0 * std::abs(c.rays.visible_share - c.pixels.visible_share), 1e3 * in.eye_m.x(),
       1e3 * in.eye_m.y(), 1e3 * in.eye_m.z());
