@@ -37,6 +37,7 @@ void describe_deformable(const HapticSetup& setup, msg::SceneDescription& d) {
     d.sphere_link_offsets().push_back(static_cast<std::uint32_t>(d.sphere_nodes().size()));
     for (auto n : layout.nodes(i)) d.sphere_nodes().push_back(n);
     for (auto w : layout.weights(i)) d.sphere_weights().push_back(static_cast<float>(w));
+    d.sphere_levels().push_back(s.origin == sphere_layout::SphereOrigin::kHugging ? 255 : s.level);
   }
 }
 

@@ -169,7 +169,33 @@ void PageModel::on_scene(const Slot& slot) {
   o.pad4();
   o.array(rest.data(), nodes * 3);
   o.array(tris.data(), n_tris * 3);
-  o.array(spheres.data(), (spheres.size() / 4) * 4);
+  const std::size_t n_spheres = spheres.size() / 4;
+  o.array(spheres.data(), n_spheres * 4);
+  // The spheres' node links and levels, so the page moves them with the
+  // tissue (c = sum w x, the layout's own definition) and shows levels
+  // apart. Links that do not fit the mesh are left out: spheres at rest.
+  const auto& offsets = d.sphere_link_offsets();
+  const auto& link_nodes = d.sphere_nodes();
+  const auto& weights = d.sphere_weights();
+  bool links_ok = offsets.size() == n_spheres && link_nodes.size() == weights.size() &&
+                  d.sphere_levels().size() == n_spheres;
+  for (std::size_t i = 0; links_ok && i < n_spheres; ++i) {
+    const std::size_t end = i + 1 < n_spheres ? offsets[i + 1] : link_nodes.size();
+    links_ok = offsets[i] <= end && end <= link_nodes.size();
+  }
+  for (std::size_t k = 0; links_ok && k < link_nodes.size(); ++k) {
+    links_ok = link_nodes[k] < nodes && std::isfinite(weights[k]);
+  }
+  if (links_ok) {
+    o.u32(static_cast<std::uint32_t>(link_nodes.size()));
+    o.array(offsets.data(), n_spheres);
+    o.array(link_nodes.data(), link_nodes.size());
+    o.array(weights.data(), weights.size());
+    o.array(d.sphere_levels().data(), n_spheres);
+    o.pad4();
+  } else {
+    o.u32(0);
+  }
   deformables_[d.body_id()] = std::move(def);
   make(kSceneStreamBase + static_cast<int>(d.body_id()), true, true, std::move(o.s));
 }

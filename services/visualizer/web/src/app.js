@@ -69,7 +69,7 @@ let tool = null; // { proxy, ghost }
 const contactGroup = new THREE.Group();
 scene.add(contactGroup);
 const sphereGroup = new THREE.Group();
-sphereGroup.visible = false;
+sphereGroup.visible = false; // the "spheres" toggle; each level has its own below
 scene.add(sphereGroup);
 const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 1, 0), new THREE.Vector3(), 0.01, 0x40d040, 0.006, 0.003);
 arrow.visible = false;
@@ -102,7 +102,24 @@ function readScene(buf) {
   const tris = new Uint32Array(buf.slice(off, off + nt * 12));
   off += nt * 12;
   const spheres = new Float32Array(buf.slice(off, off + ns * 16));
-  return { bodyId, role, name, pos, tris, spheres };
+  off += ns * 16;
+  // The spheres' node links and levels (deformable bodies; none: at rest).
+  let links = null;
+  if (ns > 0) {
+    const nl = new Uint32Array(buf, off, 1)[0];
+    off += 4;
+    if (nl > 0) {
+      const first = new Uint32Array(buf.slice(off, off + ns * 4));
+      off += ns * 4;
+      const nodes = new Uint32Array(buf.slice(off, off + nl * 4));
+      off += nl * 4;
+      const weights = new Float32Array(buf.slice(off, off + nl * 4));
+      off += nl * 4;
+      const levels = new Uint8Array(buf.slice(off, off + ns));
+      links = { first, nodes, weights, levels };
+    }
+  }
+  return { bodyId, role, name, pos, tris, spheres, links };
 }
 
 function addBody(b) {
@@ -125,20 +142,7 @@ function addBody(b) {
     entry.meshes.push(mesh);
     entry.rest = b.pos.slice();
     scene.add(mesh);
-    sphereGroup.clear();
-    const sphereGeom = new THREE.SphereGeometry(1, 10, 8);
-    const mat = new THREE.MeshBasicMaterial({ color: 0x70a0ff, wireframe: true, transparent: true, opacity: 0.35 });
-    const count = b.spheres.length / 4;
-    if (count > 0) {
-      const inst = new THREE.InstancedMesh(sphereGeom, mat, count);
-      const m = new THREE.Matrix4();
-      for (let i = 0; i < count; i++) {
-        const r = b.spheres[4 * i + 3];
-        m.makeScale(r, r, r).setPosition(b.spheres[4 * i], b.spheres[4 * i + 1], b.spheres[4 * i + 2]);
-        inst.setMatrixAt(i, m);
-      }
-      sphereGroup.add(inst);
-    }
+    buildSpheres(b);
   } else if (b.role === 1) {
     // The tool: the blade at the proxy pose, and a translucent grey copy at
     // the device pose while the device has lost track.
@@ -163,6 +167,96 @@ function addBody(b) {
   stats.bodies = [...bodies.values()].map((e) => ({ name: e.name, role: e.role }));
 }
 
+// --- AIST spheres: one instanced mesh per level, moved with the tissue ----
+const LEVEL_COLOURS = [0x70a0ff, 0x70e0a0, 0xe0c070, 0xe070d0];
+const HUGGING = 255;
+let sphereSets = []; // { level, name, indices, mesh }
+let sphereSource = null; // { spheres, links }
+function buildSpheres(b) {
+  sphereGroup.clear();
+  sphereSets = [];
+  sphereSource = { spheres: b.spheres, links: b.links };
+  const count = b.spheres.length / 4;
+  if (count === 0) return;
+  const byLevel = new Map();
+  for (let i = 0; i < count; i++) {
+    const level = b.links ? b.links.levels[i] : 0;
+    if (!byLevel.has(level)) byLevel.set(level, []);
+    byLevel.get(level).push(i);
+  }
+  // Coarse spheres: thousands of them, drawn in software on machines without a GPU.
+  const geom = new THREE.SphereGeometry(1, 8, 5);
+  for (const level of [...byLevel.keys()].sort((a, c) => a - c)) {
+    const indices = byLevel.get(level);
+    const colour = level === HUGGING ? 0xff9060 : LEVEL_COLOURS[level % LEVEL_COLOURS.length];
+    const mat = new THREE.MeshBasicMaterial({ color: colour, wireframe: true, transparent: true, opacity: 0.35 });
+    const mesh = new THREE.InstancedMesh(geom, mat, indices.length);
+    const name = level === HUGGING ? "hugging" : `level ${level}`;
+    const set = { level, name, indices, mesh };
+    mesh.visible = show.spheres && sphereLevelShown(name);
+    sphereSets.push(set);
+    sphereGroup.add(mesh);
+  }
+  placeSpheres(null);
+  makeSphereToggles();
+}
+const hiddenLevels = new Set();
+function sphereLevelShown(name) {
+  return !hiddenLevels.has(name);
+}
+// Sphere centres from the node positions (null: at rest): c = sum w x.
+const sphereMatrix = new THREE.Matrix4();
+function placeSpheres(pos) {
+  if (!sphereSource) return;
+  const { spheres, links } = sphereSource;
+  for (const set of sphereSets) {
+    if (!set.mesh.visible && pos) continue;
+    set.indices.forEach((i, k) => {
+      let x = spheres[4 * i];
+      let y = spheres[4 * i + 1];
+      let z = spheres[4 * i + 2];
+      if (pos && links) {
+        const end = i + 1 < links.first.length ? links.first[i + 1] : links.nodes.length;
+        x = y = z = 0;
+        for (let l = links.first[i]; l < end; l++) {
+          const n = links.nodes[l];
+          const w = links.weights[l];
+          x += w * pos[3 * n];
+          y += w * pos[3 * n + 1];
+          z += w * pos[3 * n + 2];
+        }
+      }
+      const r = spheres[4 * i + 3];
+      sphereMatrix.makeScale(r, r, r).setPosition(x, y, z);
+      set.mesh.setMatrixAt(k, sphereMatrix);
+    });
+    set.mesh.instanceMatrix.needsUpdate = true;
+  }
+  stats.sphereLevels = sphereSets.map((s) => ({ name: s.name, count: s.indices.length, visible: s.mesh.visible }));
+  stats.spheresMoved = !!(pos && links);
+}
+function makeSphereToggles() {
+  const row = document.getElementById("sphere-levels");
+  row.textContent = "";
+  for (const set of sphereSets) {
+    const b = document.createElement("button");
+    b.textContent = `${set.name} (${set.indices.length})`;
+    b.className = sphereLevelShown(set.name) ? "on" : "";
+    b.onclick = () => {
+      if (hiddenLevels.has(set.name)) hiddenLevels.delete(set.name);
+      else hiddenLevels.add(set.name);
+      b.className = sphereLevelShown(set.name) ? "on" : "";
+      updateSphereVisibility();
+    };
+    row.appendChild(b);
+  }
+}
+let lastPositions = null;
+function updateSphereVisibility() {
+  for (const set of sphereSets) set.mesh.visible = show.spheres && sphereLevelShown(set.name);
+  placeSpheres(lastPositions);
+}
+
 function applyDeformation(buf) {
   const u = new Uint32Array(buf, 0, 4);
   const bodyId = u[1];
@@ -175,6 +269,8 @@ function applyDeformation(buf) {
   if (attr.count !== n) return;
   attr.array.set(pos);
   attr.needsUpdate = true;
+  lastPositions = attr.array;
+  if (show.spheres) placeSpheres(lastPositions);
   const colours = entry.geometry.attributes.color;
   let max = 0;
   let sum = 0;
@@ -353,6 +449,7 @@ for (const key of Object.keys(show)) {
     show[key] = !show[key];
     b.className = show[key] ? "on" : "";
     sphereGroup.visible = show.spheres;
+    updateSphereVisibility();
     for (const e of bodies.values()) if (e.role === 2) e.meshes.forEach((m) => (m.visible = show.anatomy));
     if (!show.arrow) arrow.visible = false;
   };
