@@ -212,8 +212,10 @@ if [ "$mode" = lockstep ]; then
   if [ -n "$replay" ]; then
     "$replayer" "$replay" --mode lockstep "${gateway_flags[@]}" >"$logs/gateway.log" 2>&1 &
   else
+    # The gateway runs the clock's steps: past the script's end (13 s of the
+    # intubation) the hand holds its last pose, as in real time.
     stdbuf -oL "$gateway" "${gateway_flags[@]}" --mode lockstep --force-input-period 1 --backend simulated \
-      --script "$script" --duration-s 0 >"$logs/gateway.log" 2>&1 &
+      --script "$script" --duration-s "$duration_s" >"$logs/gateway.log" 2>&1 &
   fi
   gateway_pid=$!; pids+=("$gateway_pid")
   steps=$(awk "BEGIN { printf \"%d\", $duration_s * 1000 }")

@@ -6,9 +6,12 @@
 # laryngoscopist could hold, and (with --recording) a recorded run's rest,
 # best and last view; the wall time of a score; the pictures.
 #
-#   bench/glottic_view/glottic_view.sh [BUILD_DIR] [--recording RUN.mcap]
+#   bench/glottic_view/glottic_view.sh [BUILD_DIR] [--recording RUN.mcap | --run S]
 #       [--pictures DIR] [--markdown [FILE]]
 #
+# --run S: record S simulated seconds of the intubation in lockstep first
+# (deployment/run_local.sh --record; about 4 s of wall time per second) and
+# score that recording.
 # --pictures DIR: the laryngoscopist's views as PNG (the opening in green).
 # --markdown: also write the output to FILE (a name ending in .md), by
 # default bench/results/<machine>/glottic-view.md. About 30 s.
@@ -17,11 +20,13 @@ repo=$(cd "$(dirname "$0")/../.." && pwd)
 command=("$0" "$@")
 build="$repo/build"
 recording=""
+run_s=""
 pictures=""
 markdown=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --recording) recording="$2"; shift 2 ;;
+    --run) run_s="$2"; shift 2 ;;
     --pictures) pictures="$2"; shift 2 ;;
     --markdown)
       if [ $# -gt 1 ] && [[ "$2" == *.md ]]; then markdown=(--markdown "$2"); shift 2
@@ -40,6 +45,11 @@ fi
 [ -z "$pictures" ] || mkdir -p "$pictures"
 work=$(mktemp -d /tmp/fahr-glottic-view-XXXXXX)
 trap 'rm -rf "$work"' EXIT
+if [ -n "$run_s" ]; then
+  recording="$work/intubation_lockstep_${run_s}s.mcap"
+  bash "$repo/deployment/run_local.sh" "$build" --mode lockstep --duration-s "$run_s" \
+    --record "$recording" >"$work/run.log" 2>&1 || { cat "$work/run.log" >&2; exit 1; }
+fi
 
 # "view L: rays R % (s/n samples, T ms), pixels P % (v/t), difference D points; eye (..) mm"
 row() {

@@ -11,9 +11,10 @@
 // at X,Y,Z mm turned PITCH degrees about +z (default: the scene's pose).
 // --eye X,Y,Z: the eye in the world, mm, instead of the scene's eye on the
 // tool. --recording: the tongue and the tool pose of each FEM state in the
-// file, scored every --every-ms of the run; prints the rest, the largest
-// and the last score, each by both methods; --png-prefix P writes
-// P_rest.png, P_best.png and P_last.png.
+// file, scored every --every-ms of the run's simulated time; prints the
+// rest view, the one under the blade's largest force on the tissue, the
+// best and the last, each by both methods; --png-prefix P writes
+// P_rest.png, P_pressed.png, P_best.png and P_last.png.
 //
 // A line per view: "view <label>: rays R % (seen/facing samples, its wall
 // time), pixels P % (seen/drawn), difference D points". Exit 0, or 1 on an
@@ -136,6 +137,7 @@ struct Moment {
   Eigen::Isometry3d world_from_tool = Eigen::Isometry3d::Identity();
   bool has_tool = false;
   double share = 0.0;
+  double force_n = 0.0;  // the blade's force on the tissue (its ContactSet rows)
 };
 
 int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshes,
@@ -146,7 +148,7 @@ int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshe
   const std::size_t nodes = view.deformable_node_counts.front();
   msg::DeformationState state;
   msg::ContactSet contacts;
-  Moment current, rest, best, last;
+  Moment current, rest, pressed, best, last;
   // Until a ContactSet says where the blade is, it is where the scene puts it.
   current.world_from_tool = scene_tool_pose;
   current.has_tool = true;
@@ -167,12 +169,19 @@ int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshe
       current.world_from_tool.translation() =
           Eigen::Vector3d(p.position_m().x(), p.position_m().y(), p.position_m().z());
       current.has_tool = true;
+      Eigen::Vector3d force = Eigen::Vector3d::Zero();
+      for (const auto& k : contacts.contacts()) {
+        if (k.kind() == msg::CONTACT_OBSTACLE) continue;
+        force += k.force_n() * Eigen::Vector3d(k.normal().x(), k.normal().y(), k.normal().z());
+      }
+      current.force_n = force.allFinite() ? force.norm() : 0.0;
       return;
     }
     if (c.topic != "fahr/DeformationState") return;
     if (!common::decode_cdr<msg::DeformationStatePubSubType>(m.data, state)) return;
     if (state.body_id() != body) return;
-    const auto t = static_cast<std::int64_t>(m.log_time);
+    // The run's simulated time (lockstep: the clock's; real time: the wall's).
+    const std::int64_t t = state.header().sim_time_ns();
     if (t0 < 0) t0 = t;
     if (t < next) return;
     next = t + every_ns;
@@ -203,6 +212,7 @@ int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshe
       have_rest = true;
     }
     if (current.share > best.share || scored == 1) best = current;
+    if (current.force_n > pressed.force_n || scored == 1) pressed = current;
     last = current;
   });
   if (!report.valid()) {
@@ -213,14 +223,15 @@ int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshe
   std::printf("fahr_glottic_score: %s: %zu states scored every %.0f ms, %zu refused\n",
               path.c_str(), scored, every_ms, refused);
   const std::pair<const char*, const Moment*> moments[] = {
-      {"rest", &rest}, {"best", &best}, {"last", &last}};
+      {"rest", &rest}, {"pressed", &pressed}, {"best", &best}, {"last", &last}};
   for (const auto& [label, moment] : moments) {
     ViewInput in;
     in.eye_m = moment->world_from_tool * view.eye_in_tool_m;
     if (moment->has_tool) in.world_from_tool = moment->world_from_tool;
     in.deformable_positions.emplace_back(moment->tongue);
     char name[64];
-    std::snprintf(name, sizeof name, "%s (t %.2f s)", label, moment->t_s);
+    std::snprintf(name, sizeof name, "%s (t %.2f s, blade %.2f N)", label, moment->t_s,
+                  moment->force_n);
     print(name, compare(view, meshes, in), in);
     if (!png_prefix.empty()) {
       write_png(meshes, view.view.opening(), in, png_prefix + "_" + label + ".png");
@@ -242,7 +253,8 @@ int run(int argc, char** argv) {
   app.add_option("--recording", recording, "score the FEM states of this MCAP recording");
   app.add_option("--every-ms", every_ms, "score a recording this often")
       ->check(CLI::Range(1.0, 1e6));
-  app.add_option("--png-prefix", png_prefix, "a recording's pictures: PREFIX_rest/_best/_last.png");
+  app.add_option("--png-prefix", png_prefix,
+                 "a recording's pictures: PREFIX_rest/_pressed/_best/_last.png");
   CLI11_PARSE(app, argc, argv);
 
   const auto scene = scene::load_scene(scene_path);
