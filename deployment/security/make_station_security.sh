@@ -26,7 +26,8 @@
 #   replay          publishes DevicePose, ContactSet, DeformationState,
 #                   SceneDescription (a recorded run, or the gateway's poses in
 #                   a lockstep replay); never ForceCommand
-#   visualizer      publishes fahr/RemoteInput (the mouse as the device)
+#   visualizer      publishes fahr/RemoteInput (the mouse as the device) and
+#                   fahr/GlotticView (the glottic view score)
 #   lockstep_clock  publishes SimClock
 #   logger, fahr_run_summary, fahr_dds_check, fault_probe: publish nothing
 #   intruder        a valid identity allowed only ServiceStatus (tests: a
@@ -75,7 +76,7 @@ sign() {  # sign IN.xml OUT.p7s: S/MIME, clear text, signed by the CA
 }
 
 topics=(DevicePose ForceCommand ContactSet DeformationState SceneDescription ServiceStatus
-  ServiceEvents SimClock StepAck RemoteInput bench/ping bench/pong)
+  ServiceEvents SimClock StepAck GlotticView RemoteInput bench/ping bench/pong)
 reports=(ServiceStatus ServiceEvents StepAck)
 
 # Governance: who may join (only authenticated, permitted participants), and
@@ -177,7 +178,7 @@ identity haptic ForceCommand ContactSet SceneDescription "${reports[@]}"
 identity fem DeformationState "${reports[@]}"
 identity device_gateway DevicePose "${reports[@]}"
 identity replay DevicePose ContactSet DeformationState SceneDescription "${reports[@]}"
-identity visualizer RemoteInput "${reports[@]}"
+identity visualizer RemoteInput GlotticView "${reports[@]}"
 identity lockstep_clock SimClock "${reports[@]}"
 identity logger
 identity fahr_run_summary
