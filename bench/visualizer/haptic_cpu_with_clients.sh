@@ -6,10 +6,12 @@
 # the mouth, so every window sees the same tick), in every other window of
 # W seconds a Foxglove WebSocket client (tests/visualizer/js
 # foxglove_check.mjs, subscribed to every channel) and the page in Debian's
-# chromium (playwright-core, software WebGL) are connected. The haptic service's per-tick thread CPU comes from its
-# ServiceEvents tick spans, written by the run's fahr_run_summary
-# (--tick-spans) and split by the windows' wall-clock bounds; each window's
-# first 2 s (the clients starting or stopping) are left out.
+# chromium (playwright-core, software WebGL) are connected. The haptic
+# service's per-tick thread CPU comes from its ServiceEvents tick spans,
+# written by the run's fahr_run_summary (--tick-spans) and split by the
+# windows' wall-clock bounds: a window with clients begins a second after
+# both are connected and ends before they are stopped; one without begins
+# a second after the previous clients are gone.
 #
 #   bench/visualizer/haptic_cpu_with_clients.sh [BUILD_DIR] [--runs 2] [--seconds 70]
 #       [--window-s 8] [--markdown [FILE]]
@@ -40,7 +42,7 @@ while [ $# -gt 0 ]; do
     --markdown)
       if [ $# -gt 1 ] && [[ "$2" == *.md ]]; then markdown=(--markdown "$2"); shift 2
       else markdown=(--markdown); shift; fi ;;
-    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     -*) echo "haptic_cpu_with_clients: unknown flag '$1'" >&2; exit 2 ;;
     *) build=$(cd "$1" && pwd); shift ;;
   esac
@@ -76,19 +78,24 @@ cleanup() {
 trap cleanup EXIT
 port=8765
 
-# The page, open for SECONDS: how many deformation frames it drew.
+# The page in chromium until SIGINT: says "page: connected" once it draws
+# deformation frames, and at the end how many it drew since.
 page_client() {
-  (cd "$js" && node --input-type=module -e '
+  cd "$js" && exec node --input-type=module -e '
     import { chromium } from "playwright-core";
-    const [url, seconds] = process.argv.slice(1);
-    const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", headless: true,
+    const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", headless: true, handleSIGINT: false,
       args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist"] });
     const page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
-    await page.goto(url, { waitUntil: "load" });
-    await page.waitForTimeout(Number(seconds) * 1000);
-    const s = await page.evaluate(() => window.fahrStats);
-    console.log(`page: ${s.deformFrames} deformation frames, ${s.stateFrames} state frames`);
-    await browser.close();' "http://127.0.0.1:$port/" "$1")
+    await page.goto(process.argv[1], { waitUntil: "load" });
+    const frames = () => page.evaluate(() => window.fahrStats.deformFrames);
+    while ((await frames()) === 0) await page.waitForTimeout(100);
+    const first = await frames();
+    console.log("page: connected");
+    process.on("SIGINT", async () => {
+      console.log(`page: ${(await frames()) - first} deformation frames`);
+      await browser.close();
+      process.exit(0);
+    });' "http://127.0.0.1:$port/"
 }
 
 # One run: the visualizer, the demo with the summary writing tick spans,
@@ -119,25 +126,39 @@ one_run() {
   : >"$work/windows.txt"
   local i=0 from_ns to_ns page fox
   while [ $(($(date +%s) - run_start_s + window_s)) -le "$seconds" ]; do
-    from_ns=$(($(date +%s%N) + 2000000000))
     if [ $((i % 2)) -eq 1 ]; then
-      page_client "$window_s" >>"$work/clients.log" 2>&1 &
+      # The window begins once both clients are connected (chromium takes a
+      # few seconds to start on a loaded machine), and a second to settle.
+      (page_client) >"$work/page$i.log" 2>&1 &
       page=$!
-      node "$js/foxglove_check.mjs" "ws://127.0.0.1:$port" "$window_s" \
+      node "$js/foxglove_check.mjs" "ws://127.0.0.1:$port" $((window_s + 120)) \
         DevicePose,ForceCommand,ContactSet,DeformationState,SceneDescription,ServiceStatus \
-        >>"$work/clients.log" 2>&1 &
+        >"$work/foxglove$i.log" 2>&1 &
       fox=$!
+      local waited=0
+      while ! grep -q "^page: connected" "$work/page$i.log" && [ "$waited" -lt 600 ]; do
+        sleep 0.1
+        waited=$((waited + 1))
+      done
+      echo "window $i: the page connected after $((waited / 10)) s" >>"$work/clients.log"
+      sleep 1
+      from_ns=$(date +%s%N)
       sleep "$window_s"
       to_ns=$(date +%s%N)
+      kill -INT "$page" "$fox" 2>/dev/null || true
       wait "$page" "$fox" || true
+      cat "$work/page$i.log" >>"$work/clients.log"
       echo "$from_ns $to_ns with" >>"$work/windows.txt"
     else
+      # A second for the previous window's clients to be gone.
+      from_ns=$(($(date +%s%N) + 1000000000))
       sleep "$window_s"
       echo "$from_ns $(date +%s%N) without" >>"$work/windows.txt"
     fi
     i=$((i + 1))
   done
   wait "$run_pid" || { echo "haptic_cpu_with_clients: the run failed:" >&2; tail -n 20 "$work/run.log" >&2; exit 1; }
+  grep -h "window\|^page: [0-9]" "$work/clients.log" | sed "s/^/run $run: /" >&2
   kill -INT "$vis_pid"
   wait "$vis_pid" || true
   pids=()
@@ -179,8 +200,9 @@ for run in $(seq 1 "$runs"); do one_run "$run"; done
   echo
   echo "In each run fahr_visualizer ran for the whole ${seconds} s (the intubation script, then the blade"
   echo "at rest out of the mouth); after the script's first ${script_s} s a Foxglove WebSocket client (every"
-  echo "channel) and the page in chromium were connected in every other ${window_s} s window; each window's"
-  echo "first 2 s left out. Ticks from the haptic service's ServiceEvents tick spans, on $(nproc) cores."
+  echo "channel) and the page in chromium were connected in every other ${window_s} s window (measured from"
+  echo "a second after both were connected until they were stopped; without clients, from a second after"
+  echo "the previous ones were gone). Ticks from the haptic service's ServiceEvents tick spans, on $(nproc) cores."
   echo
   echo "| run | phase | ticks | ticks/s | CPU p50 us | CPU p99 us | CPU p99.9 us | CPU max us | wall p99.9 us |"
   echo "|---:|---|---:|---:|---:|---:|---:|---:|---:|"
