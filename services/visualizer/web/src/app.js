@@ -605,7 +605,9 @@ function frame() {
   controls.update();
   renderer.render(scene, camera);
   stats.tongueRect = tongueRect();
-  stats.ghostRect = tool && tool.ghost.visible ? screenRect(tool.box.clone().applyMatrix4(tool.ghost.matrix)) : null;
+  stats.ghostRect = tool && tool.ghost.visible
+    ? screenRect(tool.ghost.geometry.boundingBox.clone().applyMatrix4(tool.ghost.matrix))
+    : null;
   requestAnimationFrame(frame);
 }
 requestAnimationFrame(frame);
