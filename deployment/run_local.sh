@@ -10,7 +10,8 @@
 #                           [--mode realtime|lockstep] [--haptic-collision aist|triangle]
 #                           [--cpus-fem LIST] [--cpus-haptic LIST]
 #                           [--record FILE.mcap] [--record-decimate TOPIC=N] [--record-arg ARG]
-#                           [--replay FILE.mcap] [--security DIR]
+#                           [--replay FILE.mcap] [--security DIR] [--pace R]
+#                           [--summary-arg ARG]
 #
 # --record FILE.mcap: fahr_logger joins first and records every topic of the
 # run to FILE.mcap (FILE.mcap.part until it closes, after the services have
@@ -35,6 +36,11 @@
 # allows); the clock prints each service's output hash, the same on every
 # run and every vendor mix. No run summary then (wall-clock rates mean
 # nothing in lockstep); each service prints its own figures at the end.
+# --pace R (lockstep only): the clock lets simulated time run at most R
+# times as fast as wall time (1: real time at most, for a viewer); the
+# hashes stay the same.
+# --summary-arg ARG passes one more argument to fahr_run_summary (realtime;
+# repeatable), e.g. --summary-arg --tick-spans --summary-arg FILE.csv.
 #
 # --dds-<service> puts one service on another vendor (a mixed-vendor run);
 # the summary listens with --dds.
@@ -64,6 +70,8 @@ record=""
 record_extra=()
 replay=""
 security=""
+clock_extra=()
+summary_extra=()
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -84,7 +92,9 @@ while [ $# -gt 0 ]; do
     --record-arg) record_extra+=("$2"); shift 2 ;;
     --replay) replay="$2"; shift 2 ;;
     --security) security=$(cd "$2" && pwd); shift 2 ;;
-    -h|--help) sed -n '2,42p' "$0"; exit 0 ;;
+    --pace) clock_extra+=(--pace "$2"); shift 2 ;;
+    --summary-arg) summary_extra+=("$2"); shift 2 ;;
+    -h|--help) sed -n '2,52p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
@@ -113,6 +123,9 @@ needed=("$gateway" "$fem" "$haptic" "$summary")
 [ "$mode" = lockstep ] && needed+=("$clock")
 [ -n "$record" ] && needed+=("$logger")
 replayer="$build/tools/replay/fahr_replay"
+if [ ${#clock_extra[@]} -gt 0 ] && [ "$mode" != lockstep ]; then
+  echo "run_local: --pace needs --mode lockstep" >&2; exit 2
+fi
 if [ -n "$replay" ]; then
   [ "$mode" = lockstep ] || { echo "run_local: --replay needs --mode lockstep" >&2; exit 2; }
   needed+=("$replayer")
@@ -220,7 +233,8 @@ if [ "$mode" = lockstep ]; then
   gateway_pid=$!; pids+=("$gateway_pid")
   steps=$(awk "BEGIN { printf \"%d\", $duration_s * 1000 }")
   status=0
-  "$clock" --participants device_gateway,fem,haptic --steps "$steps" "${common[@]}" | tee "$logs/clock.log" || status=$?
+  "$clock" --participants device_gateway,fem,haptic --steps "$steps" "${common[@]}" "${clock_extra[@]}" \
+    | tee "$logs/clock.log" || status=$?
   for name in gateway haptic fem; do
     pid_var="${name}_pid"
     # The clock told them to stop; give them a moment to print their figures.
@@ -238,7 +252,7 @@ fi
 
 # The summary listens a little longer than the gateway runs, so it sees the
 # services' last reports.
-"$summary" --duration-s "$(awk "BEGIN { print $duration_s + 2 }")" "${common[@]}" \
+"$summary" --duration-s "$(awk "BEGIN { print $duration_s + 2 }")" "${common[@]}" "${summary_extra[@]}" \
   >"$logs/summary.md" 2>"$logs/summary.err" &
 summary_pid=$!; pids+=("$summary_pid")
 sleep 0.5  # the summary's readers match before the first DevicePose

@@ -5,8 +5,12 @@
 // runs were identical, bit for bit, whatever the load and the vendor.
 //
 //   fahr_lockstep_clock --participants device_gateway,fem,haptic --steps N
-//                       [--base-period-ms 1] [--stall-timeout-s 60]
+//                       [--base-period-ms 1] [--stall-timeout-s 60] [--pace R]
 //                       [--dds V] [--domain N] [--dds-profile F]
+//
+// --pace R: simulated time runs at most R times as fast as wall time (1.0:
+// no faster than real time, so a browser watching the run sees it at the
+// speed it happens); without it, as fast as the machine allows.
 //
 // Exit status: 0 when every step was granted and completed, 1 on a stall
 // (a participant made no progress within the timeout), 2 on bad flags.
@@ -32,6 +36,7 @@ int run(int argc, char** argv) {
   std::uint64_t steps = 0;
   double base_period_ms = 1.0;
   double stall_timeout_s = 60.0;
+  double pace = 0.0;
   app.add_option("--participants", participants_csv,
                  "comma-separated lockstep names (device_gateway, fem, haptic)")
       ->required();
@@ -39,6 +44,9 @@ int run(int argc, char** argv) {
   app.add_option("--base-period-ms", base_period_ms, "simulated time of one base step, ms")
       ->check(CLI::PositiveNumber);
   app.add_option("--stall-timeout-s", stall_timeout_s, "fail when nothing progresses this long")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--pace", pace,
+                 "at most this many simulated seconds per wall second (default: unpaced)")
       ->check(CLI::PositiveNumber);
   app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds, inprocess");
   app.add_option("--domain", domain, "DDS domain id 0-230");
@@ -68,7 +76,7 @@ int run(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     const auto result = coordinator.run(
         names, steps,
-        std::chrono::milliseconds(static_cast<std::int64_t>(stall_timeout_s * 1000.0)));
+        std::chrono::milliseconds(static_cast<std::int64_t>(stall_timeout_s * 1000.0)), pace);
     const double wall_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("lockstep_clock: %s after %llu of %llu steps, %.2f s wall (%.2fx real time)\n",

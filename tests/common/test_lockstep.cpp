@@ -49,7 +49,7 @@ std::map<std::string, std::uint64_t> run_processes(Vendor coordinator_vendor, Ve
   return result.hashes;
 }
 
-std::map<std::string, std::uint64_t> run_in_process(std::uint32_t jitter_seed) {
+std::map<std::string, std::uint64_t> run_in_process(std::uint32_t jitter_seed, double pace = 0.0) {
   common::TransportConfig config;
   config.vendor = Vendor::kInProcess;
   config.domain_id = 40 + jitter_seed;
@@ -63,7 +63,7 @@ std::map<std::string, std::uint64_t> run_in_process(std::uint32_t jitter_seed) {
   auto slow = std::async(std::launch::async, [&] {
     return run_lockstep_participant(slow_participant, "slow", jitter_seed);
   });
-  const auto result = coordinator.run({"fast", "slow"}, kSteps, 20s);
+  const auto result = coordinator.run({"fast", "slow"}, kSteps, 20s, pace);
   EXPECT_TRUE(result.completed);
   EXPECT_EQ(fast.get(), result.hashes.at("fast"));
   EXPECT_EQ(slow.get(), result.hashes.at("slow"));
@@ -97,6 +97,26 @@ TEST(Lockstep, HashesAreBitIdenticalAcrossRunsAndVendors) {
                 static_cast<unsigned long long>(hashes.count("fast") ? hashes.at("fast") : 0),
                 static_cast<unsigned long long>(hashes.count("slow") ? hashes.at("slow") : 0));
   }
+}
+
+// --pace for a viewer: step k is granted no earlier than k base periods /
+// pace after step 0, so 2000 steps of 1 ms at pace 2 take at least 1 s of
+// wall time (unpaced, the in-process run takes a few tens of ms); pacing
+// only delays grants, so the hashes are the unpaced run's.
+TEST(Lockstep, PaceHoldsSimulatedTimeToAMultipleOfWallTime) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto unpaced = run_in_process(0);
+  const double unpaced_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto paced_start = std::chrono::steady_clock::now();
+  const auto paced = run_in_process(0, 2.0);
+  const double paced_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - paced_start).count();
+  std::printf("lockstep %llu steps of 1 ms: unpaced %.3f s, at pace 2 %.3f s wall\n",
+              static_cast<unsigned long long>(kSteps), unpaced_s, paced_s);
+  const double floor_s = static_cast<double>(kSteps - 1) * 1e-3 / 2.0;
+  EXPECT_GE(paced_s, floor_s);
+  EXPECT_EQ(paced, unpaced);
 }
 
 }  // namespace

@@ -11,17 +11,33 @@
 #           decodes DevicePose, ForceCommand, ContactSet, DeformationState,
 #           SceneDescription and ServiceStatus with the advertised omgidl
 #           schemas, and its client publishing is refused.
-# browser:  a realtime run; Debian's chromium (playwright-core) opens the page:
-#           scene, tongue vertices updating at the display rate, force arrow,
-#           pixels in the tongue's bounds changing, no console error;
-#           screenshots (browser_check.mjs's "lost" mode also waits for the
-#           grey device blade; no scripted run loses track reliably yet).
-# replay:   a lockstep run recorded by fahr_logger, replayed by the visualizer
-#           (indexed seeks) in the page; a seek and a pause are exercised.
+# browser:  a lockstep run of the intubation script paced to real time at
+#           most (run_local.sh --pace 1, so the page sees it as it would
+#           happen); Debian's chromium (playwright-core) opens the page
+#           before the run starts: tongue vertices updating at the display
+#           rate, force arrow, pixels in the tongue's bounds differing
+#           between the rest frame and a pressed one, no console error.
+# replay:   a lockstep run of the overshoot script on a 100 kPa tongue
+#           (the shipped 10 kPa one yields and never reaches the device's
+#           limit: bench/results/amd-epyc-2c/overshoot.md, overshoot-100kpa.md),
+#           recorded by fahr_logger, replayed by the visualizer (indexed
+#           seeks) in the page: paused in the hand's first second, the rest
+#           frame against tests/visualizer/reference/rest_side.png within
+#           the tolerance of js/image_compare.mjs, and two perturbed frames
+#           (camera turned 3 mm, tongue colours 10 % off) outside it; played,
+#           and paused again once the device has lost track: the grey device
+#           blade's pixels change when its toggle hides it; a seek and a
+#           pause exercised.
 # remote:   the gateway on --backend remote and the visualizer with
 #           --allow-remote-input: poses sent as the page's mouse device
 #           reach the gateway (its DevicePose follows them, clamped).
-# FAHR_KEEP_SCREENSHOTS=DIR keeps the PNGs. Runs inside a loopback-only
+# FAHR_KEEP_SCREENSHOTS=DIR keeps the PNGs (live_rest, lost_track,
+# live_later, live_blade_view, replay_rest, replay_early, replay_later)
+# and the JSON.
+# FAHR_UPDATE_REFERENCE=1 (replay mode) writes the rest frame to
+# tests/visualizer/reference/rest_side.png instead of comparing: after a
+# change to the page's drawing or the scene, or on another chromium; look
+# at the new PNG before committing it. Runs inside a loopback-only
 # network namespace (tests/run_in_netns.sh). Exit 77 only if node, npm or
 # chromium is absent.
 set -euo pipefail
@@ -51,7 +67,11 @@ pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
-  if [ -n "${FAHR_KEEP_SCREENSHOTS:-}" ]; then mkdir -p "$FAHR_KEEP_SCREENSHOTS"; cp "$out"/*.png "$out"/*.json "$FAHR_KEEP_SCREENSHOTS/" 2>/dev/null || true; fi
+  if [ -n "${FAHR_KEEP_SCREENSHOTS:-}" ]; then
+    mkdir -p "$FAHR_KEEP_SCREENSHOTS"
+    cp "$out"/*.png "$out"/*.json "$FAHR_KEEP_SCREENSHOTS/" 2>/dev/null || true
+    cp -r "$out/logs" "$FAHR_KEEP_SCREENSHOTS/" 2>/dev/null || true
+  fi
   rm -rf "$out"
 }
 trap cleanup EXIT
@@ -88,24 +108,33 @@ case "$mode" in
     ;;
   browser)
     start_visualizer --dds cyclonedds --domain 42
-    start_run 30 intubation
-    # The watch begins with the gateway's script: run_local.sh starts the
-    # gateway once the FEM and haptic services are set up (6 s on a calm
-    # machine, 15 s on a loaded one), and the blade reaches the tongue about
-    # 3 s into the script.
-    for _ in $(seq 1200); do [ -s "$out/logs/gateway.log" ] && break; sleep 0.1; done
-    [ -s "$out/logs/gateway.log" ] || { echo "visualizer_run_test: the run's gateway never started" >&2; cat "$out/run.log" >&2; exit 1; }
-    node "$js/browser_check.mjs" "$url" "$out" 14 live | tee "$out/browser.json"
+    # 7 s of the intubation script: the blade reaches the tongue about 3 s
+    # in and presses from 5 s. The page is open before the clock grants
+    # step 0 (run_local.sh starts it once the services are set up, 6-15 s),
+    # so it sees the rest frame.
+    bash "$repo/deployment/run_local.sh" "$build" --dds cyclonedds --domain 42 --mode lockstep \
+      --pace 1 --script intubation --duration-s 7 >"$out/run.log" 2>&1 &
+    pids+=($!)
+    node "$js/browser_check.mjs" "$url" "$out" 90 live | tee "$out/browser.json"
     stop_visualizer
     ;;
   replay)
+    # The overshoot script: the hand presses at 4.5 s and pushes past the
+    # limit from 5.5 s; the 100 kPa tongue holds, the device loses track.
+    # Paced, so the recording's clock never runs behind simulated time and
+    # the page can pause in the hand's first second.
+    sed -e 's#youngs_modulus_pa: 10000$#youngs_modulus_pa: 100000#' -e "s#\.\./\.\./meshes/#$repo/meshes/#g" \
+      "$repo/deployment/scenes/neonatal_intubation.yaml" >"$out/stiff_tongue.yaml"
+    grep -q "youngs_modulus_pa: 100000" "$out/stiff_tongue.yaml" || { echo "visualizer_run_test: the scene's modulus line moved" >&2; exit 1; }
     bash "$repo/deployment/run_local.sh" "$build" --dds cyclonedds --domain 42 --mode lockstep \
-      --duration-s 7 --record "$out/run.mcap" >"$out/run.log" 2>&1 || {
+      --script overshoot --scene "$out/stiff_tongue.yaml" --duration-s 7 --pace 1 --record "$out/run.mcap" \
+      >"$out/run.log" 2>&1 || {
       echo "visualizer_run_test: the recorded run failed:" >&2; tail -n 30 "$out/run.log" >&2; exit 1; }
-    # The blade reaches the tongue about 3 s into the script: 7 s recorded,
-    # played from its start at full speed, watched to its end.
+    # 7 s recorded, played from its start at full speed after the rest
+    # frame, watched until the device has lost track (about 5.3 s in).
     start_visualizer --replay "$out/run.mcap" --speed 1
-    node "$js/browser_check.mjs" "$url" "$out" 4 replay | tee "$out/replay.json"
+    node "$js/browser_check.mjs" "$url" "$out" 10 replay "$repo/tests/visualizer/reference/rest_side.png" \
+      | tee "$out/replay.json"
     # Seek to the middle and pause: the position must follow.
     (cd "$js" && node --input-type=module -e '
       import WebSocket from "ws";

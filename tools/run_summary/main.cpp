@@ -8,6 +8,11 @@
 // comes back as another participant was restarted.
 //
 //   fahr_run_summary --duration-s S [--dds V] [--domain N] [--dds-profile F]
+//                    [--tick-spans FILE]
+//
+// --tick-spans FILE: also writes every tick span the services report
+// (ServiceEvents: a service's per-tick wall start, wall duration and thread
+// CPU time) to FILE as CSV, so a bench can split one run's ticks by time.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -15,6 +20,7 @@
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
@@ -193,8 +199,23 @@ int main(int argc, char** argv) try {
   app.add_option("--security", security,
                  "DDS Security: the station's folder "
                  "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
+  std::string spans_path;
+  app.add_option("--tick-spans", spans_path,
+                 "write every reported tick span to this CSV file "
+                 "(service,tick,start_ns,duration_ns,cpu_ns)");
   CLI11_PARSE(app, argc, argv);
   common::install_stop_handlers();
+  // Closed at exit; written under the tally's mutex, off every service's loop.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> spans_file(nullptr, &std::fclose);
+  if (!spans_path.empty()) {
+    spans_file.reset(std::fopen(spans_path.c_str(), "w"));
+    if (!spans_file) {
+      std::fprintf(stderr, "fahr_run_summary: --tick-spans: cannot write '%s'\n",
+                   spans_path.c_str());
+      return 2;
+    }
+    std::fprintf(spans_file.get(), "service,tick,start_ns,duration_ns,cpu_ns\n");
+  }
   try {
     common::Participant participant(
         common::transport_config_from(dds, domain, profile, "fahr_run_summary", security));
@@ -245,6 +266,16 @@ int main(int argc, char** argv) try {
         [&](const msg::ServiceEvents& e, const common::SampleInfo&) {
           std::lock_guard lock(tally.mutex);
           auto& t = tally.services[e.service_name().to_string()];
+          if (spans_file) {
+            for (const auto& span : e.tick_spans()) {
+              std::fprintf(spans_file.get(), "%s,%llu,%lld,%lld,%lld\n",
+                           e.service_name().to_string().c_str(),
+                           static_cast<unsigned long long>(span.tick()),
+                           static_cast<long long>(span.start_ns()),
+                           static_cast<long long>(span.duration_ns()),
+                           static_cast<long long>(span.cpu_ns()));
+            }
+          }
           for (const auto& q : e.qos_events())
             t.qos_events[q.kind()] += std::max(q.total_count_change(), 0);
           if (!e.errors().empty() &&

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#include <thread>
 
 #include "contact_setPubSubTypes.h"
 #include "deformation_statePubSubTypes.h"
@@ -93,7 +94,8 @@ void LockstepCoordinator::grant(std::uint64_t step, bool stop) {
 
 LockstepCoordinator::Result LockstepCoordinator::run(const std::vector<std::string>& participants,
                                                      std::uint64_t total_steps,
-                                                     std::chrono::milliseconds stall_timeout) {
+                                                     std::chrono::milliseconds stall_timeout,
+                                                     double pace) {
   Result result;
   auto all_through = [&](std::int64_t step) {
     return std::all_of(participants.begin(), participants.end(), [&](const std::string& name) {
@@ -103,8 +105,16 @@ LockstepCoordinator::Result LockstepCoordinator::run(const std::vector<std::stri
   };
   std::unique_lock lock(mutex_);
   if (!changed_.wait_for(lock, stall_timeout, [&] { return all_through(-1); })) return result;
+  const auto paced_start = std::chrono::steady_clock::now();
   for (std::uint64_t step = 0; step < total_steps; ++step) {
     lock.unlock();
+    if (pace > 0.0) {
+      // Step k's simulated start, k base periods, in wall time at this pace.
+      const auto due = std::chrono::duration<double, std::nano>(
+          static_cast<double>(step) * static_cast<double>(base_period_.count()) / pace);
+      std::this_thread::sleep_until(
+          paced_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(due));
+    }
     grant(step, false);
     lock.lock();
     if (!changed_.wait_for(lock, stall_timeout,

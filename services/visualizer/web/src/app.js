@@ -12,7 +12,7 @@ const DEFORM_FRAME = 2;
 const STRAIN_FULL_SCALE = 0.3; // the colour map's top, Green strain
 const FORCE_ARROW_M_PER_N = 0.006;
 
-// What tests read (tests/visualizer/browser_test.mjs).
+// What tests read (tests/visualizer/js/browser_check.mjs).
 const stats = {
   connected: false,
   hello: null,
@@ -22,6 +22,7 @@ const stats = {
   deformTimes: [],
   positionsChecksum: 0,
   deformSimTime: 0, // the FEM's simulated time of the last deformation frame, s
+  stateSimTime: 0, // the simulated time of the last ForceCommand (the blade's pose), s
   maxStrain: 0,
   arrowVisible: false,
   ghostVisible: false,
@@ -31,6 +32,7 @@ const stats = {
   replay: null,
   refusals: [],
   tongueRect: null,
+  ghostRect: null, // the grey device blade's projected bounds while drawn, canvas pixels
   bodies: [],
   glottic: null, // the newest GlotticView: percent, force_n, peak_force_n, eye, target
   camera: "overview",
@@ -75,7 +77,7 @@ const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 1, 0), new THREE.Vector
 arrow.visible = false;
 scene.add(arrow);
 
-const show = { anatomy: true, spheres: false, contacts: true, arrow: true };
+const show = { anatomy: true, spheres: false, contacts: true, arrow: true, ghost: true };
 
 // Strain -> colour: blue, cyan, green, yellow, red over [0, full scale].
 const ramp = [
@@ -348,13 +350,14 @@ function applyState(s) {
     tool.proxy.matrix.copy(poseMatrix(cmd.proxy.p, cmd.proxy.q));
     tool.proxy.matrixWorldNeedsUpdate = true;
     stats.lostTrack = cmd.lost_track;
+    stats.stateSimTime = cmd.t;
     if (cmd.lost_track && dev) {
       tool.ghost.matrix.copy(poseMatrix(dev.pose.p, dev.pose.q));
       tool.ghost.matrixWorldNeedsUpdate = true;
     }
-    tool.ghost.visible = !!cmd.lost_track && !!dev;
+    tool.ghost.visible = !!cmd.lost_track && !!dev && show.ghost;
     stats.ghostVisible = tool.ghost.visible;
-    document.getElementById("lost").style.display = tool.ghost.visible ? "block" : "none";
+    document.getElementById("lost").style.display = cmd.lost_track ? "block" : "none";
   }
   if (cmd) {
     const f = new THREE.Vector3(...cmd.force);
@@ -452,6 +455,8 @@ for (const key of Object.keys(show)) {
     updateSphereVisibility();
     for (const e of bodies.values()) if (e.role === 2) e.meshes.forEach((m) => (m.visible = show.anatomy));
     if (!show.arrow) arrow.visible = false;
+    if (tool) tool.ghost.visible = show.ghost && stats.lostTrack;
+    stats.ghostVisible = !!tool && tool.ghost.visible;
   };
   document.getElementById("toggles").appendChild(b);
 }
@@ -572,19 +577,27 @@ window.addEventListener("keyup", (e) => {
 });
 
 // --- drawing -------------------------------------------------------------------
+// A world-frame box's projected bounds on the canvas, pixels.
+function screenRect(b) {
+  let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+  for (const x of [b.min.x, b.max.x]) for (const y of [b.min.y, b.max.y]) for (const z of [b.min.z, b.max.z]) {
+    const v = new THREE.Vector3(x, y, z).project(camera);
+    const px = ((v.x + 1) / 2) * renderer.domElement.width;
+    const py = ((1 - v.y) / 2) * renderer.domElement.height;
+    x0 = Math.min(x0, px); y0 = Math.min(y0, py); x1 = Math.max(x1, px); y1 = Math.max(y1, py);
+  }
+  // Clipped to the canvas: a long body (the blade's handle) runs off it.
+  x0 = Math.max(0, x0);
+  y0 = Math.max(0, y0);
+  x1 = Math.min(renderer.domElement.width, x1);
+  y1 = Math.min(renderer.domElement.height, y1);
+  return { x: x0, y: y0, w: Math.max(0, x1 - x0), h: Math.max(0, y1 - y0) };
+}
 function tongueRect() {
   for (const e of bodies.values()) {
     if (e.role !== 0) continue;
     e.geometry.computeBoundingBox();
-    const b = e.geometry.boundingBox;
-    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
-    for (const x of [b.min.x, b.max.x]) for (const y of [b.min.y, b.max.y]) for (const z of [b.min.z, b.max.z]) {
-      const v = new THREE.Vector3(x, y, z).project(camera);
-      const px = ((v.x + 1) / 2) * renderer.domElement.width;
-      const py = ((1 - v.y) / 2) * renderer.domElement.height;
-      x0 = Math.min(x0, px); y0 = Math.min(y0, py); x1 = Math.max(x1, px); y1 = Math.max(y1, py);
-    }
-    return { x: Math.max(0, x0), y: Math.max(0, y0), w: x1 - Math.max(0, x0), h: y1 - Math.max(0, y0) };
+    return screenRect(e.geometry.boundingBox);
   }
   return null;
 }
@@ -592,6 +605,9 @@ function frame() {
   controls.update();
   renderer.render(scene, camera);
   stats.tongueRect = tongueRect();
+  stats.ghostRect = tool && tool.ghost.visible
+    ? screenRect(tool.ghost.geometry.boundingBox.clone().applyMatrix4(tool.ghost.matrix))
+    : null;
   requestAnimationFrame(frame);
 }
 requestAnimationFrame(frame);

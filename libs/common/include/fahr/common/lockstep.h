@@ -64,9 +64,13 @@ class LockstepCoordinator {
   // Waits until the named participants have joined, grants steps
   // 0 .. total_steps-1 in order, then tells everyone to stop. Fails (returns
   // completed = false) if a participant makes no progress within
-  // `stall_timeout`.
+  // `stall_timeout`. `pace` > 0 holds step k back until k base periods /
+  // pace of wall time have passed since step 0 (1.0: no faster than real
+  // time, for a viewer watching the run); 0 grants as fast as the
+  // participants complete. Pacing only delays grants: the outputs, and so
+  // the hashes, are the same.
   Result run(const std::vector<std::string>& participants, std::uint64_t total_steps,
-             std::chrono::milliseconds stall_timeout);
+             std::chrono::milliseconds stall_timeout, double pace = 0.0);
 
  private:
   void on_ack(const msg::StepAck& ack);
