@@ -168,6 +168,7 @@ TEST(GlotticViewService, ScoresTheNewestStateFromTheEyeOnTheBladeAndRefusesBadSt
   EXPECT_NEAR(view->eye_m().y(), eye.y(), 1e-9);
   EXPECT_NEAR(view->tool_force_n(), std::sqrt(5.0), 1e-9);  // |(2, 1, 0)| N
   EXPECT_NEAR(view->peak_tool_force_n(), std::sqrt(5.0), 1e-9);
+  EXPECT_FALSE(service.update());  // nothing new: no second view of the same geometry
 
   // The blade where the scene starts it: the eye behind the lips sees none
   // of the opening; a smaller force keeps the peak.

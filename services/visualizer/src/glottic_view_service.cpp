@@ -39,6 +39,7 @@ struct GlotticViewService::Impl {
   std::optional<common::Publisher<msg::GlotticView>> publisher;
   // Scratch, kept between views.
   std::vector<Slot> slots;
+  std::vector<std::uint64_t> seen;                      // slot versions already read
   std::vector<std::vector<Eigen::Vector3d>> positions;  // per soft body
   std::vector<bool> have_state;
   msg::DeformationState state;
@@ -54,15 +55,23 @@ struct GlotticViewService::Impl {
   Stats stats;
 
   // Reads the changed slots; false if a soft body's state was refused.
-  bool read_slots();
+  // `changed`: a new FEM state or ContactSet was read.
+  bool read_slots(bool& changed);
   void read_contacts(const msg::ContactSet& set);
 };
 
-bool GlotticViewService::Impl::read_slots() {
+bool GlotticViewService::Impl::read_slots(bool& changed) {
   bool ok = true;
+  changed = false;
+  if (seen.size() < slots.size()) seen.resize(slots.size(), 0);
   live.collect(slots);
-  for (const Slot& slot : slots) {
+  seen.resize(slots.size(), 0);
+  for (std::size_t s = 0; s < slots.size(); ++s) {
+    const Slot& slot = slots[s];
+    if (slot.version == seen[s]) continue;
+    seen[s] = slot.version;
     if (slot.bytes.empty()) continue;
+    if (slot.topic == kContactSet || slot.topic == kDeformationState) changed = true;
     if (slot.topic == kContactSet) {
       if (common::decode_cdr<msg::ContactSetPubSubType>(slot.bytes, contacts))
         read_contacts(contacts);
@@ -139,10 +148,14 @@ void GlotticViewService::stop() {
 
 bool GlotticViewService::update() {
   Impl& m = *impl_;
-  if (!m.read_slots()) {
+  bool changed = false;
+  if (!m.read_slots(changed)) {
     std::lock_guard lock(m.mutex);
     ++m.stats.refused;
   }
+  // The same geometry gives the same view: none until something moved (a
+  // paused replay, a sleeping tongue with the blade away).
+  if (!changed) return false;
   for (const bool have : m.have_state) {
     if (!have) return false;
   }

@@ -22,7 +22,7 @@ const stats = {
   deformTimes: [],
   positionsChecksum: 0,
   deformSimTime: 0, // the FEM's simulated time of the last deformation frame, s
-  stateSimTime: 0, // the simulated time of the last ForceCommand (the blade's pose), s
+  stateSimTime: -1, // the newest state frame's ForceCommand's simulated time, s; -1: none
   maxStrain: 0,
   arrowVisible: false,
   ghostVisible: false,
@@ -346,11 +346,15 @@ function applyState(s) {
   const dev = s.device[0];
   const limit = dev ? dev.limit_n : 0;
   stats.limitN = limit;
+  // No ForceCommand (before the first, or after a replay's seek): the
+  // blade's pose is unknown, and it is not drawn rather than drawn at the
+  // world's origin.
+  if (tool) tool.proxy.visible = !!cmd;
+  stats.stateSimTime = cmd ? cmd.t : -1;
   if (tool && cmd) {
     tool.proxy.matrix.copy(poseMatrix(cmd.proxy.p, cmd.proxy.q));
     tool.proxy.matrixWorldNeedsUpdate = true;
     stats.lostTrack = cmd.lost_track;
-    stats.stateSimTime = cmd.t;
     if (cmd.lost_track && dev) {
       tool.ghost.matrix.copy(poseMatrix(dev.pose.p, dev.pose.q));
       tool.ghost.matrixWorldNeedsUpdate = true;
@@ -444,20 +448,26 @@ for (const name of ["overview", "side", "top", "front", "blade"]) {
   b.onclick = () => setCamera(name);
   document.getElementById("cameras").appendChild(b);
 }
+const toggleButtons = {};
+function setShow(key, on) {
+  if (!(key in show)) return;
+  show[key] = on;
+  toggleButtons[key].className = on ? "on" : "";
+  sphereGroup.visible = show.spheres;
+  updateSphereVisibility();
+  for (const e of bodies.values()) if (e.role === 2) e.meshes.forEach((m) => (m.visible = show.anatomy));
+  if (!show.arrow) arrow.visible = false;
+  if (!show.contacts) contactGroup.clear();
+  if (tool) tool.ghost.visible = show.ghost && stats.lostTrack;
+  stats.ghostVisible = !!tool && tool.ghost.visible;
+}
+window.fahrShow = setShow; // what the buttons do, for tests
 for (const key of Object.keys(show)) {
   const b = document.createElement("button");
   b.textContent = key;
   b.className = show[key] ? "on" : "";
-  b.onclick = () => {
-    show[key] = !show[key];
-    b.className = show[key] ? "on" : "";
-    sphereGroup.visible = show.spheres;
-    updateSphereVisibility();
-    for (const e of bodies.values()) if (e.role === 2) e.meshes.forEach((m) => (m.visible = show.anatomy));
-    if (!show.arrow) arrow.visible = false;
-    if (tool) tool.ghost.visible = show.ghost && stats.lostTrack;
-    stats.ghostVisible = !!tool && tool.ghost.visible;
-  };
+  b.onclick = () => setShow(key, !show[key]);
+  toggleButtons[key] = b;
   document.getElementById("toggles").appendChild(b);
 }
 document.getElementById("strainmax").textContent = STRAIN_FULL_SCALE.toFixed(2);

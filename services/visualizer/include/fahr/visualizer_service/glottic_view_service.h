@@ -33,9 +33,11 @@ class GlotticViewService {
   void start();
   void stop();
 
-  // One view from the newest samples in the store; false when there is no
-  // FEM state of every soft body yet, or it was refused (non-finite, wrong
-  // node count). The thread calls it; tests call it directly.
+  // One view from the newest samples in the store; false when no FEM state
+  // or ContactSet arrived since the last view (the same geometry, the same
+  // view), when a soft body has no FEM state yet, or when it was refused
+  // (non-finite, wrong node count). The thread calls it; tests call it
+  // directly.
   bool update();
 
   struct Stats {
