@@ -24,7 +24,6 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
-#include <map>
 #include <sstream>
 #include <string>
 #include <vector>

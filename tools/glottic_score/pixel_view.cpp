@@ -57,7 +57,7 @@ TriangleMesh deformed(const std::vector<std::array<int, 3>>& boundary,
   return m;
 }
 
-// Draws everything but the opening; `colours` false: one grey (counting only).
+// Draws everything but the opening, all with id 0.
 void draw_occluders(scene_render::Rasterizer& r, const SceneMeshes& meshes, const ViewInput& in) {
   for (const auto& body : meshes.rigid) {
     const Vec3 colour = body.name.find("larynx") != std::string::npos ? Vec3(0.45, 0.60, 0.90)
