@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
   const std::vector<std::pair<std::string, Vec3>> rigid = {
       {"palate", Vec3(0.93, 0.88, 0.74)},
       {"jaw", Vec3(0.90, 0.85, 0.70)},
+      {"hyoid", Vec3(0.88, 0.82, 0.62)},
       {"lips_face", Vec3(0.96, 0.76, 0.66)},
       {"larynx_trachea", Vec3(0.45, 0.60, 0.90)}};
   std::map<std::string, TriangleMesh> meshes;

@@ -34,15 +34,48 @@ struct PalateParameters {
   double top_y_mm = 17.0;       // top of the (solid) maxilla block
 };
 
+// The mandible as a U-shaped bar seen from above: its outer (labial) and
+// inner (lingual) faces are elliptic arcs about one centre on the mid-line,
+// from one gonial angle round the chin to the other. The floor of the mouth
+// (part of the tongue's FEM body) spans the inside of the arch.
 struct JawParameters {
-  double front_x_mm = -1.0;  // labial face of the lower gum ridge
-  double length_mm = 34.0;   // chin to gonial angle along x
-  double front_half_width_mm = 10.0;
-  double back_half_width_mm = 31.8;        // half the intergonial width
-  double ridge_y_mm = -5.5;                // crest of the lower gum ridge
-  double bottom_y_mm = -24.0;              // inferior border of the mandible
-  double floor_gap_mm = 0.4;               // clearance below the tongue's attachment plane
-  double wall_inner_half_width_mm = 14.5;  // inner face of the mandibular bodies
+  double front_x_mm = -1.0;           // labial face of the chin and lower gum ridge
+  double length_mm = 34.0;            // chin to the intergonial line along x (outer arch)
+  double back_half_width_mm = 31.8;   // half the intergonial width (outer arch at its ends)
+  double ridge_y_mm = -5.5;           // crest of the lower gum ridge
+  double bottom_y_mm = -24.0;         // inferior border of the mandible
+  double symphysis_top_mm = 4.5;      // chin thickness at the gum ridge, labial to lingual
+  double symphysis_bottom_mm = 11.0;  // ... at the inferior border (the lingual face slopes back)
+  double body_thickness_mm = 12.0;    // mandibular body at the gonial angle, across
+  double lingual_drop_mm = 2.0;       // lingual edge of the top below the crest
+};
+
+// Floor of the mouth (mylohyoid, geniohyoid, sublingual tissue): a slab under
+// the tongue's attachment plane, inside the mandible's arch and over the
+// hyoid. Meshed with the tongue as one body; fixed only where it meets bone.
+struct FloorParameters {
+  double thickness_mm = 4.0;         // under the tongue's attachment plane
+  double bone_gap_mm = 0.3;          // clearance to the mandible and the hyoid at rest
+  double tongue_overlap_mm = 1.0;    // the tongue reaches this far below its plane into the floor
+  double top_above_plane_mm = 1.5;   // floor's top above the tongue's plane: the tongue's
+                                     // underside runs < 1 mm above the plane near the tip
+  double back_x_mm = -47.0;          // posterior edge, over the hyoid's greater horns
+  double back_half_width_mm = 10.5;  // half width at the posterior edge
+  double taper_start_x_mm = -28.0;   // behind this the floor narrows towards the hyoid
+  double attachment_band_mm = 1.2;   // boundary nodes this close to bone are fixed
+  double tongue_drop_mm = 2.0;       // the tongue is drawn down this far onto the floor
+  double edge_round_mm = 3.0;        // the floor's edges are rounded over about this
+  double junction_fillet_mm = 3.0;   // fillet where the tongue's sides meet the floor
+};
+
+// Hyoid: a small U-shaped bar (body in front, greater horns running back),
+// right under the floor's posterior part; its top follows the floor.
+struct HyoidParameters {
+  double front_x_mm = -38.0;   // anterior face of the body
+  double length_mm = 11.0;     // body front to the tips of the greater horns
+  double half_span_mm = 10.0;  // half the distance between the horn tips (outer)
+  double thickness_mm = 3.0;   // bar thickness across
+  double height_mm = 3.0;      // bar height
 };
 
 struct FaceParameters {
@@ -90,6 +123,8 @@ struct SceneParameters {
   TongueParameters tongue;
   PalateParameters palate;
   JawParameters jaw;
+  FloorParameters floor;
+  HyoidParameters hyoid;
   FaceParameters face;
   AirwayParameters airway;
   BladeParameters miller0;
