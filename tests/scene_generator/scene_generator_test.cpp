@@ -33,14 +33,17 @@ using fahr::scenegen::TriangleMesh;
 #error "FAHR_SCENE_GENERATOR must name the generator executable"
 #endif
 
-const std::vector<std::string> kSceneFiles = {"tongue.node", "tongue.ele",
-                                              "tongue.face", "tongue_fixed_nodes.txt",
-                                              "palate.obj",  "jaw.obj",
-                                              "hyoid.obj",   "lips_face.obj",
-                                              "miller0.obj", "larynx_trachea.obj",
-                                              "miller1.obj", "scene_parameters.txt"};
-const std::vector<std::string> kSurfaces = {"palate",         "jaw",     "hyoid",  "lips_face",
-                                            "larynx_trachea", "miller0", "miller1"};
+const std::vector<std::string> kSceneFiles = {"tongue.node",     "tongue.ele",
+                                              "tongue.face",     "tongue_fixed_nodes.txt",
+                                              "palate.obj",      "jaw.obj",
+                                              "hyoid.obj",       "lips_face.obj",
+                                              "miller0.obj",     "larynx_trachea.obj",
+                                              "miller1.obj",     "scene_parameters.txt",
+                                              "soft_palate.obj", "epiglottis.obj",
+                                              "pharynx.obj"};
+const std::vector<std::string> kSurfaces = {
+    "palate",     "jaw",         "hyoid",   "lips_face", "larynx_trachea",
+    "epiglottis", "soft_palate", "pharynx", "miller0",   "miller1"};
 constexpr double kMetresPerMm = 1e-3;
 constexpr double kSdfCellM = 1e-3;  // the 1 mm cell the haptic and AIST code use
 

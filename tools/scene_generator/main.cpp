@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fahr/scenegen/airway_surfaces.h"
 #include "fahr/scenegen/anatomy_surfaces.h"
 #include "fahr/scenegen/blade_poses.h"
 #include "fahr/scenegen/laryngoscope_blade.h"
@@ -74,6 +75,61 @@ Clearance clearance(const std::vector<Vec3>& points, const TriangleMesh& surface
         std::min(c.min_distance_mm, fahr::scenegen::distance_to_surface(surface, p));
   }
   return c;
+}
+
+// Posterior-most x of `solid` on the mid-line at height y (a scan from behind).
+double back_of(const fahr::scenegen::ImplicitSolid& solid, double y_mm) {
+  constexpr double kStepMm = 0.02;
+  for (double x = solid.lower_bound().x(); x < solid.upper_bound().x(); x += kStepMm) {
+    if (solid.value(Vec3(x, y_mm, 0.0)) < 0.0) return x;
+  }
+  return std::nan("");
+}
+
+// The landmark distances a published mid-sagittal neonatal airway gives,
+// measured on the generated scene (meshes/neonatal/README.md compares them).
+void print_landmarks(const fahr::scenegen::SceneParameters& p,
+                     const fahr::scenegen::TongueFloorShape& body,
+                     const std::map<std::string, TriangleMesh>& anatomy) {
+  using namespace fahr::scenegen;
+  const Vec3 lips(p.face.back_x_mm + p.face.thickness_mm + p.face.lip_protrusion_mm,
+                  p.face.mouth_centre_y_mm, 0.0);
+  const Vec3 glottis = larynx_axis_point(p.airway, p.airway.glottis_depth_mm);
+  std::printf("landmark lips to glottis (straight): %.1f mm; glottis at (%.1f, %.1f)\n",
+              (glottis - lips).norm(), glottis.x(), glottis.y());
+  // Tongue thickness: the dorsum's greatest height over the attachment plane, on the mid-line.
+  const TongueShape& tongue = body.tongue();
+  double thickness = 0.0;
+  for (double x = -50.0; x <= -8.0; x += 0.5) {
+    const double top = top_of(tongue, x, 0.0);
+    if (std::isfinite(top)) {
+      thickness = std::max(thickness, -tongue.attachment_plane_distance(Vec3(x, top, 0.0)));
+    }
+  }
+  std::printf("landmark tongue: mid-line length %.1f mm, thickness over its plane %.1f mm\n",
+              tongue.midline_length_mm(), thickness);
+  const double lean = std::tan(p.epiglottis.lean_back_deg * 3.14159265358979323846 / 180.0);
+  std::printf("landmark epiglottis length %.1f mm\n",
+              p.epiglottis.length_mm * std::sqrt(1.0 + lean * lean));
+  // AP airway behind the soft palate: from its most posterior point to the wall.
+  Vec3 velum_back = Vec3::Constant(1e9);
+  for (const auto& v : anatomy.at("soft_palate").vertices) {
+    if (v.x() < velum_back.x()) velum_back = v;
+  }
+  std::printf("landmark airway AP behind the soft palate: %.1f mm (at y %.1f)\n",
+              velum_back.x() - pharynx_wall_x(velum_back.y()) - 0.0, velum_back.y());
+  double narrowest = 1e9;
+  double at_y = 0.0;
+  for (double y = -18.0; y <= -4.0; y += 0.5) {
+    const double gap = back_of(body, y) - pharynx_wall_x(y);
+    if (gap < narrowest) {
+      narrowest = gap;
+      at_y = y;
+    }
+  }
+  std::printf("landmark airway AP behind the tongue's dorsum: %.1f mm (narrowest, at y %.1f)\n",
+              narrowest, at_y);
+  std::printf("landmark pharynx lateral walls apart: %.1f mm\n", 2.0 * p.pharynx.half_width_mm);
 }
 
 }  // namespace
@@ -145,6 +201,9 @@ int main(int argc, char** argv) {
   anatomy["hyoid"] = make_hyoid(params.hyoid, params.floor, params.tongue, res);
   anatomy["lips_face"] = make_face(params.face, res);
   anatomy["larynx_trachea"] = make_larynx_trachea(params.airway, res);
+  anatomy["epiglottis"] = make_epiglottis(params.epiglottis, params.airway, res);
+  anatomy["soft_palate"] = make_soft_palate(params.soft_palate, params.palate, body_shape, res);
+  anatomy["pharynx"] = make_pharynx(params.pharynx, res);
   std::map<std::string, TriangleMesh> blades;
   blades["miller0"] = make_miller_blade(params.miller0, res);
   blades["miller1"] = make_miller_blade(params.miller1, res);
@@ -183,7 +242,10 @@ int main(int argc, char** argv) {
   const std::map<std::string, ParamBox> boxes = {
       {"palate", palate_box(params.palate, res)},
       {"jaw", jaw_box(params.jaw, res)},
-      {"hyoid", hyoid_box(params.hyoid, params.floor, params.tongue, res)}};
+      {"hyoid", hyoid_box(params.hyoid, params.floor, params.tongue, res)},
+      {"epiglottis", epiglottis_box(params.epiglottis, params.airway, res)},
+      {"soft_palate", soft_palate_box(params.soft_palate, params.palate, body_shape, res)},
+      {"pharynx", pharynx_box(params.pharynx, res)}};
   for (const auto& [name, box] : boxes) {
     const int folded = folded_box_tets(box);
     std::printf("%s: %d folded or flat tets in its %dx%dx%d parameter lattice\n", name.c_str(),
@@ -256,6 +318,7 @@ int main(int argc, char** argv) {
                 initial.name.c_str(), inside);
     ok = ok && inside == 0;
   }
+  print_landmarks(params, body_shape, anatomy);
   if (!ok) {
     std::fprintf(stderr, "fahr_scene_generator: scene failed its checks; nothing written\n");
     return 1;
@@ -282,7 +345,11 @@ int main(int argc, char** argv) {
       {"jaw", "mandible: U-shaped bar from gonial angle to gonial angle, gum ridge on top"},
       {"hyoid", "hyoid: body and greater horns under the floor of the mouth"},
       {"lips_face", "face around the mouth with the lips and the mouth opening"},
-      {"larynx_trachea", "laryngeal inlet with epiglottis, and the trachea (thick-walled tube)"},
+      {"larynx_trachea",
+       "larynx (aryepiglottic folds, vocal folds, glottic opening, subglottis) and trachea"},
+      {"epiglottis", "epiglottis: a curled (omega) leaf above the larynx's anterior rim"},
+      {"soft_palate", "soft palate with the uvula, lying on the tongue's dorsum"},
+      {"pharynx", "pharyngeal wall: posterior and lateral walls, open in front"},
       {"miller0", "Miller size 0 blade with handle, tool frame (see README)"},
       {"miller1", "Miller size 1 blade with handle, tool frame (see README)"}};
   for (const auto* group : {&anatomy, &blades}) {

@@ -7,15 +7,10 @@
 #include "fahr/scenegen/param_surfaces.h"
 #include "fahr/scenegen/piecewise_linear.h"
 #include "fahr/scenegen/tongue_shape.h"
+#include "surface_helpers.h"
 
 namespace fahr::scenegen {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-int cells_for(double length_mm, double resolution_mm, int minimum = 2) {
-  return std::max(minimum, static_cast<int>(std::ceil(length_mm / resolution_mm)));
-}
 
 // Dental arch: the front edge of a slab curves back at its sides by this
 // much, so palate and jaw are U-shaped seen from above.
@@ -45,30 +40,6 @@ double eased_power(double u, double power, double ease) {
 // dimensions the thinnest projected cell corner is 5.7 degrees) while the
 // half width differs from the bare power by at most 1.0 mm.
 constexpr double kPalateWidthEase = 0.2;
-
-// Closed rectangle loop in (radial, axial) with sharp corners, parametrised
-// by an index so that each side gets its own number of points.
-struct RectangleLoop {
-  int n_long;   // points along each long side
-  int n_short;  // points along each short side
-  int size() const { return 2 * (n_long + n_short); }
-  // Returns (radial fraction, axial fraction) for loop index j.
-  std::pair<double, double> at(int j) const {
-    j %= size();
-    const auto f = [](int k, int n) { return static_cast<double>(k) / static_cast<double>(n); };
-    if (j < n_long) return {0.0, f(j, n_long)};  // inner side, top to bottom
-    j -= n_long;
-    if (j < n_short) return {f(j, n_short), 1.0};  // bottom end, inner to outer
-    j -= n_short;
-    if (j < n_long) return {1.0, 1.0 - f(j, n_long)};  // outer side, bottom to top
-    j -= n_long;
-    return {1.0 - f(j, n_short), 0.0};  // top end, outer to inner
-  }
-};
-
-int loop_index(double fraction, int size) {
-  return static_cast<int>(std::lround(fraction * static_cast<double>(size))) % size;
-}
 
 }  // namespace
 
@@ -217,40 +188,6 @@ TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
     return Vec3(back + (front - back) * axial, p.mouth_centre_y_mm + zy.y(), zy.x());
   };
   const int n_around = cells_for(2.0 * kPi * p.mouth_half_width_mm, 0.5 * resolution_mm, 24);
-  return make_param_torus(map, n_around, loop.size());
-}
-
-TriangleMesh make_larynx_trachea(const AirwayParameters& p, double resolution_mm) {
-  const double tilt = p.tilt_deg * kPi / 180.0;
-  const Vec3 inlet(p.inlet_x_mm, p.inlet_y_mm, 0.0);
-  const Vec3 down(-std::sin(tilt), -std::cos(tilt), 0.0);     // along the airway, inferior
-  const Vec3 anterior(std::cos(tilt), -std::sin(tilt), 0.0);  // towards the tongue base
-  const Vec3 lateral(0.0, 0.0, 1.0);
-  const double total = p.larynx_length_mm + p.trachea_length_mm;
-  const double top_span = p.epiglottis_height_mm + total;
-  const RectangleLoop loop{cells_for(top_span, resolution_mm),
-                           cells_for(p.wall_thickness_mm, 0.5 * resolution_mm)};
-  const auto map = [&](double around, double loop_fraction) {
-    const double a = 2.0 * kPi * around;
-    const auto [radial, axial] = loop.at(loop_index(loop_fraction, loop.size()));
-    // Epiglottis: the rim rises on the anterior side only (a = 0).
-    const double front = std::max(0.0, std::cos(a));
-    const double rise = p.epiglottis_height_mm * front * front;
-    const double s = -rise + (total + rise) * axial;  // axial position, mm below the inlet
-    double lumen =
-        p.trachea_lumen_radius_mm + (p.inlet_lumen_radius_mm - p.trachea_lumen_radius_mm) *
-                                        smoothstep(p.larynx_length_mm, 0.0, s);
-    double forward = 0.0;
-    if (s < 0.0) {
-      const double t = -s / p.epiglottis_height_mm;
-      forward = p.epiglottis_flare_mm * t * t * front;
-    }
-    const double r = lumen + p.wall_thickness_mm * radial;
-    return Vec3(inlet + s * down + (r * std::cos(a) + forward) * anterior +
-                r * std::sin(a) * lateral);
-  };
-  const int n_around = cells_for(2.0 * kPi * (p.inlet_lumen_radius_mm + p.wall_thickness_mm),
-                                 0.5 * resolution_mm, 24);
   return make_param_torus(map, n_around, loop.size());
 }
 

@@ -1,6 +1,6 @@
 // Rigid anatomy of the neonatal scene as closed surfaces in the head frame
 // (mm): hard palate, mandible, hyoid, face and lips around the mouth
-// opening, larynx with epiglottis and trachea.
+// opening. The airway behind the mouth is in airway_surfaces.h.
 #pragma once
 
 #include "fahr/scenegen/geometry_types.h"
@@ -51,9 +51,5 @@ ParamBox hyoid_box(const HyoidParameters& p, const FloorParameters& floor,
 // The face is a thick ring around the mouth opening (genus one), lips bulging
 // forward at its inner rim and cheeks curving back at its outer rim.
 TriangleMesh make_face(const FaceParameters& p, double resolution_mm);
-
-// Larynx and trachea: one thick-walled tube from the laryngeal inlet down;
-// the anterior rim rises into the epiglottis, curling towards the tongue base.
-TriangleMesh make_larynx_trachea(const AirwayParameters& p, double resolution_mm);
 
 }  // namespace fahr::scenegen

@@ -89,17 +89,66 @@ struct FaceParameters {
   double lip_protrusion_mm = 3.0;  // lips bulge forward of the cheeks
 };
 
+// Larynx and trachea: one thick-walled tube down an axis leaning back from
+// the laryngeal inlet. The lumen is an ellipse (AP by lateral) at every depth:
+// the vestibule under the inlet, the vocal folds narrowing it to the glottic
+// slit, the round subglottis (cricoid) and the trachea. The inlet's rim is
+// oblique: high in front under the epiglottis, down along the aryepiglottic
+// folds to the arytenoids behind.
 struct AirwayParameters {
-  double inlet_x_mm = -62.0;  // centre of the laryngeal inlet
-  double inlet_y_mm = -30.0;
-  double tilt_deg = 8.0;           // axis leans posteriorly going down
-  double larynx_length_mm = 18.0;  // inlet to the first tracheal ring
+  double inlet_x_mm = -58.5;  // centre of the laryngeal inlet (its posterior rim's height)
+  double inlet_y_mm = -24.0;
+  double tilt_deg = 8.0;              // axis leans posteriorly going down
+  double fold_rise_mm = 3.0;          // anterior rim above the posterior (aryepiglottic folds)
+  double vestibule_half_ap_mm = 4.0;  // lumen under the inlet
+  double vestibule_half_lateral_mm = 3.0;
+  double glottis_depth_mm = 8.0;         // vocal folds below the posterior rim
+  double glottis_half_length_mm = 2.75;  // glottis 5.5 mm long (AP)
+  double glottis_half_width_mm = 1.0;    // open glottic slit, half width
+  double subglottis_radius_mm = 2.4;     // cricoid ring lumen
+  double larynx_length_mm = 16.0;        // posterior rim to the first tracheal ring
   double trachea_length_mm = 42.0;
-  double inlet_lumen_radius_mm = 3.8;
   double trachea_lumen_radius_mm = 2.3;  // ~4.6 mm lumen diameter
   double wall_thickness_mm = 1.5;
-  double epiglottis_height_mm = 12.0;  // free edge above the inlet rim
-  double epiglottis_flare_mm = 2.0;    // forward curl of its tip
+};
+
+// Epiglottis: a curled leaf (U in cross-section, its concave laryngeal face
+// posterior, the edges curling back: the neonate's omega shape) rising from
+// just above the larynx's anterior rim behind the tongue's base.
+struct EpiglottisParameters {
+  double base_gap_mm = 0.5;    // above the larynx's anterior rim
+  double front_x_mm = -53.8;   // lingual face at the mid-line, at its base
+  double length_mm = 9.5;      // base to tip along y
+  double lean_back_deg = 4.0;  // the tip lies behind the base
+  double radius_mm = 2.8;      // curl radius of the cross-section
+  double curl_deg = 95.0;      // the edges turn this far round from the mid-line
+  double thickness_mm = 1.2;
+};
+
+// Soft palate with the uvula: a slab hanging from the hard palate's posterior
+// edge and lying on the tongue's dorsum (the neonate's tongue fills the
+// mouth), a gap above it; thinning and narrowing back to the uvula.
+struct SoftPalateParameters {
+  double palate_gap_mm = 0.5;     // behind the hard palate's posterior face
+  double length_x_mm = 17.0;      // from the hard palate to the uvula's tip, along x
+  double thickness_mm = 4.0;      // at the hard palate
+  double tip_thickness_mm = 2.5;  // at the uvula
+  double half_width_mm = 10.0;    // at the hard palate
+  double uvula_length_mm = 4.5;
+  double uvula_half_width_mm = 2.0;
+  double tongue_gap_mm = 1.5;  // above the tongue's dorsum at rest
+};
+
+// Pharyngeal wall: a C-shaped channel (posterior and lateral walls, open in
+// front to the mouth and the larynx) from the nasopharynx down behind the
+// larynx. Its posterior face's x at each height is a profile (airway
+// dimensions in meshes/neonatal/README.md).
+struct PharynxParameters {
+  double top_y_mm = 14.0;
+  double bottom_y_mm = -62.0;
+  double depth_mm = 6.0;        // the lateral walls reach this far forward
+  double half_width_mm = 10.0;  // lateral walls from the mid-line
+  double thickness_mm = 3.0;
 };
 
 struct BladeParameters {
@@ -127,6 +176,9 @@ struct SceneParameters {
   HyoidParameters hyoid;
   FaceParameters face;
   AirwayParameters airway;
+  EpiglottisParameters epiglottis;
+  SoftPalateParameters soft_palate;
+  PharynxParameters pharynx;
   BladeParameters miller0;
   BladeParameters miller1;
   double surface_resolution_mm = 1.5;  // target edge length of rigid surfaces
