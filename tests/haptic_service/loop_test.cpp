@@ -217,8 +217,13 @@ struct PressRig {
 // Presses the blade into the resting tongue for 400 ticks with W of 0.02
 // m/N (FEM states every 5 ticks, reset epoch 0), then goes on for 300 ticks
 // on states of `epoch` with a ten times stiffer tongue. Returns the largest
-// change of the commanded force over one tick in that second part, N.
-double largest_step_after_change(std::uint32_t epoch, std::uint64_t* resets = nullptr) {
+// change of the commanded force over one tick in that second part, N: over
+// every tick, or (resuming_only) over the ticks whose command says it is
+// slewing (FORCE_RESUMING). Once the slew has caught up the force is the
+// response's: on this stiff, static tongue with the 64-row cap its rows come
+// and go and it chatters by a few newtons a tick, which is not the slew's.
+double largest_step_after_change(std::uint32_t epoch, std::uint64_t* resets = nullptr,
+                                 bool resuming_only = false) {
   PressRig rig;
   EXPECT_TRUE(rig.press());
   const HapticSetup& setup = rig.setup;
@@ -240,8 +245,13 @@ double largest_step_after_change(std::uint32_t epoch, std::uint64_t* resets = nu
     }
     loop.tick(device_pose(tick, deep, kPressPitchDeg), snapshot, command, contacts);
     const Eigen::Vector3d force = to_eigen(command.force_n());
-    largest = std::max(largest, (force - previous).norm());
+    if (!resuming_only || command.reason() == msg::FORCE_RESUMING) {
+      largest = std::max(largest, (force - previous).norm());
+    }
     previous = force;
+  }
+  if (resuming_only) {
+    EXPECT_EQ(command.reason(), msg::FORCE_RENDERED) << "the slew never ended";
   }
   if (resets != nullptr) *resets = loop.metrics().tissue_resets.load();
   return largest;
@@ -253,7 +263,7 @@ double largest_step_after_change(std::uint32_t epoch, std::uint64_t* resets = nu
 // its force does step by more, so the bound is the slew's doing.
 TEST(HapticLoop, ANewResetEpochSlewsTheForce) {
   std::uint64_t resets = 0;
-  const double with_epoch = largest_step_after_change(1, &resets);
+  const double with_epoch = largest_step_after_change(1, &resets, true);
   const double control = largest_step_after_change(0);
   std::printf("largest force change a tick: %.3f N after a reset epoch, %.3f N without\n",
               with_epoch, control);
@@ -336,6 +346,7 @@ TEST(HapticLoop, ANewFemWriterResumesThroughTheSlew) {
   Eigen::Vector3d previous = to_eigen(rig.command.force_n());
   ASSERT_GT(previous.norm(), 0.3);
   double largest = 0.0;
+  bool resumed = false;
   for (std::uint64_t tick = rig.tick; tick < 700; ++tick) {
     if (tick % 5 == 0) {
       // Writer 9, a stiffer tongue, its steps and epoch from 0.
@@ -346,9 +357,16 @@ TEST(HapticLoop, ANewFemWriterResumesThroughTheSlew) {
     rig.loop.tick(device_pose(tick, rig.deep, kPressPitchDeg), rig.snapshot, rig.command,
                   rig.contacts);
     const Eigen::Vector3d force = to_eigen(rig.command.force_n());
-    largest = std::max(largest, (force - previous).norm());
+    // While it slews (after that the force is the response's: see
+    // largest_step_after_change).
+    if (rig.command.reason() == msg::FORCE_RESUMING) {
+      largest = std::max(largest, (force - previous).norm());
+      resumed = true;
+    }
     previous = force;
   }
+  EXPECT_TRUE(resumed);
+  EXPECT_EQ(rig.command.reason(), msg::FORCE_RENDERED);
   EXPECT_EQ(rig.loop.metrics().fem_writers.load(), 1u);
   EXPECT_LE(largest, kResetSlewN + 1e-9);
 }

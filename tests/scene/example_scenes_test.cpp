@@ -12,9 +12,10 @@
 namespace fahr::scene::test {
 namespace {
 
-constexpr const char* kNeonatalMeshFiles[] = {"tongue.node",        "tongue.ele",  "tongue.face",
-                                              "palate.obj",         "jaw.obj",     "lips_face.obj",
-                                              "larynx_trachea.obj", "miller0.obj", "miller1.obj"};
+constexpr const char* kNeonatalMeshFiles[] = {
+    "tongue.node",   "tongue.ele",         "tongue.face", "palate.obj",      "jaw.obj",
+    "lips_face.obj", "larynx_trachea.obj", "hyoid.obj",   "soft_palate.obj", "epiglottis.obj",
+    "pharynx.obj",   "miller0.obj",        "miller1.obj"};
 
 // A copy of the repository layout: deployment/scenes/<scene> beside
 // meshes/neonatal/ with empty mesh files and a small fixed-node file.
@@ -26,10 +27,10 @@ std::filesystem::path lay_out(const TempDir& dir, const std::string& scene_file)
 
 void expect_neonatal_contents(const Scene& scene) {
   EXPECT_EQ(scene.name, "neonatal_intubation");
-  ASSERT_EQ(scene.bodies.size(), 6u);
+  ASSERT_EQ(scene.bodies.size(), 10u);
   EXPECT_EQ(scene.count(BodyRole::kDeformable), 1u);
   EXPECT_EQ(scene.count(BodyRole::kTool), 1u);
-  EXPECT_EQ(scene.count(BodyRole::kObstacle), 4u);
+  EXPECT_EQ(scene.count(BodyRole::kObstacle), 8u);
   const Body& tongue = scene.bodies[*scene.find_body("tongue")];
   EXPECT_EQ(tongue.mesh_unit, LengthUnit::kMillimetre);
   EXPECT_DOUBLE_EQ(tongue.mesh_scale, 0.001);
@@ -78,8 +79,8 @@ TEST(ExampleScenes, NeonatalReportsEveryMissingMesh) {
     load_scene(path);
     FAIL() << "expected a SceneError";
   } catch (const SceneError& error) {
-    // Six mesh files, the TetGen .ele and the fixed-node file.
-    EXPECT_EQ(error.issues().size(), 8u) << error.what();
+    // Ten mesh files, the TetGen .ele and the fixed-node file.
+    EXPECT_EQ(error.issues().size(), 12u) << error.what();
   }
 }
 

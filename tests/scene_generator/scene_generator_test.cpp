@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>  // mkdtemp (POSIX)
 
+#include <algorithm>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -32,12 +33,17 @@ using fahr::scenegen::TriangleMesh;
 #error "FAHR_SCENE_GENERATOR must name the generator executable"
 #endif
 
-const std::vector<std::string> kSceneFiles = {
-    "tongue.node", "tongue.ele",  "tongue.face",         "tongue_fixed_nodes.txt",
-    "palate.obj",  "jaw.obj",     "lips_face.obj",       "larynx_trachea.obj",
-    "miller0.obj", "miller1.obj", "scene_parameters.txt"};
-const std::vector<std::string> kSurfaces = {"palate",         "jaw",     "lips_face",
-                                            "larynx_trachea", "miller0", "miller1"};
+const std::vector<std::string> kSceneFiles = {"tongue.node",     "tongue.ele",
+                                              "tongue.face",     "tongue_fixed_nodes.txt",
+                                              "palate.obj",      "jaw.obj",
+                                              "hyoid.obj",       "lips_face.obj",
+                                              "miller0.obj",     "larynx_trachea.obj",
+                                              "miller1.obj",     "scene_parameters.txt",
+                                              "soft_palate.obj", "epiglottis.obj",
+                                              "pharynx.obj"};
+const std::vector<std::string> kSurfaces = {
+    "palate",     "jaw",         "hyoid",   "lips_face", "larynx_trachea",
+    "epiglottis", "soft_palate", "pharynx", "miller0",   "miller1"};
 constexpr double kMetresPerMm = 1e-3;
 constexpr double kSdfCellM = 1e-3;  // the 1 mm cell the haptic and AIST code use
 
@@ -101,8 +107,9 @@ TEST_F(SceneGeneratorTest, TetsHavePositiveVolumeAndBoundaryIsClosed) {
   MeshedSolid tongue;
   std::string error;
   ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "tongue").string(), tongue, error)) << error;
-  EXPECT_GE(tongue.tets.size(), 2000u);
-  EXPECT_LE(tongue.tets.size(), 6000u);
+  // The tongue (about 5,500 tets) with the floor of the mouth (about 2,600).
+  EXPECT_GE(tongue.tets.size(), 5600u);
+  EXPECT_LE(tongue.tets.size(), 10000u);
   for (size_t i = 0; i < tongue.tets.size(); ++i) {
     const auto& t = tongue.tets[i];
     for (const int v : t) ASSERT_LT(static_cast<size_t>(v), tongue.nodes.size()) << "tet " << i;
@@ -195,19 +202,34 @@ TEST_F(SceneGeneratorTest, TongueBoundaryIsCleanWithSignedField) {
   expect_clean_and_signed(surface, "tongue boundary");
 }
 
-TEST_F(SceneGeneratorTest, FixedNodesAreTongueNodes) {
+// The body is held only where it meets bone: every fixed node lies on the
+// mandible or the hyoid (within the bone gap and the attachment band,
+// 1.5 mm), and both hold some.
+TEST_F(SceneGeneratorTest, FixedNodesAreAttachedToBone) {
+  constexpr double kAttachedWithinMm = 1.5;
   MeshedSolid tongue;
   std::string error;
   ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "tongue").string(), tongue, error)) << error;
+  TriangleMesh jaw;
+  TriangleMesh hyoid;
+  ASSERT_TRUE(fahr::scenegen::read_obj((*first_ / "jaw.obj").string(), jaw, error)) << error;
+  ASSERT_TRUE(fahr::scenegen::read_obj((*first_ / "hyoid.obj").string(), hyoid, error)) << error;
   std::ifstream file(*first_ / "tongue_fixed_nodes.txt");
   std::string line;
-  int count = 0;
+  int on_jaw = 0;
+  int on_hyoid = 0;
   while (std::getline(file, line)) {
     if (line.empty() || line[0] == '#') continue;
-    EXPECT_LT(std::stoul(line), tongue.nodes.size());
-    ++count;
+    const std::size_t v = std::stoul(line);
+    ASSERT_LT(v, tongue.nodes.size());
+    const double to_jaw = fahr::scenegen::distance_to_surface(jaw, tongue.nodes[v]);
+    const double to_hyoid = fahr::scenegen::distance_to_surface(hyoid, tongue.nodes[v]);
+    EXPECT_LE(std::min(to_jaw, to_hyoid), kAttachedWithinMm) << "fixed node " << v;
+    on_jaw += to_jaw <= kAttachedWithinMm ? 1 : 0;
+    on_hyoid += to_hyoid <= kAttachedWithinMm ? 1 : 0;
   }
-  EXPECT_GT(count, 0);
+  EXPECT_GT(on_jaw, 0);
+  EXPECT_GT(on_hyoid, 0);
 }
 
 }  // namespace

@@ -33,6 +33,11 @@ struct View {
 
 std::vector<View> views() {
   const Vec3 side(0.0, 0.0, 1.0);
+  // The laryngoscopist's eye: on the line from the glottis out through the
+  // mouth, above the supine neonate's head; the patient's anterior side is
+  // up in the picture, as in a laryngoscopic view.
+  const Vec3 sight = Vec3(0.876, 0.482, 0.0).normalized();
+  const Vec3 anterior_up = (Vec3::UnitX() - sight.dot(Vec3::UnitX()) * sight).normalized();
   const Vec3 oblique = Vec3(0.8, 0.5, 1.0).normalized();
   const Vec3 up = Vec3::UnitY();
   return {
@@ -40,6 +45,12 @@ std::vector<View> views() {
       {"scene_side_closeup.png", "initial", {side, up, Vec3(-18.0, -18.0, 0.0), 100.0}, true, true},
       {"scene_front.png", "none", {Vec3::UnitX(), up, Vec3(0.0, -5.0, 0.0), 110.0}, false, false},
       {"scene_oblique.png", "initial", {oblique, up, Vec3(0.0, -20.0, 0.0), 190.0}, true, true},
+      {"scene_airway_side.png", "none", {side, up, Vec3(-38.0, -28.0, 0.0), 110.0}, true, false},
+      {"scene_laryngoscopist.png",
+       "none",
+       {sight, anterior_up, Vec3(-30.0, -15.0, 0.0), 60.0},
+       false,
+       false},
       {"scene_side_pressing.png",
        "pressing",
        {side, up, Vec3(-15.0, -18.0, 0.0), 110.0},
@@ -89,10 +100,10 @@ int main(int argc, char** argv) {
   // Colours: tissue pink, bone ivory, skin, airway blue (as in the paper's
   // figures, where the trachea is blue), steel.
   const std::vector<std::pair<std::string, Vec3>> rigid = {
-      {"palate", Vec3(0.93, 0.88, 0.74)},
-      {"jaw", Vec3(0.90, 0.85, 0.70)},
-      {"lips_face", Vec3(0.96, 0.76, 0.66)},
-      {"larynx_trachea", Vec3(0.45, 0.60, 0.90)}};
+      {"palate", Vec3(0.93, 0.88, 0.74)},         {"jaw", Vec3(0.90, 0.85, 0.70)},
+      {"hyoid", Vec3(0.88, 0.82, 0.62)},          {"lips_face", Vec3(0.96, 0.76, 0.66)},
+      {"larynx_trachea", Vec3(0.45, 0.60, 0.90)}, {"epiglottis", Vec3(0.98, 0.86, 0.55)},
+      {"soft_palate", Vec3(0.90, 0.56, 0.60)},    {"pharynx", Vec3(0.72, 0.52, 0.56)}};
   std::map<std::string, TriangleMesh> meshes;
   for (const auto& [name, colour] : rigid) {
     const std::string path = std::string(mesh_dir).append("/").append(name).append(".obj");

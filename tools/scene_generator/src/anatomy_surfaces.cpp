@@ -6,20 +6,15 @@
 
 #include "fahr/scenegen/param_surfaces.h"
 #include "fahr/scenegen/piecewise_linear.h"
+#include "fahr/scenegen/tongue_shape.h"
+#include "surface_helpers.h"
 
 namespace fahr::scenegen {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-int cells_for(double length_mm, double resolution_mm, int minimum = 2) {
-  return std::max(minimum, static_cast<int>(std::ceil(length_mm / resolution_mm)));
-}
-
 // Dental arch: the front edge of a slab curves back at its sides by this
 // much, so palate and jaw are U-shaped seen from above.
 constexpr double kPalateArchSweepBackMm = 6.0;
-constexpr double kJawArchSweepBackMm = 4.0;
 // Labial edge of a gum ridge is rounded over this fraction of the slab length.
 constexpr double kRidgeRoundFraction = 0.08;
 constexpr double kRidgeRoundMm = 2.0;
@@ -42,36 +37,9 @@ double eased_power(double u, double power, double ease) {
   return (std::pow(u + ease, power) - start) / (std::pow(1.0 + ease, power) - start);
 }
 // Chosen so the arch corners are convex with some margin (at the default
-// dimensions the thinnest projected cell corner is 5.7 degrees in the
-// palate, 3.6 in the jaw) while the half width differs from the bare power
-// by at most 1.0 mm (palate) and 1.1 mm (jaw). The jaw also needs the
-// shallower sweep: with 6 mm its corner stays reflex for any ease.
+// dimensions the thinnest projected cell corner is 5.7 degrees) while the
+// half width differs from the bare power by at most 1.0 mm.
 constexpr double kPalateWidthEase = 0.2;
-constexpr double kJawWidthEase = 0.3;
-
-// Closed rectangle loop in (radial, axial) with sharp corners, parametrised
-// by an index so that each side gets its own number of points.
-struct RectangleLoop {
-  int n_long;   // points along each long side
-  int n_short;  // points along each short side
-  int size() const { return 2 * (n_long + n_short); }
-  // Returns (radial fraction, axial fraction) for loop index j.
-  std::pair<double, double> at(int j) const {
-    j %= size();
-    const auto f = [](int k, int n) { return static_cast<double>(k) / static_cast<double>(n); };
-    if (j < n_long) return {0.0, f(j, n_long)};  // inner side, top to bottom
-    j -= n_long;
-    if (j < n_short) return {f(j, n_short), 1.0};  // bottom end, inner to outer
-    j -= n_short;
-    if (j < n_long) return {1.0, 1.0 - f(j, n_long)};  // outer side, bottom to top
-    j -= n_long;
-    return {1.0 - f(j, n_short), 0.0};  // top end, outer to inner
-  }
-};
-
-int loop_index(double fraction, int size) {
-  return static_cast<int>(std::lround(fraction * static_cast<double>(size))) % size;
-}
 
 }  // namespace
 
@@ -102,38 +70,97 @@ TriangleMesh make_palate(const PalateParameters& p, double resolution_mm) {
   return make_param_box(palate_box(p, resolution_mm));
 }
 
-ParamBox jaw_box(const JawParameters& p, const TongueParameters& tongue, double resolution_mm) {
-  constexpr double kWallRiseMm = 3.0;        // inner face of the mandibular body, horizontal run
-  constexpr double kRidgeBackSlopeMm = 4.0;  // lingual slope of the lower gum ridge
-  constexpr double kRidgeCrestMm = 2.0;      // crest width of the lower gum ridge
-  constexpr double kMinThicknessMm = 3.0;    // bone under the floor never thinner than this
-  const auto map = [p, tongue](double u, double v, double w) {
-    const double lateral = 2.0 * v - 1.0;
-    const double x = arch_x(p.front_x_mm, p.length_mm, kJawArchSweepBackMm, u, lateral);
-    const double half_width =
-        p.front_half_width_mm +
-        (p.back_half_width_mm - p.front_half_width_mm) * eased_power(u, 0.8, kJawWidthEase);
-    const double z = lateral * half_width;
-    // Floor: the tongue's attachment plane lowered by the gap.
-    const double floor_y =
-        tongue.floor_y_at_x15_mm + tongue.floor_slope * (x + 15.0) - p.floor_gap_mm;
-    const double wall = smoothstep(p.wall_inner_half_width_mm,
-                                   p.wall_inner_half_width_mm + kWallRiseMm, std::abs(z));
-    const double ridge = smoothstep(p.front_x_mm - kRidgeCrestMm - kRidgeBackSlopeMm,
-                                    p.front_x_mm - kRidgeCrestMm, x);
-    const double rim = std::max(wall, ridge);
-    const double top = std::max(floor_y, floor_y + (p.ridge_y_mm - floor_y) * rim);
-    const double bottom = std::min(p.bottom_y_mm, top - kMinThicknessMm);
-    return Vec3(x, bottom + (top - bottom) * w, z);
-  };
-  const double width = 2.0 * p.back_half_width_mm;
-  return {map, cells_for(p.length_mm, resolution_mm), cells_for(width, 0.75 * resolution_mm),
-          cells_for(p.ridge_y_mm - p.bottom_y_mm, 2.0 * resolution_mm)};
+double ellipse_distance(const ArchEllipse& e, double x_mm, double z_mm) {
+  const double u = (x_mm - e.centre_x_mm) / e.a_mm;
+  const double v = z_mm / e.b_mm;
+  const double rho = std::sqrt(u * u + v * v);
+  // |grad rho| = sqrt(u^2 / a^2 + v^2 / b^2) / rho; distance ~ (rho - 1) / |grad rho|.
+  const double g = std::sqrt(u * u / (e.a_mm * e.a_mm) + v * v / (e.b_mm * e.b_mm));
+  if (g < 1e-12) return -std::min(e.a_mm, e.b_mm);  // the centre
+  return (rho - 1.0) * rho / g;
 }
 
-TriangleMesh make_jaw(const JawParameters& p, const TongueParameters& tongue,
-                      double resolution_mm) {
-  return make_param_box(jaw_box(p, tongue, resolution_mm));
+ArchEllipse mandible_outer(const JawParameters& p) {
+  return {p.front_x_mm - p.length_mm, p.length_mm, p.back_half_width_mm};
+}
+
+ArchEllipse mandible_inner(const JawParameters& p, double y_mm) {
+  const double top = p.ridge_y_mm - p.lingual_drop_mm;
+  const double w = std::clamp((y_mm - p.bottom_y_mm) / (top - p.bottom_y_mm), 0.0, 1.0);
+  const double chin = p.symphysis_bottom_mm + (p.symphysis_top_mm - p.symphysis_bottom_mm) * w;
+  const ArchEllipse outer = mandible_outer(p);
+  return {outer.centre_x_mm, outer.a_mm - chin, outer.b_mm - p.body_thickness_mm};
+}
+
+namespace {
+
+// A U-shaped bar: u runs along the arch from one end (t = -90 deg) round the
+// front (t = 0) to the other end, v from the inner arch to the outer one, w
+// from the bottom to the top. inner(w) and outer give the arches; y(x, v, w)
+// the height.
+template <typename InnerArch, typename Height>
+ParamBox arch_bar_box(const ArchEllipse& outer, InnerArch inner, Height height, double arc_mm,
+                      double across_mm, double tall_mm, double resolution_mm) {
+  const auto map = [outer, inner, height](double u, double v, double w) {
+    const double t = (2.0 * u - 1.0) * 0.5 * kPi;
+    const ArchEllipse in = inner(w);
+    const Eigen::Vector2d a(in.centre_x_mm + in.a_mm * std::cos(t), in.b_mm * std::sin(t));
+    const Eigen::Vector2d b(outer.centre_x_mm + outer.a_mm * std::cos(t), outer.b_mm * std::sin(t));
+    const Eigen::Vector2d xz = a + v * (b - a);
+    return Vec3(xz.x(), height(xz.x(), v, w), xz.y());
+  };
+  return {map, cells_for(arc_mm, resolution_mm), cells_for(across_mm, 0.5 * resolution_mm),
+          cells_for(tall_mm, resolution_mm)};
+}
+
+// Length of half an ellipse (Ramanujan's approximation), for the lattice size.
+double half_ellipse_mm(double a, double b) {
+  return 0.5 * kPi * (3.0 * (a + b) - std::sqrt((3.0 * a + b) * (a + 3.0 * b)));
+}
+
+}  // namespace
+
+ParamBox jaw_box(const JawParameters& p, double resolution_mm) {
+  // The top: the crest over the outer 60 % of the bar, the lingual edge
+  // lingual_drop_mm lower.
+  constexpr double kCrestFromV = 0.4;
+  const double top_inner = p.ridge_y_mm - p.lingual_drop_mm;
+  const auto inner = [p, top_inner](double w) {
+    return mandible_inner(p, p.bottom_y_mm + (top_inner - p.bottom_y_mm) * w);
+  };
+  const auto height = [p](double, double v, double w) {
+    const double top = p.ridge_y_mm - p.lingual_drop_mm * (1.0 - smoothstep(0.0, kCrestFromV, v));
+    return p.bottom_y_mm + (top - p.bottom_y_mm) * w;
+  };
+  const ArchEllipse outer = mandible_outer(p);
+  return arch_bar_box(outer, inner, height, half_ellipse_mm(outer.a_mm, outer.b_mm),
+                      std::max(p.symphysis_bottom_mm, p.body_thickness_mm),
+                      p.ridge_y_mm - p.bottom_y_mm, resolution_mm);
+}
+
+TriangleMesh make_jaw(const JawParameters& p, double resolution_mm) {
+  return make_param_box(jaw_box(p, resolution_mm));
+}
+
+ParamBox hyoid_box(const HyoidParameters& p, const FloorParameters& floor,
+                   const TongueParameters& tongue, double resolution_mm) {
+  const ArchEllipse outer{p.front_x_mm - p.length_mm, p.length_mm, p.half_span_mm};
+  const ArchEllipse in{outer.centre_x_mm, p.length_mm - p.thickness_mm,
+                       p.half_span_mm - p.thickness_mm};
+  const auto inner = [in](double) { return in; };
+  const auto height = [p, floor, tongue](double x, double, double w) {
+    const double slope = std::sqrt(1.0 + tongue.floor_slope * tongue.floor_slope);
+    const double top =
+        attachment_plane_y(tongue, x) - (floor.thickness_mm + floor.bone_gap_mm) * slope;
+    return top - p.height_mm * (1.0 - w);
+  };
+  return arch_bar_box(outer, inner, height, half_ellipse_mm(outer.a_mm, outer.b_mm), p.thickness_mm,
+                      p.height_mm, 0.5 * resolution_mm);
+}
+
+TriangleMesh make_hyoid(const HyoidParameters& p, const FloorParameters& floor,
+                        const TongueParameters& tongue, double resolution_mm) {
+  return make_param_box(hyoid_box(p, floor, tongue, resolution_mm));
 }
 
 TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
@@ -161,40 +188,6 @@ TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
     return Vec3(back + (front - back) * axial, p.mouth_centre_y_mm + zy.y(), zy.x());
   };
   const int n_around = cells_for(2.0 * kPi * p.mouth_half_width_mm, 0.5 * resolution_mm, 24);
-  return make_param_torus(map, n_around, loop.size());
-}
-
-TriangleMesh make_larynx_trachea(const AirwayParameters& p, double resolution_mm) {
-  const double tilt = p.tilt_deg * kPi / 180.0;
-  const Vec3 inlet(p.inlet_x_mm, p.inlet_y_mm, 0.0);
-  const Vec3 down(-std::sin(tilt), -std::cos(tilt), 0.0);     // along the airway, inferior
-  const Vec3 anterior(std::cos(tilt), -std::sin(tilt), 0.0);  // towards the tongue base
-  const Vec3 lateral(0.0, 0.0, 1.0);
-  const double total = p.larynx_length_mm + p.trachea_length_mm;
-  const double top_span = p.epiglottis_height_mm + total;
-  const RectangleLoop loop{cells_for(top_span, resolution_mm),
-                           cells_for(p.wall_thickness_mm, 0.5 * resolution_mm)};
-  const auto map = [&](double around, double loop_fraction) {
-    const double a = 2.0 * kPi * around;
-    const auto [radial, axial] = loop.at(loop_index(loop_fraction, loop.size()));
-    // Epiglottis: the rim rises on the anterior side only (a = 0).
-    const double front = std::max(0.0, std::cos(a));
-    const double rise = p.epiglottis_height_mm * front * front;
-    const double s = -rise + (total + rise) * axial;  // axial position, mm below the inlet
-    double lumen =
-        p.trachea_lumen_radius_mm + (p.inlet_lumen_radius_mm - p.trachea_lumen_radius_mm) *
-                                        smoothstep(p.larynx_length_mm, 0.0, s);
-    double forward = 0.0;
-    if (s < 0.0) {
-      const double t = -s / p.epiglottis_height_mm;
-      forward = p.epiglottis_flare_mm * t * t * front;
-    }
-    const double r = lumen + p.wall_thickness_mm * radial;
-    return Vec3(inlet + s * down + (r * std::cos(a) + forward) * anterior +
-                r * std::sin(a) * lateral);
-  };
-  const int n_around = cells_for(2.0 * kPi * (p.inlet_lumen_radius_mm + p.wall_thickness_mm),
-                                 0.5 * resolution_mm, 24);
   return make_param_torus(map, n_around, loop.size());
 }
 

@@ -135,6 +135,34 @@ ClosednessReport check_closed(const TriangleMesh& mesh) {
       ++report.inconsistent_edges;
     }
   }
+  // A vertex is pinched when its triangles, joined through the edges they
+  // share at it, form more than one fan (two sheets touching at a point).
+  std::map<int, std::vector<std::pair<int, int>>> spokes;  // vertex -> (edge end, triangle)
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      spokes[tri[k]].push_back({tri[(k + 1) % 3], static_cast<int>(t)});
+      spokes[tri[k]].push_back({tri[(k + 2) % 3], static_cast<int>(t)});
+    }
+  }
+  for (auto& [vertex, around] : spokes) {
+    std::map<int, int> parent;  // triangle -> parent triangle
+    const auto find = [&parent](int i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    for (const auto& [end, tri] : around) parent[tri] = tri;
+    std::map<int, int> first_at_end;  // edge end -> a triangle using the edge (vertex, end)
+    for (const auto& [end, tri] : around) {
+      const auto [it, inserted] = first_at_end.emplace(end, tri);
+      if (!inserted) parent[find(tri)] = find(it->second);
+    }
+    int fans = 0;
+    for (const auto& [tri, up] : parent) {
+      if (find(tri) == tri) ++fans;
+    }
+    if (fans > 1) ++report.pinched_vertices;
+  }
   return report;
 }
 

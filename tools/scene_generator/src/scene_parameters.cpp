@@ -20,6 +20,8 @@ std::vector<Flag> flag_table(SceneParameters& p) {
   auto& pa = p.palate;
   auto& j = p.jaw;
   auto& f = p.face;
+  auto& fl = p.floor;
+  auto& h = p.hyoid;
   auto& a = p.airway;
   std::vector<Flag> flags = {
       {"tongue-cell-mm", &t.cell_mm, "background grid cell of the tongue mesher"},
@@ -42,15 +44,41 @@ std::vector<Flag> flag_table(SceneParameters& p) {
       {"jaw-length-mm", &j.length_mm, "chin to gonial angle"},
       {"jaw-back-half-width-mm", &j.back_half_width_mm, "half intergonial width"},
       {"jaw-ridge-y-mm", &j.ridge_y_mm, "lower gum ridge crest"},
-      {"jaw-floor-gap-mm", &j.floor_gap_mm, "gap under the tongue attachment"},
+      {"jaw-bottom-y-mm", &j.bottom_y_mm, "inferior border of the mandible"},
+      {"jaw-symphysis-top-mm", &j.symphysis_top_mm, "chin thickness at the gum ridge"},
+      {"jaw-symphysis-bottom-mm", &j.symphysis_bottom_mm, "chin thickness at the border"},
+      {"jaw-body-thickness-mm", &j.body_thickness_mm, "mandibular body thickness at the angle"},
+      {"floor-thickness-mm", &fl.thickness_mm, "floor of the mouth under the tongue plane"},
+      {"floor-bone-gap-mm", &fl.bone_gap_mm, "floor to bone clearance at rest"},
+      {"floor-back-x-mm", &fl.back_x_mm, "posterior edge of the floor"},
+      {"floor-back-half-width-mm", &fl.back_half_width_mm, "half width at the posterior edge"},
+      {"floor-tongue-drop-mm", &fl.tongue_drop_mm, "tongue drawn down onto the floor"},
+      {"floor-edge-round-mm", &fl.edge_round_mm, "rounding of the floor edges"},
+      {"floor-junction-fillet-mm", &fl.junction_fillet_mm, "fillet between tongue and floor"},
+      {"floor-attachment-band-mm", &fl.attachment_band_mm, "nodes this close to bone are fixed"},
+      {"hyoid-front-x-mm", &h.front_x_mm, "anterior face of the hyoid body"},
+      {"hyoid-length-mm", &h.length_mm, "hyoid body front to horn tips"},
+      {"hyoid-half-span-mm", &h.half_span_mm, "half the span of the greater horns"},
       {"mouth-half-width-mm", &f.mouth_half_width_mm, "half mouth opening width"},
       {"mouth-half-height-mm", &f.mouth_half_height_mm, "half mouth opening height"},
       {"lip-thickness-mm", &f.thickness_mm, "lip and cheek thickness"},
       {"larynx-inlet-x-mm", &a.inlet_x_mm, "laryngeal inlet centre x"},
-      {"larynx-inlet-y-mm", &a.inlet_y_mm, "laryngeal inlet centre y"},
+      {"larynx-inlet-y-mm", &a.inlet_y_mm, "laryngeal inlet posterior rim y"},
+      {"larynx-tilt-deg", &a.tilt_deg, "larynx axis lean, posterior going down"},
+      {"glottis-depth-mm", &a.glottis_depth_mm, "vocal folds below the posterior rim"},
+      {"glottis-half-length-mm", &a.glottis_half_length_mm, "half the glottis length (AP)"},
+      {"glottis-half-width-mm", &a.glottis_half_width_mm, "half the glottic slit width"},
+      {"subglottis-radius-mm", &a.subglottis_radius_mm, "cricoid lumen radius"},
       {"trachea-length-mm", &a.trachea_length_mm, "trachea length"},
       {"trachea-lumen-radius-mm", &a.trachea_lumen_radius_mm, "trachea lumen radius"},
-      {"epiglottis-height-mm", &a.epiglottis_height_mm, "epiglottis above the inlet"},
+      {"epiglottis-length-mm", &p.epiglottis.length_mm, "epiglottis base to tip"},
+      {"epiglottis-radius-mm", &p.epiglottis.radius_mm, "epiglottis curl radius"},
+      {"epiglottis-curl-deg", &p.epiglottis.curl_deg, "epiglottis curl angle"},
+      {"soft-palate-length-x-mm", &p.soft_palate.length_x_mm, "soft palate along x"},
+      {"soft-palate-thickness-mm", &p.soft_palate.thickness_mm, "soft palate thickness"},
+      {"soft-palate-tongue-gap-mm", &p.soft_palate.tongue_gap_mm, "soft palate above the tongue"},
+      {"pharynx-half-width-mm", &p.pharynx.half_width_mm, "pharyngeal lateral walls"},
+      {"pharynx-depth-mm", &p.pharynx.depth_mm, "pharyngeal lateral walls' forward reach"},
       {"surface-resolution-mm", &p.surface_resolution_mm, "rigid surface edge length"},
   };
   for (BladeParameters* b : {&p.miller0, &p.miller1}) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "fahr/scenegen/mesh_checks.h"
@@ -26,19 +27,41 @@ std::array<int, 3> sorted_face(const std::array<int, 4>& t, int f) {
   return k;
 }
 
+// The cube grid, turned about z by `turn` (grid frame to head frame).
 struct Grid {
-  Vec3 origin;
+  Vec3 origin;  // in the grid frame
   double h;
   int nx, ny, nz;
+  Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();
   int node(int i, int j, int k) const { return (i * (ny + 1) + j) * (nz + 1) + k; }
-  Vec3 position(int i, int j, int k) const { return origin + h * Vec3(i, j, k); }
+  Vec3 position(int i, int j, int k) const { return turn * (origin + h * Vec3(i, j, k)); }
 };
 
-Grid make_grid(const TongueShape& shape, double h) {
-  // One spare cell on every side so the surface never touches the grid edge.
-  const Vec3 lo = shape.lower_bound() - Vec3::Constant(h);
-  const Vec3 hi = shape.upper_bound() + Vec3::Constant(h);
-  Grid g{lo, h, 0, 0, 0};
+Grid make_grid(const ImplicitSolid& shape, const TetMesherSettings& settings) {
+  const double h = settings.cell_mm;
+  Grid g{Vec3::Zero(), h, 0, 0, 0};
+  g.turn =
+      Eigen::AngleAxisd(settings.grid_turn_z_deg * 3.14159265358979323846 / 180.0, Vec3::UnitZ())
+          .toRotationMatrix();
+  // The shape's box in the grid frame, with one spare cell on every side so
+  // the surface never touches the grid edge.
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = -lo;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 c((corner & 1) ? shape.upper_bound().x() : shape.lower_bound().x(),
+                 (corner & 2) ? shape.upper_bound().y() : shape.lower_bound().y(),
+                 (corner & 4) ? shape.upper_bound().z() : shape.lower_bound().z());
+    const Vec3 local = g.turn.transpose() * c;
+    lo = lo.cwiseMin(local);
+    hi = hi.cwiseMax(local);
+  }
+  lo -= Vec3::Constant(h);
+  hi += Vec3::Constant(h);
+  if (settings.grid_level_y_mm) {
+    // Put a grid level on the requested plane (y in the grid frame).
+    lo.y() = *settings.grid_level_y_mm - h * std::ceil((*settings.grid_level_y_mm - lo.y()) / h);
+  }
+  g.origin = lo;
   g.nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / h));
   g.ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / h));
   g.nz = static_cast<int>(std::ceil((hi.z() - lo.z()) / h));
@@ -49,7 +72,7 @@ Grid make_grid(const TongueShape& shape, double h) {
 }
 
 // Tets whose centroid is inside the solid, indices into the full grid.
-std::vector<std::array<int, 4>> inside_tets(const TongueShape& shape, const Grid& g) {
+std::vector<std::array<int, 4>> inside_tets(const ImplicitSolid& shape, const Grid& g) {
   std::vector<std::array<int, 4>> tets;
   for (int i = 0; i < g.nx; ++i) {
     for (int j = 0; j < g.ny; ++j) {
@@ -120,6 +143,94 @@ void remove_nonmanifold_edges(std::vector<std::array<int, 4>>& tets) {
   }
 }
 
+// Number of fans the boundary triangles around each vertex form (1 on a
+// manifold surface).
+std::map<int, int> boundary_fans(const std::vector<std::array<int, 3>>& faces) {
+  std::map<int, std::vector<std::pair<int, int>>> spokes;  // vertex -> (edge end, face)
+  for (size_t f = 0; f < faces.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      spokes[faces[f][k]].push_back({faces[f][(k + 1) % 3], static_cast<int>(f)});
+      spokes[faces[f][k]].push_back({faces[f][(k + 2) % 3], static_cast<int>(f)});
+    }
+  }
+  std::map<int, int> fans;
+  for (const auto& [v, around] : spokes) {
+    std::map<int, int> parent;
+    const auto find = [&parent](int i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    for (const auto& [end, f] : around) parent[f] = f;
+    std::map<int, int> first_at_end;
+    for (const auto& [end, f] : around) {
+      const auto [it, inserted] = first_at_end.emplace(end, f);
+      if (!inserted) parent[find(f)] = find(it->second);
+    }
+    int count = 0;
+    for (const auto& [f, up] : parent) count += find(f) == f ? 1 : 0;
+    fans[v] = count;
+  }
+  return fans;
+}
+
+// Tets that touch only at a vertex (two cones of tets meeting at a point,
+// where the tongue nearly touches the floor beside it) leave a boundary that
+// is not a manifold at that vertex. Around such a vertex the incident tets
+// are grouped by the faces they share through it and all but the largest
+// group are removed; when they form one group (the outside touches itself
+// there instead) all of them go. Alternates with the edge pass until both
+// hold.
+bool remove_pinched_vertices(std::vector<std::array<int, 4>>& tets) {
+  std::vector<int> pinched;
+  for (const auto& [v, fans] : boundary_fans(boundary_faces(tets))) {
+    if (fans > 1) pinched.push_back(v);
+  }
+  if (pinched.empty()) return false;
+  std::map<int, std::vector<int>> incident;
+  for (size_t t = 0; t < tets.size(); ++t) {
+    for (const int v : tets[t]) incident[v].push_back(static_cast<int>(t));
+  }
+  std::vector<bool> remove(tets.size(), false);
+  for (const int v : pinched) {
+    const std::vector<int>& around = incident[v];
+    // Union-find over the tets around v, joined by shared faces through v.
+    std::vector<int> parent(around.size());
+    for (size_t i = 0; i < around.size(); ++i) parent[i] = static_cast<int>(i);
+    const auto find = [&parent](int i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    std::map<std::array<int, 3>, int> face_owner;
+    for (size_t i = 0; i < around.size(); ++i) {
+      const auto& t = tets[around[i]];
+      for (int f = 0; f < 4; ++f) {
+        const std::array<int, 3> key = sorted_face(t, f);
+        if (std::find(key.begin(), key.end(), v) == key.end()) continue;
+        const auto [it, inserted] = face_owner.emplace(key, static_cast<int>(i));
+        if (!inserted) parent[find(static_cast<int>(i))] = find(it->second);
+      }
+    }
+    std::map<int, int> group_size;
+    for (size_t i = 0; i < around.size(); ++i) ++group_size[find(static_cast<int>(i))];
+    int largest = -1;
+    if (group_size.size() > 1) {
+      largest = group_size.begin()->first;
+      for (const auto& [root, size] : group_size) {
+        if (size > group_size[largest]) largest = root;
+      }
+    }
+    for (size_t i = 0; i < around.size(); ++i) {
+      if (find(static_cast<int>(i)) != largest) remove[around[i]] = true;
+    }
+  }
+  std::vector<std::array<int, 4>> kept;
+  for (size_t t = 0; t < tets.size(); ++t) {
+    if (!remove[t]) kept.push_back(tets[t]);
+  }
+  tets.swap(kept);
+  return true;
+}
+
 bool tet_acceptable(const MeshedSolid& m, const std::array<int, 4>& t, double min_volume,
                     double min_dihedral) {
   const Vec3& a = m.nodes[t[0]];
@@ -132,12 +243,16 @@ bool tet_acceptable(const MeshedSolid& m, const std::array<int, 4>& t, double mi
 
 }  // namespace
 
-MeshedSolid mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& settings,
+MeshedSolid mesh_implicit_solid(const ImplicitSolid& shape, const TetMesherSettings& settings,
                                 TetMesherReport& report) {
-  const Grid grid = make_grid(shape, settings.cell_mm);
+  const Grid grid = make_grid(shape, settings);
   report.grid_cells = grid.nx * grid.ny * grid.nz;
   auto tets = inside_tets(shape, grid);
-  remove_nonmanifold_edges(tets);
+  constexpr int kMaxTopologyPasses = 10;
+  for (int pass = 0; pass < kMaxTopologyPasses; ++pass) {
+    remove_nonmanifold_edges(tets);
+    if (!remove_pinched_vertices(tets)) break;
+  }
 
   // Compact the used grid nodes, in grid order (deterministic numbering).
   std::map<int, int> renumber;
@@ -175,22 +290,51 @@ MeshedSolid mesh_implicit_solid(const TongueShape& shape, const TetMesherSetting
   const double grid_tet_volume = std::pow(settings.cell_mm, 3) / 6.0;
   const double min_volume = settings.min_volume_fraction * grid_tet_volume;
   std::vector<double> moved_fraction(mesh.nodes.size(), 0.0);
-  for (int pass = 0; pass < settings.snap_passes; ++pass) {
-    for (const int v : boundary_nodes) {
-      const Vec3 start = mesh.nodes[v];
-      const Vec3 target = shape.project_to_surface(start);
-      for (const double fraction : {1.0, 0.5, 0.25}) {
-        mesh.nodes[v] = start + fraction * (target - start);
-        bool ok = true;
-        for (const int ti : node_tets[v]) {
-          ok = ok && tet_acceptable(mesh, mesh.tets[ti], min_volume, settings.min_dihedral_deg);
-        }
-        if (ok) {
-          moved_fraction[v] = fraction;
-          break;
-        }
-        mesh.nodes[v] = start;
-        moved_fraction[v] = 0.0;
+  const auto move_guarded = [&](int v, const Vec3& start, const Vec3& target,
+                                std::initializer_list<double> fractions) {
+    for (const double fraction : fractions) {
+      mesh.nodes[v] = start + fraction * (target - start);
+      bool ok = true;
+      for (const int ti : node_tets[v]) {
+        ok = ok && tet_acceptable(mesh, mesh.tets[ti], min_volume, settings.min_dihedral_deg);
+      }
+      if (ok) return fraction;
+    }
+    mesh.nodes[v] = start;
+    return 0.0;
+  };
+  // Interior nodes and their edge neighbours, for the smoothing between
+  // snapping rounds: an interior node moved towards the mean of its
+  // neighbours often unblocks a boundary node whose snap flattened a tet.
+  std::vector<bool> on_boundary(mesh.nodes.size(), false);
+  for (const int v : boundary_nodes) on_boundary[v] = true;
+  std::vector<std::vector<int>> neighbours(mesh.nodes.size());
+  for (const auto& t : mesh.tets) {
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        if (a != b) neighbours[t[a]].push_back(t[b]);
+      }
+    }
+  }
+  for (auto& n : neighbours) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  for (int round = 0; round <= settings.smoothing_rounds; ++round) {
+    if (round > 0) {
+      for (size_t v = 0; v < mesh.nodes.size(); ++v) {
+        if (on_boundary[v] || neighbours[v].empty()) continue;
+        Vec3 mean = Vec3::Zero();
+        for (const int u : neighbours[v]) mean += mesh.nodes[u];
+        mean /= static_cast<double>(neighbours[v].size());
+        move_guarded(static_cast<int>(v), mesh.nodes[v], mean, {0.5, 0.25});
+      }
+    }
+    for (int pass = 0; pass < settings.snap_passes; ++pass) {
+      for (const int v : boundary_nodes) {
+        const Vec3 start = mesh.nodes[v];
+        moved_fraction[v] =
+            move_guarded(v, start, shape.project_to_surface(start), {1.0, 0.5, 0.25});
       }
     }
   }

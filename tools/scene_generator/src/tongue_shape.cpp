@@ -22,8 +22,6 @@ const PiecewiseLinear kDorsalProfile{{0.0, 0.45}, {0.3, 0.95}, {0.6, 1.0}, {1.0,
 const PiecewiseLinear kVentralProfile{{0.0, 0.3}, {0.25, 0.8}, {0.5, 1.0}, {1.0, 0.9}};
 const PiecewiseLinear kWidthProfile{{0.0, 0.5}, {0.3, 0.8}, {0.7, 1.0}, {1.0, 1.0}};
 constexpr double kTipCapOfHalfWidth = 0.6;  // rounded tip: cap length / tip half width
-constexpr double kGradientStepMm = 1e-4;
-constexpr int kNewtonSteps = 6;
 
 Eigen::Vector2d bezier(const Eigen::Vector2d* c, double t) {
   const double s = 1.0 - t;
@@ -121,36 +119,18 @@ double TongueShape::sweep_value(const Vec3& p) const {
   return (g - 1.0) * size;
 }
 
-double TongueShape::attachment_plane_distance(const Vec3& p) const {
+double attachment_plane_y(const TongueParameters& params, double x_mm) {
   constexpr double kReferenceX = -15.0;  // x at which floor_y_at_x15_mm is given
-  const double floor_y = params_.floor_y_at_x15_mm + params_.floor_slope * (p.x() - kReferenceX);
-  return (floor_y - p.y()) / std::sqrt(1.0 + params_.floor_slope * params_.floor_slope);
+  return params.floor_y_at_x15_mm + params.floor_slope * (x_mm - kReferenceX);
+}
+
+double TongueShape::attachment_plane_distance(const Vec3& p) const {
+  return (attachment_plane_y(params_, p.x()) - p.y()) /
+         std::sqrt(1.0 + params_.floor_slope * params_.floor_slope);
 }
 
 double TongueShape::value(const Vec3& p) const {
   return std::max(sweep_value(p), attachment_plane_distance(p));
-}
-
-Vec3 TongueShape::gradient(const Vec3& p) const {
-  Vec3 g;
-  for (int i = 0; i < 3; ++i) {
-    Vec3 dp = Vec3::Zero();
-    dp[i] = kGradientStepMm;
-    g[i] = (value(p + dp) - value(p - dp)) / (2.0 * kGradientStepMm);
-  }
-  return g;
-}
-
-Vec3 TongueShape::project_to_surface(const Vec3& p) const {
-  Vec3 x = p;
-  for (int i = 0; i < kNewtonSteps; ++i) {
-    const double f = value(x);
-    const Vec3 g = gradient(x);
-    const double g2 = g.squaredNorm();
-    if (g2 < 1e-12) break;  // flat spot (crease of the max): stop where we are
-    x -= (f / g2) * g;
-  }
-  return x;
 }
 
 }  // namespace fahr::scenegen

@@ -28,6 +28,7 @@ struct ClosednessReport {
   int edge_count = 0;
   int bad_edges = 0;           // undirected edges not used by exactly two triangles
   int inconsistent_edges = 0;  // edges whose two triangles run them the same way
+  int pinched_vertices = 0;    // vertices whose triangles form more than one fan
   int degenerate_triangles = 0;
   // Edges whose two triangles lie back to back (anti-parallel normals): the
   // surface folds onto itself with zero thickness there.
@@ -35,7 +36,9 @@ struct ClosednessReport {
   // Smallest opening angle between the two triangles of an edge (180 = flat,
   // 0 = folded), over edges shared by exactly two non-degenerate triangles.
   double sharpest_edge_deg = 180.0;
-  bool closed_and_oriented() const { return bad_edges == 0 && inconsistent_edges == 0; }
+  bool closed_and_oriented() const {
+    return bad_edges == 0 && inconsistent_edges == 0 && pinched_vertices == 0;
+  }
   // Closed, oriented, and usable for a signed distance: no folds, no zero-area triangles.
   bool clean() const {
     return closed_and_oriented() && folded_edges == 0 && degenerate_triangles == 0;

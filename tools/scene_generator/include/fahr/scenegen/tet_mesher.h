@@ -5,11 +5,12 @@
 // refused when it would invert a tet or push it below the quality floor.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "fahr/scenegen/geometry_types.h"
-#include "fahr/scenegen/tongue_shape.h"
+#include "fahr/scenegen/implicit_solid.h"
 
 namespace fahr::scenegen {
 
@@ -18,6 +19,13 @@ struct TetMesherSettings {
   double min_dihedral_deg = 8.0;     // snapping keeps every touched tet above this
   double min_volume_fraction = 0.1;  // ... and above this fraction of a grid tet's volume
   int snap_passes = 3;
+  // Rounds of interior smoothing, each followed by the snap passes again.
+  int smoothing_rounds = 2;
+  // The grid turned about z by this angle (a plane of the solid can then lie
+  // along grid faces), and optionally one grid level put on y = this value
+  // in the turned frame.
+  double grid_turn_z_deg = 0.0;
+  std::optional<double> grid_level_y_mm;
 };
 
 struct TetMesherReport {
@@ -30,7 +38,7 @@ struct TetMesherReport {
   int nonmanifold_boundary_edges = 0;
 };
 
-MeshedSolid mesh_implicit_solid(const TongueShape& shape, const TetMesherSettings& settings,
+MeshedSolid mesh_implicit_solid(const ImplicitSolid& shape, const TetMesherSettings& settings,
                                 TetMesherReport& report);
 
 }  // namespace fahr::scenegen

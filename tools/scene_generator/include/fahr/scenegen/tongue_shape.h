@@ -8,25 +8,29 @@
 #include <vector>
 
 #include "fahr/scenegen/geometry_types.h"
+#include "fahr/scenegen/implicit_solid.h"
 #include "fahr/scenegen/scene_parameters.h"
 
 namespace fahr::scenegen {
 
-class TongueShape {
+// Height (y, mm) of the tongue's attachment plane at x: the plane where the
+// tongue meets the floor of the mouth, rising anteriorly.
+double attachment_plane_y(const TongueParameters& params, double x_mm);
+
+class TongueShape final : public ImplicitSolid {
  public:
   explicit TongueShape(const TongueParameters& params);
 
-  double value(const Vec3& p) const;
-  Vec3 gradient(const Vec3& p) const;  // central differences
-  // Newton steps along the gradient onto the zero level set.
-  Vec3 project_to_surface(const Vec3& p) const;
+  // The swept tongue cut by its attachment plane.
+  double value(const Vec3& p) const override;
+  // The swept tongue alone (no cut).
+  double sweep_value(const Vec3& p) const;
 
   // Signed distance (mm) to the attachment plane, negative above it (tissue side).
   double attachment_plane_distance(const Vec3& p) const;
 
-  // Conservative bounds of the solid, mm.
-  Vec3 lower_bound() const { return lower_; }
-  Vec3 upper_bound() const { return upper_; }
+  Vec3 lower_bound() const override { return lower_; }
+  Vec3 upper_bound() const override { return upper_; }
   double midline_length_mm() const { return length_; }
 
  private:
@@ -41,7 +45,6 @@ class TongueShape {
     double half_width_mm;
   };
   Section section_at(double arc_mm) const;
-  double sweep_value(const Vec3& p) const;
 
   TongueParameters params_;
   std::vector<SpineSample> spine_;

@@ -1,0 +1,40 @@
+// The airway behind the mouth as closed surfaces in the head frame (mm):
+// soft palate with the uvula, pharyngeal wall, epiglottis, larynx (vocal
+// folds, glottic opening, aryepiglottic folds) and trachea. Dimensions and
+// sources: meshes/neonatal/README.md.
+#pragma once
+
+#include "fahr/scenegen/geometry_types.h"
+#include "fahr/scenegen/implicit_solid.h"
+#include "fahr/scenegen/param_surfaces.h"
+#include "fahr/scenegen/scene_parameters.h"
+
+namespace fahr::scenegen {
+
+// Larynx and trachea: one thick-walled tube (AirwayParameters).
+TriangleMesh make_larynx_trachea(const AirwayParameters& p, double resolution_mm);
+// The larynx axis point `depth_mm` below the posterior rim (the glottis at
+// glottis_depth_mm), for the landmarks.
+Vec3 larynx_axis_point(const AirwayParameters& p, double depth_mm);
+
+ParamBox epiglottis_box(const EpiglottisParameters& e, const AirwayParameters& a,
+                        double resolution_mm);
+TriangleMesh make_epiglottis(const EpiglottisParameters& e, const AirwayParameters& a,
+                             double resolution_mm);
+
+// The soft palate lies on the tongue's dorsum at rest: `tongue` is the FEM
+// body's shape, whose top it follows at tongue_gap_mm.
+ParamBox soft_palate_box(const SoftPalateParameters& s, const PalateParameters& palate,
+                         const ImplicitSolid& tongue, double resolution_mm);
+TriangleMesh make_soft_palate(const SoftPalateParameters& s, const PalateParameters& palate,
+                              const ImplicitSolid& tongue, double resolution_mm);
+
+// x of the posterior pharyngeal wall's anterior face at the mid-line, at height y.
+double pharynx_wall_x(double y_mm);
+ParamBox pharynx_box(const PharynxParameters& p, double resolution_mm);
+TriangleMesh make_pharynx(const PharynxParameters& p, double resolution_mm);
+
+// Highest y (mm) inside `solid` on the vertical line through (x, z), or NaN.
+double top_of(const ImplicitSolid& solid, double x_mm, double z_mm);
+
+}  // namespace fahr::scenegen
