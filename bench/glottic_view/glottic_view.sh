@@ -2,7 +2,8 @@
 # The glottic view score (libs/glottic_view) on the shipped scene, by lines
 # of sight and by a pixel count of the same view (fahr_glottic_score): the
 # blade's suggested poses from the scene's eye, a sweep of eyes around the
-# opening that sees all, part and none of it, the grid of blade poses the
+# opening that sees all, part and none of it, what the rigid anatomy alone
+# lets through from the mouth's side, the grid of blade poses the
 # laryngoscopist could hold, and (with --recording) a recorded run's rest,
 # best and last view; the wall time of a score; the pictures.
 #
@@ -71,17 +72,27 @@ row() {
     "$tool" --pose "$pose" "${png[@]}" | grep '^view' | row
   done
   echo
-  echo "## Eyes 30 mm from the opening, turned from its normal towards the mouth (mid-sagittal, 4 mm aside)"
+  echo "## Eyes 20 mm from the opening, turned from its normal towards the mouth (mid-sagittal, 4 mm aside)"
   echo
   echo "| turned, deg | eye, world mm | rays % | pixels % | difference, points | score ms |"
   echo "| --- | --- | ---: | ---: | ---: | ---: |"
-  # The opening's centre, normal and the anterior direction in the
-  # mid-sagittal plane, from the scene's glottic_view section.
-  for deg in -70 -40 -10 10 14 17 19 21 30 60; do
-    eye=$(awk -v d="$deg" 'BEGIN { pi = atan2(0, -1); t = d * pi / 180; s = sin(8 * pi / 180); c = cos(8 * pi / 180);
-      x = -62.070 + 30 * (cos(t) * s + sin(t) * c); y = -30.495 + 30 * (cos(t) * c - sin(t) * s);
-      printf "%.2f,%.2f,4", x, y }')
-    "$tool" --eye "$eye" | grep '^view' | row | sed -E "s/^\| scene \|/| $deg |/"
+  for deg in -70 -40 -10 0 10 14 17 19 21 30; do
+    "$tool" --around "$deg,20,4" | grep '^view' | row | sed -E "s/^\| scene \|/| $deg |/"
+  done
+  echo
+  echo "## The rigid anatomy alone (no tongue, no blade), rays only: eyes turned from the opening's normal towards the mouth"
+  echo
+  echo "A line from the glottis through the mouth opening is turned 52-57 deg; the eyes at 150 and 300 mm on it lie beyond the lips."
+  echo
+  echo "| turned, deg | 40 mm | 150 mm | 300 mm |"
+  echo "| ---: | ---: | ---: | ---: |"
+  for deg in 0 10 20 35 45 55; do
+    line="| $deg |"
+    for mm in 40 150 300; do
+      r=$("$tool" --anatomy-only --around "$deg,$mm,0" --samples 256 | sed -E 's/.*rays ([0-9.]+) %.*/\1/')
+      line="$line $r |"
+    done
+    echo "$line"
   done
   echo
   echo "## Blade poses: tip (x, y) mm and pitch, the tongue at rest, rays only"

@@ -62,6 +62,25 @@ TEST(SceneErrors, GlotticViewNeedsItsKeysAUnitNormalAndATool) {
   expect_contains(message, {"glottic_view: the eye rides on the tool: the scene has no tool"});
 }
 
+TEST(SceneErrors, AnEllipticOpeningNeedsBothKeysAnAxisInItsPlaneAndTheSmallerRadiusAcross) {
+  const std::string section =
+      "glottic_view:\n  opening_centre_m: [-0.06, -0.03, 0]\n  opening_normal: [0, 1, 0]\n"
+      "  opening_radius_m: 0.003\n  eye_in_tool_m: [0.3, 0.05, 0]\n";
+  expect_contains(
+      error_of(std::string(kMinimalScene) + section + "  opening_minor_radius_m: 0.001\n"),
+      {"glottic_view.opening_minor_radius_m: an elliptic opening needs both"});
+  expect_contains(
+      error_of(std::string(kMinimalScene) + section +
+               "  opening_major_axis: [0, 1, 0]\n  opening_minor_radius_m: 0.004\n"),
+      {"glottic_view.opening_major_axis: the major axis must have unit length and lie in the "
+       "opening's plane",
+       "glottic_view.opening_minor_radius_m: the minor radius must not exceed opening_radius_m"});
+  const auto scene = parse(std::string(kMinimalScene) + section +
+                           "  opening_major_axis: [1, 0, 0]\n  opening_minor_radius_m: 0.001\n");
+  EXPECT_DOUBLE_EQ(scene->glottic_view->opening_minor_radius_m, 0.001);
+  EXPECT_DOUBLE_EQ(scene->glottic_view->opening_major_axis.x(), 1.0);
+}
+
 TEST(SceneErrors, GlotticViewLoads) {
   const auto scene = parse(std::string(kMinimalScene) +
                            "glottic_view:\n  opening_centre_m: [-0.06, -0.03, 0]\n"

@@ -144,12 +144,13 @@ TEST(GlotticViewService, ScoresTheNewestStateFromTheEyeOnTheBladeAndRefusesBadSt
   }
   state.positions_m(xyz);
   put(live, kDeformationState, state);
-  // The blade placed so that the eye sits 30 mm above the opening, on its
-  // axis: the whole opening is in view. Three contacts: two of the tool
+  // The blade placed so that the eye sits 20 mm above the glottis on the
+  // larynx's axis (inside the laryngeal vestibule and pharynx): the whole
+  // opening is in view. (30 mm up, rigid anatomy hides it.) Three contacts: two of the tool
   // (1 N and 2 N, one along +y, one at 90 deg) and one of the anatomy,
   // which is not the blade's force.
   const Eigen::Vector3d eye =
-      reference.view.opening().centre_m + 0.03 * reference.view.opening().normal;
+      reference.view.opening().centre_m + 0.02 * reference.view.opening().normal;
   const Eigen::Vector3d tip = eye - reference.eye_in_tool_m;
   msg::ContactSet set;
   set.body_id(state.body_id());

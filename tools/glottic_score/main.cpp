@@ -4,17 +4,20 @@
 // for one blade pose or over a recording; and the laryngoscopist's picture.
 //
 //   fahr_glottic_score [--scene FILE] [--pose initial|pressing|X,Y,Z,PITCH]
-//                     [--eye X,Y,Z] [--png FILE] [--samples N]
+//                     [--eye X,Y,Z | --around DEG,MM,ASIDE] [--png FILE] [--samples N]
 //   fahr_glottic_score --recording RUN.mcap [--every-ms 100] [--png-prefix P]
 //
 // --pose: the tool's pose, a preset of meshes/neonatal/README.md or the tip
 // at X,Y,Z mm turned PITCH degrees about +z (default: the scene's pose).
 // --eye X,Y,Z: the eye in the world, mm, instead of the scene's eye on the
-// tool. --recording: the tongue and the tool pose of each FEM state in the
-// file, scored every --every-ms of the run's simulated time; prints the
-// rest view, the one under the blade's largest force on the tissue, the
-// best and the last, each by both methods; --png-prefix P writes
-// P_rest.png, P_pressed.png, P_best.png and P_last.png.
+// tool. --around DEG,MM,ASIDE: the eye MM from the opening's centre, turned
+// DEG from its normal towards the mouth (+x) in the mid-sagittal plane and
+// ASIDE mm along +z. --anatomy-only: only the rigid anatomy in the view, no
+// soft body and no tool (what the skeleton of the airway allows). --recording: the tongue and the
+// tool pose of each FEM state in the file, scored every --every-ms of the run's simulated time;
+// prints the rest view, the one under the blade's largest force on the tissue, the best and the
+// last, each by both methods; --png-prefix P writes P_rest.png, P_pressed.png, P_best.png and
+// P_last.png.
 //
 // A line per view: "view <label>: rays R % (seen/facing samples, its wall
 // time), pixels P % (seen/drawn), difference D points". Exit 0, or 1 on an
@@ -241,12 +244,20 @@ int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshe
 
 int run(int argc, char** argv) {
   CLI::App app{"fahr_glottic_score: the glottic view score by lines of sight and by pixels"};
-  std::string scene_path = FAHR_DEFAULT_SCENE, pose_text, eye_text, png, recording, png_prefix;
+  std::string scene_path = FAHR_DEFAULT_SCENE, pose_text, eye_text, around_text, png, recording,
+              png_prefix;
   std::size_t samples = 1024;
   double every_ms = 100.0;
+  bool anatomy_only = false;
   app.add_option("--scene", scene_path, "scene file (its glottic_view section)");
   app.add_option("--pose", pose_text, "initial | pressing | X,Y,Z,PITCH (mm, deg about +z)");
   app.add_option("--eye", eye_text, "X,Y,Z: the eye in the world, mm (default: the scene's)");
+  app.add_option("--around", around_text,
+                 "DEG,MM,ASIDE: the eye MM from the opening, DEG from its normal towards the "
+                 "mouth, ASIDE mm along +z")
+      ->excludes("--eye");
+  app.add_flag("--anatomy-only", anatomy_only,
+               "only the rigid anatomy in the view: no soft body, no tool (the eye stays)");
   app.add_option("--png", png, "write the laryngoscopist's picture here");
   app.add_option("--samples", samples, "samples on the opening")->check(CLI::Range(16, 1 << 20));
   app.add_option("--recording", recording, "score the FEM states of this MCAP recording");
@@ -270,7 +281,19 @@ int run(int argc, char** argv) {
     const auto v = numbers(eye_text, 3, "--eye");
     in.eye_m = 1e-3 * Eigen::Vector3d(v[0], v[1], v[2]);
   }
-  for (const auto& rest : view.deformable_rest_m) in.deformable_positions.emplace_back(rest);
+  if (!around_text.empty()) {
+    const auto v = numbers(around_text, 3, "--around");
+    const glottic_view::Opening& o = view.view.opening();
+    const Eigen::Vector3d towards_mouth = o.normal.cross(Eigen::Vector3d::UnitZ()).normalized();
+    const double a = v[0] * M_PI / 180.0;
+    in.eye_m = o.centre_m + 1e-3 * v[1] * (std::cos(a) * o.normal + std::sin(a) * towards_mouth) +
+               1e-3 * v[2] * Eigen::Vector3d::UnitZ();
+  }
+  if (anatomy_only) {
+    in.world_from_tool.reset();
+  } else {
+    for (const auto& rest : view.deformable_rest_m) in.deformable_positions.emplace_back(rest);
+  }
   print(pose_text.empty() ? "scene" : pose_text, compare(view, meshes, in), in);
   if (!png.empty()) write_png(meshes, view.view.opening(), in, png);
   return 0;

@@ -31,12 +31,10 @@ TriangleMesh to_mm(const geometry::SurfaceMesh& s, const scene::Pose* pose) {
 
 TriangleMesh disc_mm(const glottic_view::Opening& o) {
   TriangleMesh m;
-  const Eigen::Vector3d u = o.normal.unitOrthogonal();
-  const Eigen::Vector3d v = o.normal.cross(u);
   m.vertices.push_back(1e3 * o.centre_m);
   for (int i = 0; i < kDiscSegments; ++i) {
     const double a = 2.0 * kPi * i / kDiscSegments;
-    m.vertices.push_back(1e3 * (o.centre_m + o.radius_m * (std::cos(a) * u + std::sin(a) * v)));
+    m.vertices.push_back(1e3 * glottic_view::opening_point(o, std::cos(a), std::sin(a)));
     m.triangles.push_back({0, 1 + i, 1 + (i + 1) % kDiscSegments});
   }
   return m;

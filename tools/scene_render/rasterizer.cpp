@@ -12,7 +12,7 @@ namespace {
 constexpr double kAmbient = 0.45;
 constexpr double kDiffuse = 0.55;
 constexpr double kBackFaceShade = 0.6;  // inner faces seen through the cut
-constexpr double kNearMm = 1.0;         // perspective: nothing closer to the eye is drawn
+constexpr double kNearMm = 0.05;        // perspective: nothing closer to the eye is drawn
 constexpr double kPi = 3.14159265358979323846;
 
 }  // namespace

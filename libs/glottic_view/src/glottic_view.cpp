@@ -9,23 +9,28 @@
 namespace fahr::glottic_view {
 namespace {
 
-// Vogel's sunflower: sample i at radius R sqrt((i + 1/2) / n), turned by the
-// golden angle each step; every sample stands for an equal area of the disc.
+// Vogel's sunflower on the unit disc: sample i at radius sqrt((i + 1/2) / n),
+// turned by the golden angle each step; every sample stands for an equal
+// area. opening_point's map is linear, so they stay equal-area on the ellipse.
 std::vector<Eigen::Vector3d> sunflower(const Opening& o, std::size_t n) {
   const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  const Eigen::Vector3d u = o.normal.unitOrthogonal();
-  const Eigen::Vector3d v = o.normal.cross(u);
   std::vector<Eigen::Vector3d> points(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double r =
-        o.radius_m * std::sqrt((static_cast<double>(i) + 0.5) / static_cast<double>(n));
+    const double r = std::sqrt((static_cast<double>(i) + 0.5) / static_cast<double>(n));
     const double a = golden * static_cast<double>(i);
-    points[i] = o.centre_m + r * (std::cos(a) * u + std::sin(a) * v);
+    points[i] = opening_point(o, r * std::cos(a), r * std::sin(a));
   }
   return points;
 }
 
 }  // namespace
+
+Eigen::Vector3d opening_point(const Opening& o, double x, double y) {
+  const bool ellipse = o.minor_radius_m > 0.0;
+  const Eigen::Vector3d u = ellipse ? o.major_axis : o.normal.unitOrthogonal();
+  const Eigen::Vector3d v = o.normal.cross(u);
+  return o.centre_m + o.radius_m * x * u + (ellipse ? o.minor_radius_m : o.radius_m) * y * v;
+}
 
 GlotticView::GlotticView(const Opening& opening, std::size_t samples) : opening_(opening) {
   if (!(opening.radius_m > 0.0) || !std::isfinite(opening.radius_m)) {
@@ -39,6 +44,20 @@ GlotticView::GlotticView(const Opening& opening, std::size_t samples) : opening_
     throw std::invalid_argument("glottic view: at least 16 samples");
   }
   opening_.normal /= length;
+  if (opening.minor_radius_m != 0.0) {
+    if (!(opening.minor_radius_m > 0.0) || !(opening.minor_radius_m <= opening.radius_m)) {
+      throw std::invalid_argument(
+          "glottic view: the opening's minor radius must lie in (0, radius]");
+    }
+    Eigen::Vector3d u =
+        opening.major_axis - opening.major_axis.dot(opening_.normal) * opening_.normal;
+    if (!u.allFinite() || !(u.norm() > 1e-6)) {
+      throw std::invalid_argument(
+          "glottic view: an elliptic opening needs a major axis in its plane");
+    }
+    u.normalize();
+    opening_.major_axis = u;
+  }
   points_ = sunflower(opening_, samples);
 }
 

@@ -11,7 +11,8 @@ namespace fahr::glottic_view {
 namespace {
 
 Opening opening_of(const scene::GlotticViewSettings& g) {
-  return {g.opening_centre_m, g.opening_normal, g.opening_radius_m};
+  return {g.opening_centre_m, g.opening_normal, g.opening_radius_m, g.opening_major_axis,
+          g.opening_minor_radius_m};
 }
 
 geometry::SurfaceMesh posed(const geometry::SurfaceMesh& local, const scene::Pose& pose) {

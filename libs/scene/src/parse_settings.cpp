@@ -294,9 +294,9 @@ ContactSettings parse_contact(const ParseContext& ctx, const MapReader& top,
 std::optional<GlotticViewSettings> parse_glottic_view(const ParseContext& ctx, const MapReader& top,
                                                       const std::vector<Body>& bodies) {
   if (!top.has("glottic_view")) return std::nullopt;
-  const MapReader map(
-      ctx.log, top.value("glottic_view"), "glottic_view",
-      {"opening_centre_m", "opening_normal", "opening_radius_m", "eye_in_tool_m", "rate_hz"});
+  const MapReader map(ctx.log, top.value("glottic_view"), "glottic_view",
+                      {"opening_centre_m", "opening_normal", "opening_radius_m",
+                       "opening_major_axis", "opening_minor_radius_m", "eye_in_tool_m", "rate_hz"});
   GlotticViewSettings g;
   for (const std::string_view key :
        {"opening_centre_m", "opening_normal", "opening_radius_m", "eye_in_tool_m"}) {
@@ -311,6 +311,28 @@ std::optional<GlotticViewSettings> parse_glottic_view(const ParseContext& ctx, c
     g.opening_normal.normalize();
   }
   map.read("opening_radius_m", open_closed(0.0, 0.1), g.opening_radius_m);
+  const bool has_axis = map.read("opening_major_axis", closed(-1.0, 1.0), g.opening_major_axis);
+  const bool has_minor =
+      map.read("opening_minor_radius_m", open_closed(0.0, 0.1), g.opening_minor_radius_m);
+  if (has_minor != has_axis) {
+    const std::string_view given = has_minor ? "opening_minor_radius_m" : "opening_major_axis";
+    ctx.log.add(map.value(given).Mark(), map.child_path(given),
+                "an elliptic opening needs both opening_major_axis and opening_minor_radius_m");
+  } else if (has_minor) {
+    const Eigen::Vector3d in_plane =
+        g.opening_major_axis - g.opening_major_axis.dot(g.opening_normal) * g.opening_normal;
+    if (std::abs(g.opening_major_axis.norm() - 1.0) > 1e-3 ||
+        in_plane.norm() < 0.999 * g.opening_major_axis.norm()) {
+      ctx.log.add(map.value("opening_major_axis").Mark(), map.child_path("opening_major_axis"),
+                  "the major axis must have unit length and lie in the opening's plane "
+                  "(perpendicular to opening_normal)");
+    }
+    if (g.opening_minor_radius_m > g.opening_radius_m) {
+      ctx.log.add(map.value("opening_minor_radius_m").Mark(),
+                  map.child_path("opening_minor_radius_m"),
+                  "the minor radius must not exceed opening_radius_m");
+    }
+  }
   map.read("eye_in_tool_m", closed(-10.0, 10.0), g.eye_in_tool_m);
   map.read("rate_hz", open_closed(0.0, 100.0), g.rate_hz);
   const bool has_tool = std::any_of(bodies.begin(), bodies.end(),

@@ -3,7 +3,9 @@
 // of glottic opening, POGO, that trainers grade laryngoscopy by: Levitan et
 // al., Acad Emerg Med 1998;5:919).
 //
-// The opening is a disc. Its area is sampled by a sunflower pattern; each
+// The opening is an ellipse (a disc when its two radii are equal: the glottic
+// slit is long from front to back and narrow across). Its area is sampled by
+// a sunflower pattern; each
 // sample is seen when the segment from the eye to it crosses no occluding
 // triangle, and counts with the solid angle its patch of disc subtends at the
 // eye (cos(normal, sight) / distance^2), so the score is the visible share
@@ -33,8 +35,18 @@ namespace fahr::glottic_view {
 struct Opening {
   Eigen::Vector3d centre_m = Eigen::Vector3d::Zero();  // world frame
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();   // unit; out of the airway, towards the eye
-  double radius_m = 0.0;
+  double radius_m = 0.0;  // along major_axis (the disc's radius when minor_radius_m is 0)
+  // An ellipse: the direction of radius_m (in the opening's plane; its part
+  // along the normal is removed) and the radius across it, (0, radius_m].
+  // A zero minor radius makes the opening a disc and major_axis unused.
+  Eigen::Vector3d major_axis = Eigen::Vector3d::Zero();
+  double minor_radius_m = 0.0;
 };
+
+// The opening's point at (x, y) of the unit disc: x along the major axis
+// (any direction in the plane for a disc), y across it. For an opening as
+// GlotticView::opening() gives it (unit normal, major axis in its plane).
+Eigen::Vector3d opening_point(const Opening& opening, double x, double y);
 
 struct ViewScore {
   double visible_share = 0.0;  // [0, 1]: the POGO score / 100
@@ -45,8 +57,9 @@ struct ViewScore {
 
 class GlotticView {
  public:
-  // Throws std::invalid_argument on a non-positive radius, a zero normal or
-  // fewer than 16 samples.
+  // Throws std::invalid_argument on a non-positive radius, a zero normal, a
+  // minor radius above the radius or with no major axis in the opening's
+  // plane, or fewer than 16 samples.
   explicit GlotticView(const Opening& opening, std::size_t samples = 1024);
 
   // A rigid occluder, world frame (m).
@@ -68,7 +81,7 @@ class GlotticView {
                   std::span<const std::span<const Eigen::Vector3d>> deformable_positions);
 
   const Opening& opening() const { return opening_; }
-  // The sample points on the disc, world frame (for tests and pictures).
+  // The sample points on the opening, world frame (for tests and pictures).
   const std::vector<Eigen::Vector3d>& sample_points() const { return points_; }
 
  private:
