@@ -169,6 +169,11 @@ void LockstepClient::complete_through(std::uint64_t step, std::uint64_t output_h
   acks_.write(ack);
 }
 
+bool LockstepClient::wait_for_stop(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  return changed_.wait_for(lock, timeout, [&] { return stop_; });
+}
+
 bool LockstepClient::stopped() const {
   std::lock_guard lock(mutex_);
   return stop_;

@@ -256,6 +256,9 @@ int run_lockstep(const GatewayOptions& o, GatewaySetup& setup, common::Participa
       metrics.offer(state.snapshot);
     }
   }
+  // Past its own last step, stay until the clock stops the run, so the last
+  // acknowledgement and DevicePose reach their readers.
+  if (total_ticks != 0 && core.ticks() == total_ticks) client.wait_for_stop(20s);
   fill_snapshot(core, setup, state);
   metrics.offer(state.snapshot);
   std::printf("lockstep: %llu steps, DevicePose hash %016llx\n",

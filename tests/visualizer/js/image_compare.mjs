@@ -9,16 +9,17 @@
 // a pixel: those pixels differ, but few of them (edges are a small part of
 // the frame) and rarely by much. A real change (the camera a millimetre
 // off, a colour map off by a tenth, a body missing or moved) changes many
-// pixels or changes them a lot. So: at most 0.3 % of the pixels may differ
+// pixels or changes them a lot. So: at most 0.5 % of the pixels may differ
 // by more than 32 (an eighth of full scale), and the mean over all pixels
-// of the largest channel difference must stay below 0.4. Measured on the
-// held rest frame (tests/visualizer/README.md): the same state drawn
-// twice 0 and 0; the hand's first second, start against 0.4 s in, 0.008 %
-// and 0.075; the camera turned 2.9 mm 0.45 % and 0.87; the tongue's
-// colours 10 % off 0.02 % and 1.4.
+// of the largest channel difference must stay below 0.6. Measured on the
+// held rest frame (tests/visualizer/README.md) of the shipped scene: the
+// same state drawn twice 0 and 0; two frames of the hand's first second
+// (0.145 s against 0.242 s: the tongue settles on its yielding floor)
+// 0.31 % and 0.40; the camera turned 2.9 mm 0.80 % and 1.31; the tongue's
+// colours 10 % off 0.32 % and 2.17.
 import { PNG } from "pngjs";
 
-export const TOLERANCE = { step: 32, shareAbove: 0.003, meanAbs: 0.4 };
+export const TOLERANCE = { step: 32, shareAbove: 0.005, meanAbs: 0.6 };
 
 export function decodePng(buffer) {
   return PNG.sync.read(buffer);

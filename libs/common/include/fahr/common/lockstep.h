@@ -98,6 +98,12 @@ class LockstepClient {
   // Reports every step up to and including `step` complete.
   void complete_through(std::uint64_t step, std::uint64_t output_hash);
   bool stopped() const;
+  // Blocks until the coordinator says stop; false after the timeout. A
+  // client that leaves after its own last step waits here first: leaving
+  // at once can take its last acknowledgement and outputs with it (a
+  // reliable writer deleted before the readers acknowledged; seen on Fast
+  // DDS as a clock stalled one step before the end).
+  bool wait_for_stop(std::chrono::milliseconds timeout);
 
  private:
   void on_clock(const msg::SimClock& clock);
