@@ -119,7 +119,9 @@ row() {
     echo
     grep '^fahr_glottic_score' "$work/run.txt" || true
   fi
-} | tee "$work/out.md"
-if [ ${#markdown[@]} -gt 0 ]; then
-  "$results" glottic-view "${markdown[@]}" -- "${command[@]}" <"$work/out.md"
+} | if [ ${#markdown[@]} -gt 0 ]; then
+  # It copies the tables to stdout as they come, so its wall time is the run's.
+  "$results" glottic-view "${markdown[@]}" -- "${command[@]}"
+else
+  cat
 fi
