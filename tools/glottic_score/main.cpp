@@ -34,6 +34,7 @@
 #include "contact_setPubSubTypes.h"
 #include "deformation_statePubSubTypes.h"
 #include "fahr/common/cdr_bytes.h"
+#include "fahr/glottic_view/blade_from_contacts.h"
 #include "fahr/glottic_view/scene_view.h"
 #include "fahr/mcap/reader.h"
 #include "fahr/scene/load_scene.h"
@@ -162,21 +163,11 @@ int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshe
                                                 const mcap::MessageView& m) {
     if (c.topic == "fahr/ContactSet") {
       if (!common::decode_cdr<msg::ContactSetPubSubType>(m.data, contacts)) return;
-      const auto& p = contacts.world_from_tool();
-      const auto& q = p.orientation();
-      if (q.w() == 0.0 && q.x() == 0.0 && q.y() == 0.0 && q.z() == 0.0) return;
-      current.world_from_tool = Eigen::Isometry3d::Identity();
-      current.world_from_tool.linear() =
-          Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
-      current.world_from_tool.translation() =
-          Eigen::Vector3d(p.position_m().x(), p.position_m().y(), p.position_m().z());
+      const glottic_view::BladeFromContacts blade = glottic_view::blade_from_contacts(contacts);
+      if (!blade.world_from_tool) return;
+      current.world_from_tool = *blade.world_from_tool;
       current.has_tool = true;
-      Eigen::Vector3d force = Eigen::Vector3d::Zero();
-      for (const auto& k : contacts.contacts()) {
-        if (k.kind() == msg::CONTACT_OBSTACLE) continue;
-        force += k.force_n() * Eigen::Vector3d(k.normal().x(), k.normal().y(), k.normal().z());
-      }
-      current.force_n = force.allFinite() ? force.norm() : 0.0;
+      current.force_n = blade.tool_force_n;
       return;
     }
     if (c.topic != "fahr/DeformationState") return;

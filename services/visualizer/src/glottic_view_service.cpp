@@ -12,6 +12,7 @@
 #include "fahr/common/clock.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/topics.h"
+#include "fahr/glottic_view/blade_from_contacts.h"
 #include "glottic_viewPubSubTypes.h"
 
 namespace fahr::visualizer_service {
@@ -102,21 +103,10 @@ bool GlotticViewService::Impl::read_slots(bool& changed) {
 }
 
 void GlotticViewService::Impl::read_contacts(const msg::ContactSet& set) {
-  const auto& p = set.world_from_tool();
-  const auto& q = p.orientation();
-  const double length = std::sqrt(q.w() * q.w() + q.x() * q.x() + q.y() * q.y() + q.z() * q.z());
-  if (!(length > 0.5) || !std::isfinite(length)) return;  // a zero quaternion: no tool pose
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
-  pose.translation() = Eigen::Vector3d(p.position_m().x(), p.position_m().y(), p.position_m().z());
-  if (!pose.matrix().allFinite()) return;
-  world_from_tool = pose;
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();
-  for (const auto& c : set.contacts()) {
-    if (c.kind() == msg::CONTACT_OBSTACLE) continue;
-    force += c.force_n() * Eigen::Vector3d(c.normal().x(), c.normal().y(), c.normal().z());
-  }
-  tool_force_n = force.allFinite() ? force.norm() : 0.0;
+  const glottic_view::BladeFromContacts blade = glottic_view::blade_from_contacts(set);
+  if (!blade.world_from_tool) return;  // no tool pose: keep the last one
+  world_from_tool = blade.world_from_tool;
+  tool_force_n = blade.tool_force_n;
   haptic_tick = set.haptic_tick();
 }
 
