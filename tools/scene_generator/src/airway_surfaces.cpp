@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <vector>
 
 #include "fahr/scenegen/piecewise_linear.h"
 #include "surface_helpers.h"
@@ -34,17 +33,15 @@ LarynxFrame larynx_frame(const AirwayParameters& p) {
 // tapering to the trachea at the first ring.
 std::pair<double, double> lumen(const AirwayParameters& p, double depth) {
   const double g = p.glottis_depth_mm;
-  const std::vector<std::pair<double, double>> ap = {
-      {g - 2.5, p.vestibule_half_ap_mm},
-      {g, p.glottis_half_length_mm},
-      {g + 2.0, p.subglottis_radius_mm},
-      {p.larynx_length_mm, p.trachea_lumen_radius_mm}};
-  const std::vector<std::pair<double, double>> lateral = {
-      {g - 2.5, p.vestibule_half_lateral_mm},
-      {g, p.glottis_half_width_mm},
-      {g + 2.0, p.subglottis_radius_mm},
-      {p.larynx_length_mm, p.trachea_lumen_radius_mm}};
-  return {interpolate_knots(ap, depth), interpolate_knots(lateral, depth)};
+  const PiecewiseLinear ap = {{g - 2.5, p.vestibule_half_ap_mm},
+                              {g, p.glottis_half_length_mm},
+                              {g + 2.0, p.subglottis_radius_mm},
+                              {p.larynx_length_mm, p.trachea_lumen_radius_mm}};
+  const PiecewiseLinear lateral = {{g - 2.5, p.vestibule_half_lateral_mm},
+                                   {g, p.glottis_half_width_mm},
+                                   {g + 2.0, p.subglottis_radius_mm},
+                                   {p.larynx_length_mm, p.trachea_lumen_radius_mm}};
+  return {ap(depth), lateral(depth)};
 }
 
 }  // namespace
@@ -157,10 +154,10 @@ double pharynx_wall_x(double y_mm) {
   // Estimates fitted to the airway's published diameters behind the soft
   // palate and the tongue (meshes/neonatal/README.md): the wall slopes back
   // going down, and behind the larynx it leaves room for the hypopharynx.
-  static const std::vector<std::pair<double, double>> kWall = {
-      {-62.0, -72.0}, {-32.0, -69.0}, {-24.0, -66.0}, {-20.0, -62.5},
-      {-14.0, -59.5}, {-8.0, -57.5},  {2.0, -51.0},   {14.0, -48.0}};
-  return interpolate_knots(kWall, y_mm);
+  static const PiecewiseLinear kWall = {{-62.0, -72.0}, {-32.0, -69.0}, {-24.0, -66.0},
+                                        {-20.0, -62.5}, {-14.0, -59.5}, {-8.0, -57.5},
+                                        {2.0, -51.0},   {14.0, -48.0}};
+  return kWall(y_mm);
 }
 
 ParamBox pharynx_box(const PharynxParameters& p, double resolution_mm) {

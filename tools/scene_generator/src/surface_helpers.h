@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
-#include <vector>
 
 namespace fahr::scenegen {
 
@@ -36,20 +35,6 @@ struct RectangleLoop {
 
 inline int loop_index(double fraction, int size) {
   return static_cast<int>(std::lround(fraction * static_cast<double>(size))) % size;
-}
-
-// Linear interpolation through (position, value) knots in mm, held constant
-// beyond the ends.
-inline double interpolate_knots(const std::vector<std::pair<double, double>>& knots, double at) {
-  if (at <= knots.front().first) return knots.front().second;
-  for (size_t i = 1; i < knots.size(); ++i) {
-    if (at <= knots[i].first) {
-      const auto& [a0, v0] = knots[i - 1];
-      const auto& [a1, v1] = knots[i];
-      return v0 + (v1 - v0) * (at - a0) / (a1 - a0);
-    }
-  }
-  return knots.back().second;
 }
 
 }  // namespace fahr::scenegen
