@@ -30,6 +30,7 @@
 # bench/results/<machine>/lab-link-quality.md. Needs root. About S + 25 s a
 # run, nine runs a vendor.
 set -euo pipefail
+load_at_start=$(cut -d" " -f1-3 /proc/loadavg)  # for the results file, written at the end
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 command=("$0" "$@")
 build="$repo/build"
@@ -146,6 +147,6 @@ done
 done
 cat "$work/out.md"
 if [ ${#markdown[@]} -gt 0 ]; then
-  "$results" lab-link-quality "${markdown[@]}" -- "${command[@]}" <"$work/out.md"
+  "$results" lab-link-quality "${markdown[@]}" --started "$SECONDS" "$load_at_start" -- "${command[@]}" <"$work/out.md"
 fi
 exit "$status"

@@ -14,6 +14,7 @@
 # command, commit, date) to FILE, by default
 # bench/results/<machine>/lab-mixed-vendor.md.
 set -euo pipefail
+load_at_start=$(cut -d" " -f1-3 /proc/loadavg)  # for the results file, written at the end
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 command=("$0" "$@")
 build="$repo/build"
@@ -73,6 +74,6 @@ run "all on Cyclone" --dds cyclonedds
 run "all on Fast DDS" --dds fastdds
 cat "$out"
 if [ ${#markdown[@]} -gt 0 ]; then
-  "$results" lab-mixed-vendor "${markdown[@]}" -- "${command[@]}" <"$out"
+  "$results" lab-mixed-vendor "${markdown[@]}" --started "$SECONDS" "$load_at_start" -- "${command[@]}" <"$out"
 fi
 exit "$status"

@@ -11,6 +11,7 @@
 # commit, date) to FILE, by default bench/results/<machine>/lab-three-hosts.md.
 # Needs root. About S + 20 s per run, four runs.
 set -euo pipefail
+load_at_start=$(cut -d" " -f1-3 /proc/loadavg)  # for the results file, written at the end
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 command=("$0" "$@")
 build="$repo/build"
@@ -45,6 +46,6 @@ done
 rm -f "$out.err"
 cat "$out"
 if [ ${#markdown[@]} -gt 0 ]; then
-  "$results" lab-three-hosts "${markdown[@]}" -- "${command[@]}" <"$out"
+  "$results" lab-three-hosts "${markdown[@]}" --started "$SECONDS" "$load_at_start" -- "${command[@]}" <"$out"
 fi
 exit "$status"

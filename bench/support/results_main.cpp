@@ -1,9 +1,14 @@
-// fahr_bench_results NAME [--markdown [FILE]] [-- COMMAND...]: copies its
-// standard input to its standard output and, with --markdown, into the
-// results file of NAME (bench/results/<machine>/NAME.md by default) under
-// the header every bench writes, naming COMMAND as the command. For
-// scripts whose tables come from several programs (bench/intubation.sh).
+// fahr_bench_results NAME [--markdown [FILE]] [--started S LOAD] [-- COMMAND...]:
+// copies its standard input to its standard output and, with --markdown,
+// into the results file of NAME (bench/results/<machine>/NAME.md by
+// default) under the header every bench writes, naming COMMAND as the
+// command. For scripts whose tables come from several programs
+// (bench/intubation.sh). --started: the script ran S seconds before it
+// piped its tables here (bash's $SECONDS), and LOAD is the load average it
+// began at (the first three fields of /proc/loadavg); the file's wall time
+// and load at start are then the script's.
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
 
@@ -21,14 +26,29 @@ int main(int argc, char** argv) {
         command = fahr::bench_support::command_line(argc - i - 1, argv + i + 1);
         break;
       }
+      if (arg == "--started") {
+        char* end = nullptr;
+        const double elapsed = i + 2 < argc ? std::strtod(argv[i + 1], &end) : -1.0;
+        if (end == nullptr || *end != '\0' || !(elapsed >= 0.0)) {
+          std::fprintf(stderr, "fahr_bench_results: --started needs SECONDS (>= 0) and LOAD\n");
+          return 2;
+        }
+        results.record_script_start(elapsed, argv[i + 2]);
+        i += 2;
+        continue;
+      }
       if (!name.empty() || arg.rfind("-", 0) == 0) {
-        std::fprintf(stderr, "usage: %s NAME [--markdown [FILE]] [-- COMMAND...]\n", argv[0]);
+        std::fprintf(stderr,
+                     "usage: %s NAME [--markdown [FILE]] [--started S LOAD] [-- COMMAND...]\n",
+                     argv[0]);
         return 2;
       }
       name = arg;
     }
     if (name.empty()) {
-      std::fprintf(stderr, "usage: %s NAME [--markdown [FILE]] [-- COMMAND...]\n", argv[0]);
+      std::fprintf(stderr,
+                   "usage: %s NAME [--markdown [FILE]] [--started S LOAD] [-- COMMAND...]\n",
+                   argv[0]);
       return 2;
     }
     if (!command.empty()) results.record_script(command);

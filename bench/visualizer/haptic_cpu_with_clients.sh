@@ -25,6 +25,7 @@
 # presses for a few seconds only, too short for windows of both kinds). As
 # root it runs inside a loopback-only network namespace (tests/run_in_netns.sh).
 set -euo pipefail
+load_at_start=$(cut -d" " -f1-3 /proc/loadavg)  # for the results file, written at the end
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 command=("$0" "$@")
 build="$repo/build"
@@ -212,5 +213,5 @@ for run in $(seq 1 "$runs"); do one_run "$run"; done
 } >"$top/out.md"
 cat "$top/out.md"
 if [ ${#markdown[@]} -gt 0 ]; then
-  "$results" visualizer-haptic-cpu "${markdown[@]}" -- "${command[@]}" <"$top/out.md" >/dev/null
+  "$results" visualizer-haptic-cpu "${markdown[@]}" --started "$SECONDS" "$load_at_start" -- "${command[@]}" <"$top/out.md" >/dev/null
 fi

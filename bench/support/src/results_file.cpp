@@ -311,7 +311,8 @@ void MarkdownResults::begin(std::string_view name, Output output) {
   if (!blas.empty()) header += "| BLAS | " + blas + " |\n";
   header += std::string("| build | ") + FAHR_BUILD_TYPE + ", " + kCompiler + " |\n";
   header += "| date | " + utc_date() + " |\n";
-  header += "| load average at start (1, 5, 15 min) | " + load_average() + " |\n\n";
+  header += "| load average at start (1, 5, 15 min) | " +
+            (load_at_start_.empty() ? load_average() : load_at_start_) + " |\n\n";
   if (output_ == Output::kText) header += "```text\n";
   write_text(fd_, header);
   std::fflush(stdout);
@@ -333,7 +334,7 @@ void MarkdownResults::finish() {
   }
   std::array<char, 160> footer{};
   std::snprintf(footer.data(), footer.size(), "\n_Wall time %.0f s; load average at the end %s._\n",
-                now_s() - start_s_, load_average().c_str());
+                now_s() - start_s_ + elapsed_before_s_, load_average().c_str());
   const int fd = fd_;
   fd_ = -1;
   if (output_ == Output::kText) write_text(fd, "```\n");

@@ -75,6 +75,13 @@ class MarkdownResults {
     command_ = std::move(command);
     script_ = true;
   }
+  // For a script that writes its results after its runs: the seconds it ran
+  // before (added to the footer's wall time) and the load average when it
+  // began (the header's, instead of the one when the file is opened).
+  void record_script_start(double elapsed_s, std::string load_average_at_start) {
+    elapsed_before_s_ = elapsed_s;
+    load_at_start_ = std::move(load_average_at_start);
+  }
   // Without --markdown, nothing. Otherwise opens the file (FILE, or the
   // default path for `name`), writes the header and from now on copies
   // stdout into it. Throws std::runtime_error when the file cannot be written.
@@ -93,6 +100,8 @@ class MarkdownResults {
   std::FILE* original_stdout_ = nullptr;
   std::FILE* tee_ = nullptr;
   double start_s_ = 0.0;
+  double elapsed_before_s_ = 0.0;
+  std::string load_at_start_;
 };
 
 }  // namespace fahr::bench_support
