@@ -18,6 +18,7 @@
 # header every bench writes (fahr_bench_results, bench/support). About
 # (S + 20) s a run. The load is the point: run nothing else beside it.
 set -euo pipefail
+load_at_start=$(cut -d" " -f1-3 /proc/loadavg)  # for the results file, written at the end
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 command=("$0" "$@")
 build="$repo/build"
@@ -66,8 +67,8 @@ median_hz() { awk -F'|' -v s="$1" '$2 ~ "^ *"s" *$" {gsub(/ /, "", $5); print $5
 {
   echo "$runs runs of ${seconds} s ($dds), $hogs busy loops beside each, on $(nproc) cores"
   echo
-  echo "| run | FEM resets | FEM steps | FEM median Hz | stale ContactSets | FEM lost (haptic) | most inverted tets | haptic median Hz |"
-  echo "|---:|---:|---:|---:|---:|---:|---:|---:|"
+  echo "| run | FEM resets | FEM steps | steps the line search shortened | FEM median Hz | stale ContactSets | FEM lost (haptic) | most inverted tets | haptic median Hz |"
+  echo "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 } >"$work/out.md"
 total_resets=0
 for run in $(seq 1 "$runs"); do
@@ -89,8 +90,9 @@ for run in $(seq 1 "$runs"); do
   steps=$(grep -o "fahr_fem_service: [0-9]* steps" "$fem_log" | awk '{print $2}')
   stale=$(after "stale contact sets" "$fem_log")
   inverted=$(after "max inverted elements" "$fem_log")
+  shortened=$(after "line search" "$fem_log" || true)  # "-" for a FEM from before the search
   lost=$(grep -c "FEM lost:" "$out" || true)
-  echo "| $run | $resets | $steps | $(median_hz fem "$out") | $stale | $lost | $inverted | $(median_hz haptic "$out") |" >>"$work/out.md"
+  echo "| $run | $resets | $steps | ${shortened:--} | $(median_hz fem "$out") | $stale | $lost | $inverted | $(median_hz haptic "$out") |" >>"$work/out.md"
   total_resets=$((total_resets + resets))
   rm -rf "$logs"
 done
@@ -98,5 +100,5 @@ echo >>"$work/out.md"
 echo "FEM resets in all runs: $total_resets" >>"$work/out.md"
 cat "$work/out.md"
 if [ ${#markdown[@]} -gt 0 ]; then
-  "$results" fem-realtime-under-load "${markdown[@]}" -- "${command[@]}" <"$work/out.md"
+  "$results" fem-realtime-under-load "${markdown[@]}" --started "$SECONDS" "$load_at_start" -- "${command[@]}" <"$work/out.md"
 fi

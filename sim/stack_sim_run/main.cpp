@@ -122,12 +122,14 @@ int main(int argc, char** argv) try {
     std::printf(
         "stack_sim: %llu steps, %.2f s wall (%.2fx real time), peak |F| %.3f N; FEM: %llu steps, "
         "stale "
-        "contact sets %llu, max inverted elements %llu, resets after divergence %llu\n",
+        "contact sets %llu, max inverted elements %llu, resets after divergence %llu, steps "
+        "shortened by the line search %llu\n",
         static_cast<unsigned long long>(steps), wall_s, seconds / wall_s, peak_force,
         static_cast<unsigned long long>(sim.body().step_index()),
         static_cast<unsigned long long>(sim.fem().stale_sets()),
         static_cast<unsigned long long>(sim.fem().inverted_max()),
-        static_cast<unsigned long long>(sim.fem().divergence_resets()));
+        static_cast<unsigned long long>(sim.fem().divergence_resets()),
+        static_cast<unsigned long long>(sim.fem().shortened_steps()));
     std::printf(
         "stack_sim: FEM anatomy: nodes let back through a bone %llu, node-steps beyond a bone "
         "%llu\n",

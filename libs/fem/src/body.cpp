@@ -113,6 +113,7 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
   external_force_.setZero(dofs);
   rhs_.setZero(dofs);
   v_next_.setZero(dofs);
+  x_trial_.setZero(dofs);
   gravity_force_.setZero(dofs);
   for (std::size_t i = 0; i < n; ++i) {
     gravity_force_.segment<3>(3 * static_cast<Eigen::Index>(i)) =
@@ -446,14 +447,76 @@ void Body::finish_step(StepReport& report) {
   report.time_s = static_cast<double>(step_) * h_;
 }
 
-void Body::compute_forces(StepReport& report) {
+double Body::compute_forces(StepReport& report) {
   force_ = gravity_force_ + external_force_;
-  report.inverted_elements = update_elastic_forces(false, nullptr);
+  double elastic_energy_j = 0.0;
+  report.inverted_elements = update_elastic_forces(snh_.has_value(), &elastic_energy_j);
   double residual_squared = 0.0;
   for (Eigen::Index k = 0; k < force_.size(); ++k) {
     if (fixed_dof_[static_cast<std::size_t>(k)] == 0) residual_squared += force_[k] * force_[k];
   }
   report.residual_force_n = std::sqrt(residual_squared);
+  return elastic_energy_j;
+}
+
+double Body::elastic_energy_at(const double* y) const {
+  double energy = 0.0;
+  for (std::size_t e = 0; e < rest_.size(); ++e) {
+    const Eigen::Matrix3d f = geometry::deformation_gradient(y, rest_.tets[e], rest_.dm_inv[e]);
+    energy += rest_.volume_m3[e] * snh_->energy_density(f);
+  }
+  return energy;
+}
+
+// The linearised implicit step is one Newton step, from x, on the step's
+// incremental potential
+//   E(y) = |y - x - h v|^2_M / (2 h^2) + sum V Psi(F(y)) - f_ext . y
+// (backward Euler as a minimisation; Rayleigh damping's quadratic is left
+// out, its gradient at y = x is zero), along d = h v' with v' = A^-1 (M v +
+// h f). A is positive definite, so d descends: dE/dt at t = 0 is -v'.(M v +
+// h f) = -v'^T A v' < 0. A lagged A (the factor from several steps back, or
+// a tangent assembled before the tissue stiffened) is softer than the
+// current tangent and the full step can overshoot the minimum so far that
+// E rises; repeated, the step amplifies itself until the body diverges.
+// Armijo backtracking keeps every step downhill: halve t until E(x + t d)
+// <= E(x) + c t dE/dt. With the full step accepted (every step of the
+// shipped intubation) nothing changes, bit for bit.
+void Body::search_line(double elastic_energy_j, StepReport& report) {
+  constexpr double kArmijo = 1e-4;
+  constexpr int kMaxHalvings = 10;
+  const auto dofs = static_cast<std::size_t>(x_.size());
+  double slope = 0.0;  // dE/dt at t = 0, J
+  double scale = std::abs(elastic_energy_j);
+  for (std::size_t k = 0; k < dofs; ++k) {
+    if (fixed_dof_[k] != 0) continue;
+    const auto i = static_cast<Eigen::Index>(k);
+    slope -= rhs_[i] * v_next_[i];
+    scale += std::abs(mass_per_dof_[k] * v_[i] * v_[i]) +
+             std::abs((gravity_force_[i] + external_force_[i]) * x_[i]);
+  }
+  if (!(slope < 0.0)) return;  // at rest, or no descent to check
+  // Differences of sums this large are exact to a few ulps of `scale`.
+  const double noise = 64.0 * std::numeric_limits<double>::epsilon() * scale;
+  double t = 1.0;
+  for (int halving = 0; halving <= kMaxHalvings; ++halving) {
+    // E(x + t d) - E(x), d = h v': the inertia, external and elastic parts.
+    double change = 0.0;
+    for (std::size_t k = 0; k < dofs; ++k) {
+      const auto i = static_cast<Eigen::Index>(k);
+      const double step = fixed_dof_[k] != 0 ? 0.0 : t * h_ * v_next_[i];
+      x_trial_[i] = x_[i] + step;
+      if (step == 0.0) continue;
+      // (|s - h v|^2 - |h v|^2) m / (2 h^2) = m s (s - 2 h v) / (2 h^2)
+      change += 0.5 * mass_per_dof_[k] * step * (step - 2.0 * h_ * v_[i]) / (h_ * h_) -
+                (gravity_force_[i] + external_force_[i]) * step;
+    }
+    change += elastic_energy_at(x_trial_.data()) - elastic_energy_j;
+    if (change <= kArmijo * t * slope + noise) break;  // NaN goes on halving
+    if (halving == kMaxHalvings) break;  // downhill at this scale or not: the shortest step
+    t *= 0.5;
+    report.line_search_halvings = halving + 1;
+  }
+  if (t < 1.0) v_next_ *= t;
 }
 
 void Body::prepare_system(StepReport& report) {
@@ -548,9 +611,10 @@ StepReport Body::step(const ContactSet* contacts, const SphereLinks* links) {
     return report;
   }
   // 1. forces at x^n, 2. A as the solver settings ask, 3. A v' = M v + h f.
-  compute_forces(report);
+  const double elastic_energy_j = compute_forces(report);
   prepare_system(report);
   solve_velocity(report);
+  if (snh_ && v_next_.allFinite()) search_line(elastic_energy_j, report);
   if (!v_next_.allFinite()) {
     // Guard against a broken factorisation or CG breakdown: keep the state,
     // stop the motion, and report; never publish NaN.

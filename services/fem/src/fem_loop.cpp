@@ -144,12 +144,14 @@ void print_start_line(const common::Participant& participant, const FemBodySetup
 void print_end_line(const ServiceStep& fem_step) {
   std::printf(
       "fahr_fem_service: %llu steps, stale contact sets %llu, refused (another sphere layout) "
-      "%llu, max inverted elements %llu, resets after divergence %llu\n",
+      "%llu, max inverted elements %llu, resets after divergence %llu, steps shortened by the "
+      "line search %llu\n",
       static_cast<unsigned long long>(fem_step.setup().body->step_index()),
       static_cast<unsigned long long>(fem_step.stale_sets()),
       static_cast<unsigned long long>(fem_step.layout_check().refused()),
       static_cast<unsigned long long>(fem_step.inverted_max()),
-      static_cast<unsigned long long>(fem_step.divergence_resets()));
+      static_cast<unsigned long long>(fem_step.divergence_resets()),
+      static_cast<unsigned long long>(fem_step.shortened_steps()));
   const ServiceStep::SlowestStep& slow = fem_step.slowest_step();
   std::printf(
       "fahr_fem_service: slowest step %.1f ms (step %llu): refactorised %s, W block solved %s, "

@@ -110,6 +110,7 @@ void ServiceStep::step() {
     reset_step_ = setup_.body->step_index();
     resets_.fetch_add(1, std::memory_order_relaxed);
   }
+  if (last_report_.line_search_halvings > 0) ++shortened_steps_;
   if (last_report_.solve_failed) failed_solves_.fetch_add(1, std::memory_order_relaxed);
   if (last_report_.refactorised) ++refactorisations_;
   anatomy_returned_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_returned);
@@ -184,6 +185,7 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("compliance_reuses", static_cast<double>(contact_step_.compliance_reuses()));
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));
   out.emplace_back("divergence_resets", static_cast<double>(divergence_resets_));
+  out.emplace_back("line_search_shortened_steps", static_cast<double>(shortened_steps_));
   out.emplace_back("projection_sweeps_last", static_cast<double>(last_report_.projection.sweeps));
   out.emplace_back("anatomy_nodes_last",
                    static_cast<double>(last_report_.projection.obstacle_nodes));

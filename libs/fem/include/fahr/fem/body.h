@@ -80,6 +80,9 @@ struct StepReport {
   ProjectionReport projection;
   double kinetic_energy_j = 0.0;  // after the step, J
   double residual_force_n = 0.0;  // |f| over free DOFs at the start, N
+  // Stable Neo-Hookean: halvings of the step the line search took (0: the
+  // full linearised step lowered the step's potential enough).
+  int line_search_halvings = 0;
 };
 
 struct Energy {
@@ -217,9 +220,16 @@ class Body {
   // Elastic forces (and energy) of the current positions, either model.
   int update_elastic_forces(bool accumulate_energy, double* elastic_energy_j);
   // The stages of step().
-  void compute_forces(StepReport& report);
+  // Forces at x into force_; returns the elastic energy there (Stable
+  // Neo-Hookean; 0 for the corotational model, which needs none).
+  double compute_forces(StepReport& report);
   void prepare_system(StepReport& report);
   void solve_velocity(StepReport& report);
+  // Stable Neo-Hookean: shortens v' until the step lowers its incremental
+  // potential (Armijo backtracking); elastic_energy_j is sum V Psi at x.
+  void search_line(double elastic_energy_j, StepReport& report);
+  // Sum V Psi(F) at positions y (3 per node), J; the body is not changed.
+  double elastic_energy_at(const double* y) const;
   void integrate_and_project(const ContactSet* contacts, const SphereLinks* links,
                              StepReport& report);
   void finish_step(StepReport& report);
@@ -254,7 +264,8 @@ class Body {
   std::vector<std::uint8_t> fixed_dof_;
   double total_mass_kg_ = 0.0;
 
-  Eigen::VectorXd rest_x_, x_, v_, x_start_, force_, external_force_, gravity_force_, rhs_, v_next_;
+  Eigen::VectorXd rest_x_, x_, v_, x_start_, force_, external_force_, gravity_force_, rhs_, v_next_,
+      x_trial_;
   std::vector<Eigen::Matrix3d> rotations_;
   std::vector<Eigen::Matrix3d> rotations_at_factor_;
   // Compression stiffening (compression_stiffening.h), per element: the

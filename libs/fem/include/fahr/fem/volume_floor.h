@@ -21,6 +21,16 @@
 // fixed node, which never moves). V is cubic in the positions, so one move
 // lands near, not on, the floor; sweeps repeat it. Only tets below their
 // floor cost more than the volume test.
+//
+// Only tets that can have changed are tested: a tet found above its floor
+// stays above until one of its nodes moves. The pass remembers the
+// positions it left and, at its next call, takes every node that moved
+// since (the implicit step moves them all; the tool's and the anatomy's
+// projections between two passes of one step, a few) as making its tets
+// unchecked; a sweep tests only unchecked tets, in index order, and a move
+// makes the tets around its nodes unchecked. Each tet is tested exactly when
+// a sweep over all of them would have found it changed, so the moves are
+// the same, bit for bit, as testing every tet in every sweep.
 #pragma once
 
 #include <cstddef>
@@ -70,14 +80,23 @@ class VolumeFloor {
 
  private:
   // One tet's move toward its floor; false if it was not below (slack
-  // included).
+  // included). A move marks the tets around its nodes unchecked.
   bool open(std::size_t tet, std::span<double> positions_m,
-            std::span<const double> inverse_mass_per_kg) const;
+            std::span<const double> inverse_mass_per_kg);
+  // Marks unchecked the tets of every node that moved since the last pass.
+  void note_moves(std::span<const double> positions_m);
+  void mark_around(std::uint32_t node);
 
   const ElementRest& rest_;
   VolumeFloorSettings settings_;
   std::vector<double> floor_m3_;    // ratio x rest volume, per tet
-  std::vector<std::size_t> below_;  // tets the last full sweep found below; capacity: every tet
+  std::vector<std::size_t> below_;  // tets the last sweep found below; capacity: every tet
+  // The tets of each node (compressed rows: node n's are
+  // node_tets_[node_start_[n] .. node_start_[n + 1])).
+  std::vector<std::uint32_t> node_start_;
+  std::vector<std::uint32_t> node_tets_;
+  std::vector<std::uint8_t> unchecked_;  // per tet: to be tested by the next sweep that reaches it
+  std::vector<double> last_positions_;   // where the last pass left the nodes; empty before it
 };
 
 }  // namespace fahr::fem

@@ -57,6 +57,8 @@ class ServiceStep {
   // Steps after which the body had diverged and was reset to rest
   // (fem::StepReport::diverged_reset).
   std::uint64_t divergence_resets() const { return divergence_resets_; }
+  // Steps the line search shortened (fem::StepReport::line_search_halvings).
+  std::uint64_t shortened_steps() const { return shortened_steps_; }
   // Steps that refactorised the system matrix (fem::StepReport::refactorised).
   std::uint64_t refactorisations() const { return refactorisations_; }
   // The run's slowest step (wall time of ServiceStep::step) and what it
@@ -119,6 +121,7 @@ class ServiceStep {
   fem::StepReport last_report_;
   std::uint64_t inverted_max_ = 0;
   std::uint64_t divergence_resets_ = 0;
+  std::uint64_t shortened_steps_ = 0;
   SlowestStep slowest_;
   // The body's step at its last reset: a ContactSet computed on an earlier
   // state describes a tongue that no longer exists.
