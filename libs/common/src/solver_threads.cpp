@@ -21,6 +21,18 @@ void run_solver_libraries_on_one_thread(char** argv) {
   const ssize_t length = readlink("/proc/self/exe", path, sizeof(path) - 1);
   // FAHR_SOLVER_THREADS=any in the child as well: should the environment
   // not take the limits, the child runs as is instead of re-executing again.
+#if defined(__x86_64__)
+  // OpenBLAS picks its kernels by the CPU's model. A virtual CPU it does not
+  // know (a cloud "Intel Xeon Processor" with AVX-512) gets its generic
+  // Prescott kernels, several times slower in CHOLMOD's factorisation, and
+  // an AVX-512 one it knows gets kernels that round differently from the
+  // recorded hashes' (lockstep.md). Haswell's where AVX2 and FMA are there;
+  // a value the user set is kept.
+  if (std::getenv("OPENBLAS_CORETYPE") == nullptr && __builtin_cpu_supports("avx2") &&
+      __builtin_cpu_supports("fma") && setenv("OPENBLAS_CORETYPE", "Haswell", 1) != 0) {
+    std::fprintf(stderr, "fahr: cannot set OPENBLAS_CORETYPE; OpenBLAS chooses its kernels\n");
+  }
+#endif
   if (length <= 0 || setenv("OMP_THREAD_LIMIT", "1", 1) != 0 ||
       setenv("OMP_WAIT_POLICY", "passive", 1) != 0 || setenv("OPENBLAS_NUM_THREADS", "1", 1) != 0 ||
       setenv("FAHR_SOLVER_THREADS", "any", 1) != 0) {

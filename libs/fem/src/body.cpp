@@ -494,9 +494,11 @@ void Body::search_line(double elastic_energy_j, StepReport& report) {
     scale += std::abs(mass_per_dof_[k] * v_[i] * v_[i]) +
              std::abs((gravity_force_[i] + external_force_[i]) * x_[i]);
   }
-  if (!(slope < 0.0)) return;  // at rest, or no descent to check
   // Differences of sums this large are exact to a few ulps of `scale`.
   const double noise = 64.0 * std::numeric_limits<double>::epsilon() * scale;
+  // At rest, or a descent too small for the energy to resolve: nothing to
+  // check (the change would be rounding, not overshoot).
+  if (!(-slope > noise)) return;
   double t = 1.0;
   for (int halving = 0; halving <= kMaxHalvings; ++halving) {
     // E(x + t d) - E(x), d = h v': the inertia, external and elastic parts.
@@ -512,7 +514,10 @@ void Body::search_line(double elastic_energy_j, StepReport& report) {
     }
     change += elastic_energy_at(x_trial_.data()) - elastic_energy_j;
     if (change <= kArmijo * t * slope + noise) break;  // NaN goes on halving
-    if (halving == kMaxHalvings) break;  // downhill at this scale or not: the shortest step
+    if (halving == kMaxHalvings) {
+      report.line_search_exhausted = true;  // the shortest step, reported
+      break;
+    }
     t *= 0.5;
     report.line_search_halvings = halving + 1;
   }
@@ -523,9 +528,15 @@ void Body::prepare_system(StepReport& report) {
   const SolverSettings& solver = settings_.solver;
   const bool cg = solver.kind == LinearSolver::kConjugateGradient;
   const bool factor_needed = !cg || solver.preconditioner == CgPreconditioner::kLaggedCholesky;
-  if (factor_pending_ && step_ >= factor_install_step_) {
+  bool install_now = factor_pending_ && step_ >= factor_install_step_;
+  if (install_now && !background_factor_waits_ && !cholmod_.factorize_done()) {
+    ++installs_put_off_;  // real time: on with the factor before
+    install_now = false;
+  }
+  if (install_now) {
     // The background factorisation begun factor_latency_steps_ ago: waited
-    // for if not done, so its step does not depend on the thread's speed.
+    // for if not done, so its step does not depend on the thread's speed
+    // (in real time only once it is done: set_background_factor_waits).
     factor_pending_ = false;
     report.refactorised = cholmod_.finish_factorize();
     // A failed one (A not positive definite) leaves the factor before; the

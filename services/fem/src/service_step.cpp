@@ -111,6 +111,7 @@ void ServiceStep::step() {
     resets_.fetch_add(1, std::memory_order_relaxed);
   }
   if (last_report_.line_search_halvings > 0) ++shortened_steps_;
+  if (last_report_.line_search_exhausted) uphill_steps_.fetch_add(1, std::memory_order_relaxed);
   if (last_report_.solve_failed) failed_solves_.fetch_add(1, std::memory_order_relaxed);
   if (last_report_.refactorised) ++refactorisations_;
   anatomy_returned_ += static_cast<std::uint64_t>(last_report_.projection.obstacle_returned);
@@ -169,6 +170,9 @@ void ServiceStep::take_errors(std::vector<std::string>& errors) {
   say(failed_solves_, failed_said_,
       "FEM linear solve failed or gave a non-finite velocity: the step kept the positions with "
       "zero velocity");
+  say(uphill_steps_, uphill_said_,
+      "FEM step: the line search found no downhill step in 10 halvings (the factor far from "
+      "the tissue's tangent); the shortest was taken");
   say(resets_, resets_said_,
       "FEM body diverged (a node non-finite or farther from rest than twice the body's size) "
       "and was reset to rest");
@@ -186,6 +190,7 @@ void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) cons
   out.emplace_back("inverted_elements_max", static_cast<double>(inverted_max_));
   out.emplace_back("divergence_resets", static_cast<double>(divergence_resets_));
   out.emplace_back("line_search_shortened_steps", static_cast<double>(shortened_steps_));
+  out.emplace_back("line_search_uphill_steps", static_cast<double>(uphill_steps()));
   out.emplace_back("projection_sweeps_last", static_cast<double>(last_report_.projection.sweeps));
   out.emplace_back("anatomy_nodes_last",
                    static_cast<double>(last_report_.projection.obstacle_nodes));

@@ -12,7 +12,8 @@
 namespace fahr::common {
 
 // If OMP_THREAD_LIMIT is unset and FAHR_SOLVER_THREADS is not "any", sets
-// OMP_THREAD_LIMIT=1, OMP_WAIT_POLICY=passive and OPENBLAS_NUM_THREADS=1 and
+// OMP_THREAD_LIMIT=1, OMP_WAIT_POLICY=passive and OPENBLAS_NUM_THREADS=1 (and
+// on an x86-64 CPU with AVX2 and FMA, OPENBLAS_CORETYPE=Haswell unless set) and
 // re-executes the program (its path from /proc/self/exe) with `argv`; returns only if that is not
 // needed or failed (then it prints why and the program runs on as it is). Call first in main(),
 // before any thread starts. FAHR_SOLVER_THREADS=any keeps the libraries' own threading (a station

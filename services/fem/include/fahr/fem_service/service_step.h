@@ -59,6 +59,8 @@ class ServiceStep {
   std::uint64_t divergence_resets() const { return divergence_resets_; }
   // Steps the line search shortened (fem::StepReport::line_search_halvings).
   std::uint64_t shortened_steps() const { return shortened_steps_; }
+  // Steps whose line search found no downhill step (reported as an error).
+  std::uint64_t uphill_steps() const { return uphill_steps_.load(std::memory_order_relaxed); }
   // Steps that refactorised the system matrix (fem::StepReport::refactorised).
   std::uint64_t refactorisations() const { return refactorisations_; }
   // The run's slowest step (wall time of ServiceStep::step) and what it
@@ -133,12 +135,14 @@ class ServiceStep {
   std::shared_ptr<common::AdmissionCounts> contact_admission_ =
       std::make_shared<common::AdmissionCounts>();
   std::atomic<std::uint64_t> failed_solves_{0};
+  std::atomic<std::uint64_t> uphill_steps_{0};
   std::atomic<std::uint64_t> resets_{0};
   // What take_errors() has said so far (its caller's thread only).
   std::uint64_t non_finite_said_ = 0;
   std::uint64_t ahead_said_ = 0;
   std::uint64_t unknown_said_ = 0;
   std::uint64_t failed_said_ = 0;
+  std::uint64_t uphill_said_ = 0;
   std::uint64_t resets_said_ = 0;
   std::uint64_t anatomy_returned_ = 0;
   std::uint64_t anatomy_beyond_steps_ = 0;
