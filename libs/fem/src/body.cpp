@@ -528,15 +528,9 @@ void Body::prepare_system(StepReport& report) {
   const SolverSettings& solver = settings_.solver;
   const bool cg = solver.kind == LinearSolver::kConjugateGradient;
   const bool factor_needed = !cg || solver.preconditioner == CgPreconditioner::kLaggedCholesky;
-  bool install_now = factor_pending_ && step_ >= factor_install_step_;
-  if (install_now && !background_factor_waits_ && !cholmod_.factorize_done()) {
-    ++installs_put_off_;  // real time: on with the factor before
-    install_now = false;
-  }
-  if (install_now) {
+  if (factor_pending_ && step_ >= factor_install_step_) {
     // The background factorisation begun factor_latency_steps_ ago: waited
-    // for if not done, so its step does not depend on the thread's speed
-    // (in real time only once it is done: set_background_factor_waits).
+    // for if not done, so its step does not depend on the thread's speed.
     factor_pending_ = false;
     report.refactorised = cholmod_.finish_factorize();
     // A failed one (A not positive definite) leaves the factor before; the

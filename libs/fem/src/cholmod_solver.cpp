@@ -263,13 +263,6 @@ bool CholmodSolver::begin_factorize() {
   return true;
 }
 
-bool CholmodSolver::factorize_done() const {
-  State& s = *state_;
-  if (!s.background) return true;
-  std::lock_guard lock(s.background->mutex);
-  return !s.background->job;
-}
-
 bool CholmodSolver::finish_factorize() {
   State& s = *state_;
   if (!s.background || !s.wait_background()) return false;

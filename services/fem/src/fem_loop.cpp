@@ -57,9 +57,6 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
                                                       .valid = {},
                                                       .counts = fem_step.contact_admission()});
   const auto period = scene.rates.fem_period();
-  // A factor thread starved by the servo and haptic threads (it runs at a
-  // lower priority) must not stall the step at its install.
-  fem_step.setup().body->set_background_factor_waits(false);
   const auto start = Clock::now();
   auto next = start;
   std::uint64_t resyncs = 0;
@@ -87,10 +84,6 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
     std::printf("fahr_fem_service: %llu times more than 10 steps behind: started again from now\n",
                 static_cast<unsigned long long>(resyncs));
   }
-  std::printf(
-      "fahr_fem_service: steps that went on with the factor before while the background one was "
-      "not done %llu\n",
-      static_cast<unsigned long long>(fem_step.setup().body->factor_installs_put_off()));
   std::printf(
       "fahr_fem_service: refused ContactSets: %s, non-finite %llu, unknown sphere %llu, "
       "answering a step not reached %llu\n",

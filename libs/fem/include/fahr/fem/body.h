@@ -205,14 +205,6 @@ class Body {
   double factor_nonzeros() const { return cholmod_.factor_nonzeros(); }
   // Numeric factorisations so far, set-up included.
   std::uint64_t factorisations() const { return cholmod_.factorisations(); }
-  // Real time: a background factorisation not done at its install step is
-  // installed at the first step after it is done, and the step never waits
-  // for a starved thread (false); lockstep keeps the fixed install step and
-  // so the same bits on every run (true, the default).
-  void set_background_factor_waits(bool waits) { background_factor_waits_ = waits; }
-  // Steps that found their background factorisation not done and went on
-  // with the factor before (false above); 0 when the step waits.
-  std::uint64_t factor_installs_put_off() const { return installs_put_off_; }
   // CPU time of the background factorisation thread so far, ns
   // (SolverSettings::background_factor_latency_s; 0 without it).
   std::int64_t background_cpu_ns() const { return cholmod_.background_cpu_ns(); }
@@ -319,8 +311,6 @@ class Body {
   std::uint64_t factor_latency_steps_ = 0;
   bool factor_pending_ = false;
   std::uint64_t factor_install_step_ = 0;
-  bool background_factor_waits_ = true;
-  std::uint64_t installs_put_off_ = 0;
   // A CG solve took more than cg_refresh_iterations: refactorise next step.
   bool refresh_due_ = false;
   bool external_force_set_ = false;

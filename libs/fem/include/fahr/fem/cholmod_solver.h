@@ -77,10 +77,6 @@ class CholmodSolver {
   // waits and throws the result away (before a synchronous factorize()).
   bool enable_background();
   bool begin_factorize();
-  // True when no background factorisation is under way or the one under
-  // way has finished, so finish_factorize() would not wait. Never blocks
-  // for longer than the thread's hand-over.
-  bool factorize_done() const;
   bool finish_factorize();
   void cancel_factorize();
   // CPU time the background thread has used so far, ns (0 without one).
