@@ -150,6 +150,7 @@ int main(int argc, char** argv) try {
         static_cast<unsigned long long>(sim.fem().refactorisations()),
         static_cast<unsigned long long>(sim.fem().contact_step().compliance_solves()),
         static_cast<unsigned long long>(sim.fem().contact_step().compliance_reuses()));
+    std::printf("stack_sim: %s\n", haptic_service::w_summary(sim.haptic().metrics()).c_str());
     std::printf("FEM step CPU ms median %.2f p99 %.2f max %.2f\n",
                 1e-6 * static_cast<double>(fem_cpu.percentile(0.5).count()),
                 1e-6 * static_cast<double>(fem_cpu.percentile(0.99).count()),

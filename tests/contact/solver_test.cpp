@@ -195,6 +195,62 @@ TEST(ContactSolver, TissueRowWithoutComplianceIsLeftOutAndCounted) {
   EXPECT_EQ(none.rows, 0u);
 }
 
+// The FEM's block with columns from two factorisations (its kept columns
+// are solved again on a new one a few spheres a step), the tissue 25 %
+// stiffer on the newer: neighbouring spheres under one face have nearly
+// equal columns, and the rows' A is indefinite (checked below). load()
+// scales the diagonal until A is semidefinite, and says so; the coupled
+// solve converges to a force between the two factorisations' own. (On the
+// tongue in real time PGS diverged on such an A: contact-contract.md.)
+TEST(ContactSolver, BlockFromTwoFactorisationsIsMadeSemidefinite) {
+  constexpr std::size_t n = 16;
+  const double local = 2e-4;   // m/N
+  const double shared = 2e-3;  // m/N: the patch moving together
+  test::SyntheticPatch older = test::make_patch(n, -0.001, local, shared);
+  test::SyntheticPatch newer = test::make_patch(n, -0.001, 0.8 * local, 0.8 * shared);
+  test::SyntheticPatch mixed = older;
+  const std::size_t rows = 3 * n;
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t c = 0; c < rows; ++c) {
+      if ((c / 3) % 2 == 1) mixed.w[r * rows + c] = newer.w[r * rows + c];
+    }
+  }
+  // The rows' A as the solver mirrors it (lower triangle): indefinite.
+  Eigen::MatrixXd a(n, n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j <= i; ++j) {
+      const double v =
+          mixed.compliance().normal_compliance(i, mixed.rows[i].normal, j, mixed.rows[j].normal);
+      a(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = v;
+      a(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = v;
+    }
+  }
+  ASSERT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a).eigenvalues()(0), -1e-5);
+
+  const double k = 1000.0;
+  const Eigen::Vector3d target(0, -0.002, 0);
+  const auto resultant = [&](const test::SyntheticPatch& patch, SolverLoadReport& report) {
+    ContactSolver solver(n);
+    report = solver.load(patch.rows, patch.compliance());
+    PgsSettings settings;
+    settings.max_sweeps = 2000;
+    const Eigen::Vector3d step = solver.solve_coupled(k, target, settings);
+    EXPECT_TRUE(solver.last_report().converged) << "scale " << report.diagonal_scale;
+    EXPECT_LE(step.norm(), target.norm() + 0.001 + 1e-9);
+    return solver.resultant(RowKind::kTissue).norm();
+  };
+  SolverLoadReport report;
+  const double f_old = resultant(older, report);
+  EXPECT_EQ(report.diagonal_scale, 1.0);
+  const double f_new = resultant(newer, report);
+  EXPECT_EQ(report.diagonal_scale, 1.0);
+  const double f_mixed = resultant(mixed, report);
+  EXPECT_GT(report.diagonal_scale, 1.0);
+  EXPECT_FALSE(report.indefinite);
+  EXPECT_GT(f_mixed, 0.8 * f_old);
+  EXPECT_LT(f_mixed, 1.2 * f_new);
+}
+
 TEST(ContactSolver, WarmStartConvergesInAFewSweeps) {
   // Weakly coupled so the cold solve converges within the budget.
   test::SyntheticPatch patch = test::make_patch(30, -0.002, 0.002, 0.0001);

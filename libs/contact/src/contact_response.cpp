@@ -238,6 +238,8 @@ bool ContactResponse::releases_position_hold(const DeviceSample& device,
 Eigen::Vector3d ContactResponse::hold_after_implausible_step(double limit) {
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   report_.implausible_step = true;
+  // The refused solve's lambda is no start for this one.
+  solver_.clear_lambda();
   solver_.solve_pinned(zero, settings_.pgs);
   return holds_load() ? zero : yield_to_limit(zero, limit);
 }

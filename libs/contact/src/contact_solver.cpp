@@ -24,6 +24,14 @@ constexpr double kUnitNormalTolerance = 1e-3;
 // (docs/design/force-aware-decision.md) makes harmless.
 constexpr double kMinPivotMpn = 1e-12;
 
+// A pivot of A's factorisation below -this x its diagonal entry makes A
+// indefinite; within it of zero, a row depends on the rows before it
+// (neighbouring spheres under one blade face; W is stored in float).
+constexpr double kSemidefiniteTolerance = 1e-4;
+// Scales tried on an indefinite A's diagonal: 1 + 1/16, 1 + 1/8, ... 1 + 4.
+constexpr double kFirstDiagonalShift = 1.0 / 16.0;
+constexpr double kLargestDiagonalShift = 4.0;
+
 std::uint64_t row_key(const ContactRow& row) {
   return (std::uint64_t{row.kind == RowKind::kObstacle ? 1u : 0u} << 32) | row.id;
 }
@@ -94,6 +102,7 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows,
     }
   }
   report.rows = k_;
+  make_semidefinite(report);
   // Warm start: the previous tick's lambda of the same (kind, id).
   for (std::size_t i = 0; i < k_; ++i) {
     const std::uint64_t key = row_key(rows_[i]);
@@ -106,6 +115,36 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows,
     }
   }
   return report;
+}
+
+// W = h^2 J A^-1 J^T is positive semidefinite, and so is the rows' A built
+// from it. The FEM's block is not always one W: its kept columns are solved
+// again on a new factorisation a few spheres a step (fem::ComplianceBlock),
+// so for a while neighbouring spheres' columns come from factorisations of
+// a tissue that has stiffened in between. Two spheres under one blade face
+// have nearly equal columns, and where their diagonals come from different
+// factorisations, [[a, c], [c, b]] with c close to the larger of a and b is
+// indefinite. PGS diverges on an indefinite A (on the neonatal tongue's real
+// time runs: 1e6 N after one tick, growing each tick through the warm
+// start). The smallest of the tried scales of the tissue rows' diagonal
+// that makes A semidefinite is applied: each such row a little more
+// compliant than the block says, by about the change between the
+// factorisations. Costs one factorisation of A, k^3/6, per tick.
+double ContactSolver::make_semidefinite(SolverLoadReport& report) {
+  double scale = 1.0;
+  while (!semidefinite(a_.data(), capacity_, k_, scale, kSemidefiniteTolerance, factor_.data())) {
+    const double shift = scale == 1.0 ? kFirstDiagonalShift : 2.0 * (scale - 1.0);
+    if (shift > kLargestDiagonalShift) {
+      report.indefinite = true;
+      return 1.0;
+    }
+    scale = 1.0 + shift;
+  }
+  if (scale != 1.0) {
+    for (std::size_t i = 0; i < k_; ++i) a_[i * capacity_ + i] *= scale;
+  }
+  report.diagonal_scale = scale;
+  return scale;
 }
 
 void ContactSolver::make_rigid() {

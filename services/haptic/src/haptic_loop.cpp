@@ -64,6 +64,19 @@ std::size_t keep_deepest(std::vector<std::uint32_t>& indices, std::size_t n, std
 
 }  // namespace
 
+std::string w_summary(const LoopMetrics& m) {
+  const auto get = [](const std::atomic<std::uint64_t>& a) {
+    return static_cast<unsigned long long>(a.load(std::memory_order_relaxed));
+  };
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "ticks with an indefinite W made semidefinite %llu (largest diagonal scale %.3f), "
+                "coupled steps refused %llu; rows without W %llu",
+                get(m.indefinite_w_ticks), m.w_diagonal_scale_max.load(std::memory_order_relaxed),
+                get(m.refused_steps), get(m.rows_without_compliance));
+  return line;
+}
+
 HapticLoop::HapticLoop(const HapticSetup& setup)
     : setup_(setup),
       layout_fingerprint_(setup.layout.fingerprint()),
@@ -471,6 +484,12 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   const double force_n = out.force_n.norm();
   if (force_n > metrics_.peak_force_n.load(std::memory_order_relaxed))
     relaxed_store(metrics_.peak_force_n, force_n);
+  const contact::TickReport& report = response_.report();
+  if (report.load.diagonal_scale > 1.0 || report.load.indefinite) {
+    relaxed_add<std::uint64_t>(metrics_.indefinite_w_ticks, 1);
+    store_max(metrics_.w_diagonal_scale_max, report.load.diagonal_scale);
+  }
+  if (report.implausible_step) relaxed_add<std::uint64_t>(metrics_.refused_steps, 1);
   if (out.lost_track) {
     relaxed_add<std::uint64_t>(metrics_.lost_track_ticks, 1);
     if (!was_lost_) relaxed_add<std::uint64_t>(metrics_.lost_track_episodes, 1);
@@ -603,6 +622,9 @@ void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out
   out.emplace_back("tissue_rows_total", get(metrics_.tissue_rows_total));
   out.emplace_back("rows_without_compliance", get(metrics_.rows_without_compliance));
   out.emplace_back("lost_track_ticks", get(metrics_.lost_track_ticks));
+  out.emplace_back("indefinite_w_ticks", get(metrics_.indefinite_w_ticks));
+  out.emplace_back("w_diagonal_scale_max", get(metrics_.w_diagonal_scale_max));
+  out.emplace_back("refused_steps", get(metrics_.refused_steps));
   out.emplace_back("tissue_resets", get(metrics_.tissue_resets));
   out.emplace_back("tissue_losses", get(metrics_.tissue_losses));
   out.emplace_back("tissue_returns", get(metrics_.tissue_returns));

@@ -116,6 +116,7 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
   }
   report.print(contact_sets.handed(), contact_sets.written(), contact_sets.refused(),
                feed.metrics());
+  std::printf("fahr_haptic_service: %s\n", w_summary(loop.metrics()).c_str());
   // Received against the gateway's sequence numbers: a tick runs on the
   // newest pose, so fewer ticks than poses is lateness; a gap is a pose the
   // transport lost.

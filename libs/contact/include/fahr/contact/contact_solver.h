@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -21,6 +22,11 @@ struct SolverLoadReport {
   bool overflow = false;       // more rows than capacity: the extra rows were dropped
   int missing_compliance = 0;  // tissue rows without a W block: left out of the solve
   int degenerate_normals = 0;  // rows whose normal is not unit length: dropped
+  // The tissue rows' A was not positive semidefinite (W's columns from
+  // different factorisations of the FEM: ContactSolver::load) and its
+  // diagonal was scaled by this, > 1, to make it so; 1 otherwise.
+  double diagonal_scale = 1.0;
+  bool indefinite = false;  // not semidefinite even with the largest scale
 };
 
 class ContactSolver {
@@ -30,8 +36,10 @@ class ContactSolver {
 
   // Copies the rows (in order) and builds A from `compliance`. A tissue row
   // without a block in it is left out and counted (no constant stands in
-  // for the tissue); obstacle rows get 0 (rigid). Warm starts lambda from
-  // the previous stored solution with the same (kind, id).
+  // for the tissue); obstacle rows get 0 (rigid). An A that is not positive
+  // semidefinite has its diagonal scaled up until it is (the report says
+  // by how much). Warm starts lambda from the previous stored solution with
+  // the same (kind, id).
   SolverLoadReport load(std::span<const ContactRow> rows, const TissueCompliance& compliance);
 
   // W = 0 for every row (the naive loop: the tissue does not yield).
@@ -64,6 +72,9 @@ class ContactSolver {
   // Remembers lambda per (kind, id) for the next tick's warm start.
   void store_warm_start();
   void clear_warm_start() { previous_count_ = 0; }
+  // Starts the next solve of this tick from lambda = 0 (after a solve that
+  // left it meaningless).
+  void clear_lambda() { std::fill(lambda_.begin(), lambda_.end(), 0.0); }
 
   std::size_t size() const { return k_; }
   std::size_t capacity() const { return capacity_; }
@@ -84,6 +95,9 @@ class ContactSolver {
   std::size_t capacity_;
   std::size_t k_ = 0;
   std::vector<ContactRow> rows_;
+  // Makes A positive semidefinite (load()); returns the diagonal's scale.
+  double make_semidefinite(SolverLoadReport& report);
+
   std::vector<double> a_;         // Delassus A, capacity^2, m/N
   std::vector<double> s_;         // system matrix of the current solve, capacity^2, m/N
   std::vector<double> b_;         // right-hand side, m

@@ -43,6 +43,12 @@ struct LoopMetrics {
   std::atomic<std::uint64_t> tissue_rows_total{0};   // tissue rows solved, all ticks
   std::atomic<std::uint64_t> rows_without_compliance{0};  // of those, rows without W, total
   std::atomic<std::uint64_t> lost_track_ticks{0};
+  // Ticks whose rows' A from the FEM's W was indefinite and had its
+  // diagonal scaled (contact::ContactSolver::load), and the largest scale.
+  std::atomic<std::uint64_t> indefinite_w_ticks{0};
+  std::atomic<double> w_diagonal_scale_max{1.0};
+  // Ticks whose coupled solve's step was refused (the proxy held).
+  std::atomic<std::uint64_t> refused_steps{0};
   std::atomic<std::uint64_t> tissue_resets{0};   // new DeformationState reset epochs seen
   std::atomic<std::uint64_t> tissue_losses{0};   // episodes without a usable FEM state
   std::atomic<std::uint64_t> tissue_returns{0};  // ends of those episodes
@@ -60,6 +66,11 @@ struct LoopMetrics {
   std::atomic<double> tick_us_max{0.0};
   std::atomic<double> tick_us_peak{0.0};
 };
+
+// The W figures of a run, one sentence: ticks whose rows' A needed its
+// diagonal scaled and the largest scale, coupled steps refused, rows
+// without W.
+std::string w_summary(const LoopMetrics& m);
 
 // Where the last tick's time went (steady clock, us): finding the tool's
 // contacts with the tissue (AIST query or triangle baseline, and the row
