@@ -28,6 +28,9 @@ out=${FAHR_KEEP_OVERLOAD:-$(mktemp -d /tmp/fahr-overload-XXXXXX)}
 FAHR_KEEP=${FAHR_KEEP_OVERLOAD:-}
 name=overload_test
 run_s=16
+# Normal scheduling: a SCHED_FIFO thread cannot join a cgroup that holds
+# CPU time (the kernel refuses it), and the quota is what this test is about.
+FAHR_STATION_RT=0
 source "$repo/tests/faults/station.sh"
 
 quota_mount

@@ -35,6 +35,14 @@ done
 # The station at a high CFS weight, as in fault_test.sh: these tests are
 # about one process's load, not about other work on a shared machine.
 nice_level=${FAHR_STATION_NICE:--15}
+# The gateway's and the haptic service's 1 kHz ticks SCHED_FIFO, as a lab
+# station runs them (tools/lab rt_priority): without it, on a 2-core machine
+# whose FEM misses its rate and so never sleeps, a flood's decoding took the
+# haptic service to 0.80-0.89 of its calm rate (0.845 in one run, 1.000
+# with it). FAHR_STATION_RT=0: normal scheduling.
+rt_priority=${FAHR_STATION_RT:-80}
+rt_flags=()
+[ "$rt_priority" = 0 ] || rt_flags=(--rt-priority "$rt_priority")
 status=0
 
 pids=()
@@ -58,14 +66,14 @@ station_start() {
   echo "$name: $vendor, domain $domain, a ${run_s} s run, files in $out"
   nice -n "$nice_level" "$fem_exe" --scene "$scene" "${flags[@]}" --mode realtime --duration-s "$((run_s + 30))" >"$out/fem.log" 2>&1 &
   fem=$!; pids+=("$fem")
-  nice -n "$nice_level" "$haptic_exe" --scene "$scene" "${flags[@]}" --mode realtime --duration-s "$((run_s + 30))" >"$out/haptic.log" 2>&1 &
+  nice -n "$nice_level" "$haptic_exe" --scene "$scene" "${flags[@]}" "${rt_flags[@]}" --mode realtime --duration-s "$((run_s + 30))" >"$out/haptic.log" 2>&1 &
   haptic=$!; pids+=("$haptic")
   wait_for "$out/fem.log" "Hz, realtime" 180
   wait_for "$out/haptic.log" "fahr_haptic_service: ready" 180
   nice -n "$nice_level" "$probe_exe" "${flags[@]}" --states --duration-s "$((run_s + 30))" --out "$out/probe.txt" >"$out/probe.log" 2>&1 &
   probe=$!; pids+=("$probe")
   sleep 1  # the probe's readers match before the first DevicePose
-  nice -n "$nice_level" "$gateway_exe" "${flags[@]}" --backend simulated --script intubation --duration-s "$run_s" \
+  nice -n "$nice_level" "$gateway_exe" "${flags[@]}" "${rt_flags[@]}" --backend simulated --script intubation --duration-s "$run_s" \
     >"$out/gateway.log" 2>&1 &
   gateway=$!; pids+=("$gateway")
 }
