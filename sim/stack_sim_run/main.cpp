@@ -12,6 +12,7 @@
 // --w-normals N: W along the ContactSet's normals for N spheres (the
 // scene's solver.compliance_columns: normals), with rows by free depth.
 #include <CLI/CLI.hpp>
+#include <Eigen/Core>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -76,6 +77,13 @@ int main(int argc, char** argv) try {
     const auto steps = static_cast<std::uint64_t>(std::llround(seconds * 1000.0));
     const auto start = std::chrono::steady_clock::now();
     double peak_force = 0.0;
+    // Rendering smoothness: the commanded force's change from one tick to
+    // the next, N (the fault test's 0.1 N rule is for fault handling; here
+    // it counts ordinary rendering's steps).
+    Eigen::Vector3d previous_force = Eigen::Vector3d::Zero();
+    double largest_step = 0.0;
+    std::uint64_t steps_over_tenth = 0;
+    std::uint64_t largest_step_tick = 0;
     // The contact solve's share of a tick: PGS row visits x rows (the cost
     // in k-long dot products) and solves per tick, and how many hit the cap.
     std::vector<double> pgs_cost;
@@ -116,6 +124,14 @@ int main(int argc, char** argv) try {
       states_seen = states;
       const auto& f = sim.command().force_n();
       peak_force = std::max(peak_force, std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z()));
+      const Eigen::Vector3d force(f.x(), f.y(), f.z());
+      const double step = (force - previous_force).norm();
+      if (step > 0.1) ++steps_over_tenth;
+      if (step > largest_step) {
+        largest_step = step;
+        largest_step_tick = k;
+      }
+      previous_force = force;
     }
     const double wall_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -130,6 +146,11 @@ int main(int argc, char** argv) try {
         static_cast<unsigned long long>(sim.fem().inverted_max()),
         static_cast<unsigned long long>(sim.fem().divergence_resets()),
         static_cast<unsigned long long>(sim.fem().shortened_steps()));
+    std::printf(
+        "stack_sim: commanded force step per tick: largest %.3f N (tick %llu), ticks over 0.1 N "
+        "%llu\n",
+        largest_step, static_cast<unsigned long long>(largest_step_tick),
+        static_cast<unsigned long long>(steps_over_tenth));
     std::printf(
         "stack_sim: FEM anatomy: nodes let back through a bone %llu, node-steps beyond a bone "
         "%llu\n",

@@ -201,6 +201,34 @@ TEST_F(SafetyTest, CommandsBackDuringTheRampResumeWithoutAStep) {
   EXPECT_EQ(core_.safety_counters().resumed_events, 1U);
 }
 
+// The servo loop itself stalled for a second (SIGSTOP) while the hand moved
+// 4 mm against the command's local stiffness, and a command sent meanwhile
+// arrives with its first tick back: the missed periods count as silence and
+// the command as stale, so that tick ramps down from the commanded force
+// instead of rendering F_k - K_k dx four millimetres from x_k (which steps
+// the force by the rate limit).
+TEST_F(SafetyTest, AStalledServoLoopRampsDownWithoutAStep) {
+  engage();
+  ForceCommandSample c = command(Vec3(0.0, 2.0, 0.0));
+  c.stiffness_npm(1, 1) = 1000.0;
+  for (int i = 0; i < 50; ++i) {
+    c.answered_pose_seq = core_.ticks();
+    tick(&c);
+  }
+  ASSERT_NEAR(last_force_n_.y(), 2.0, 1e-9);
+  backend_.reading.position_m.y() += 4e-3;  // into the command's direction: K dx = 4 N
+  // A command sent while the loop was stopped answers a pose from before.
+  c.answered_pose_seq = core_.ticks();
+  c.force_n = Vec3(0.0, 2.5, 0.0);
+  const std::uint64_t stale_before = core_.safety_counters().rejected_stale;
+  const auto& pose = core_.tick(tick_time(core_.ticks() + 1000), &c);
+  EXPECT_EQ(core_.safety_counters().rejected_stale, stale_before + 1);
+  EXPECT_EQ(pose.safety_state, SafetyState::kRampingDown);
+  EXPECT_LE((pose.rendered_force_n - last_force_n_).norm(), core_.config().safety.resume_step_n)
+      << "rendered " << pose.rendered_force_n.transpose();
+  EXPECT_GT(pose.rendered_force_n.norm(), 0.0);
+}
+
 // A command marked as a transition (the haptic service ramping or slewing)
 // moves the output at most resume_step_n a tick, however far it jumps (two
 // commands landing in one tick, the older skipped); an ordinary one at the

@@ -61,6 +61,22 @@ ServoCore::ServoCore(const GatewayConfig& config, Backend& backend)
 
 const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now,
                                         const ForceCommandSample* incoming) {
+  // The loop itself stalled (SIGSTOP, a starved machine) for longer than
+  // the silence rule allows: the periods it missed were periods without a
+  // command, so the silence rule ramps the force down now; a command that
+  // arrived meanwhile answers a pose from before the stall and is refused
+  // as stale (the pose count did not advance while the clock did); and the
+  // command's local stiffness is dropped, since the stylus has moved an
+  // unknown way from the pose it answered and F_k - K_k dx there
+  // extrapolates past where it holds (a gateway back from a 1 s SIGSTOP
+  // stepped the force by 0.39 N on its first tick).
+  const auto silence = config_.period * config_.safety.silence_periods;
+  const bool stalled = last_now_.count() >= 0 && now - last_now_ > silence;
+  if (stalled) {
+    safety_.count_missed_ticks(static_cast<std::uint64_t>((now - last_now_) / config_.period) - 1);
+    renderer_.drop_stiffness();
+  }
+  last_now_ = now;
   const DeviceReading reading = backend_.read(now);
   pose_.servo_tick = tick_;
   pose_.seq = tick_ + 1;
@@ -69,7 +85,9 @@ const DevicePoseSample& ServoCore::tick(std::chrono::nanoseconds now,
   pose_times_.record(pose_.seq, now);
 
   bool accepted = false;
-  if (incoming != nullptr) {
+  if (incoming != nullptr && stalled) {
+    safety_.count_stale();
+  } else if (incoming != nullptr) {
     // Only poses of earlier ticks have been published: seq <= tick_.
     const Verdict verdict = safety_.screen(
         *incoming, tick_, renderer_.has_command() ? renderer_.answered_pose_seq() : 0);

@@ -33,6 +33,9 @@ class ForceRenderer {
   // stiffness is active). No allocation.
   void set_command(const ForceCommandSample& command);
   void clear();
+  // Keeps F_k and drops K_k: the stylus is no longer near x_k in a way the
+  // linearisation knows (after a stall of the servo loop).
+  void drop_stiffness() { stiffness_npm_.setZero(); }
   bool has_command() const { return has_command_; }
   std::uint64_t answered_pose_seq() const { return answered_pose_seq_; }
   const Vec3& torque_nm() const { return torque_nm_; }

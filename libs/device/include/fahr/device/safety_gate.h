@@ -18,6 +18,7 @@
 // a fault zeroes it at once.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 
@@ -105,6 +106,15 @@ class SafetyGate {
   Vec3 limit(const Vec3& candidate_n, const Vec3& commanded_n, bool accepted_now, bool fault,
              double renderable_n, bool transition = false);
 
+  // `ticks` servo ticks went by without a tick of this gate (the servo loop
+  // itself stalled): they count as ticks without a command.
+  void count_missed_ticks(std::uint64_t ticks) {
+    ticks_since_command_ = static_cast<std::uint32_t>(
+        std::min<std::uint64_t>(std::uint64_t{ticks_since_command_} + ticks, UINT32_MAX));
+  }
+  // A command refused as stale by the caller (one that answers a pose from
+  // before a stall of the servo loop).
+  void count_stale() { ++counters_.rejected_stale; }
   SafetyState state() const { return state_; }
   const SafetyCounters& counters() const { return counters_; }
 

@@ -71,7 +71,8 @@ class ServoCore {
   PoseTimeRing pose_times_;
   DevicePoseSample pose_;
   std::uint64_t tick_ = 0;
-  bool transition_ = false;  // the command in use ramps or slews (ForceCommandSample)
+  std::chrono::nanoseconds last_now_{-1};  // the previous tick's time (-1: none yet)
+  bool transition_ = false;                // the command in use ramps or slews (ForceCommandSample)
   double energy_to_hand_j_ = 0.0;
   double peak_rendered_n_ = 0.0;
 };
