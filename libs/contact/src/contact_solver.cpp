@@ -124,8 +124,8 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows,
 // a tissue that has stiffened in between. Two spheres under one blade face
 // have nearly equal columns, and where their diagonals come from different
 // factorisations, [[a, c], [c, b]] with c close to the larger of a and b is
-// indefinite. PGS diverges on an indefinite A (on the neonatal tongue's real
-// time runs: 1e6 N after one tick, growing each tick through the warm
+// indefinite. PGS can diverge on an indefinite A (it did in real-time runs
+// of the neonatal scene: 1e6 N after one tick, growing each tick through the warm
 // start). The smallest of the tried scales of the tissue rows' diagonal
 // that makes A semidefinite is applied: each such row a little more
 // compliant than the block says, by about the change between the
