@@ -130,21 +130,18 @@ SolverLoadReport ContactSolver::load(std::span<const ContactRow> rows,
 // that makes A semidefinite is applied: each such row a little more
 // compliant than the block says, by about the change between the
 // factorisations. Costs one factorisation of A, k^3/6, per tick.
-double ContactSolver::make_semidefinite(SolverLoadReport& report) {
+void ContactSolver::make_semidefinite(SolverLoadReport& report) {
   double scale = 1.0;
   while (!semidefinite(a_.data(), capacity_, k_, scale, kSemidefiniteTolerance, factor_.data())) {
     const double shift = scale == 1.0 ? kFirstDiagonalShift : 2.0 * (scale - 1.0);
     if (shift > kLargestDiagonalShift) {
       report.indefinite = true;
-      return 1.0;
+      return;
     }
     scale = 1.0 + shift;
   }
-  if (scale != 1.0) {
-    for (std::size_t i = 0; i < k_; ++i) a_[i * capacity_ + i] *= scale;
-  }
+  for (std::size_t i = 0; i < k_ && scale != 1.0; ++i) a_[i * capacity_ + i] *= scale;
   report.diagonal_scale = scale;
-  return scale;
 }
 
 void ContactSolver::make_rigid() {

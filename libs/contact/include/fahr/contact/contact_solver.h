@@ -95,8 +95,8 @@ class ContactSolver {
   std::size_t capacity_;
   std::size_t k_ = 0;
   std::vector<ContactRow> rows_;
-  // Makes A positive semidefinite (load()); returns the diagonal's scale.
-  double make_semidefinite(SolverLoadReport& report);
+  // Makes A positive semidefinite (load()); the report says how.
+  void make_semidefinite(SolverLoadReport& report);
 
   std::vector<double> a_;         // Delassus A, capacity^2, m/N
   std::vector<double> s_;         // system matrix of the current solve, capacity^2, m/N
