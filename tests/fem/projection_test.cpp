@@ -224,6 +224,18 @@ TEST(Projection, StaleSetsAreIgnoredAndCounted) {
   set.contacts[0].hold_centre_m = links.centre(0, body->positions_m().data());
   report = body->step(&set, &links);
   EXPECT_TRUE(report.contacts_applied);
+  // Computed on a state long past but just arrived (the sender's snapshot
+  // lagged): its planes are where the tool is, so it is applied; once it
+  // has been the newest for longer than the age (the sender silent), not.
+  set.state_step = body->step_index() - 8;
+  set.received_step = body->step_index();
+  report = body->step(&set, &links);
+  EXPECT_TRUE(report.contacts_applied);
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(body->step(&set, &links).contacts_applied);
+  report = body->step(&set, &links);
+  EXPECT_TRUE(report.contacts_stale);
+  EXPECT_EQ(body->stale_sets_ignored(), 3u);
+  set.received_step = 0;
   // Links that reference nodes beyond this mesh are refused, not followed.
   SphereLinks foreign;
   const std::array<std::uint32_t, 1> far_node = {static_cast<std::uint32_t>(mesh.nodes_m.size())};

@@ -268,5 +268,46 @@ TEST(ResetRefusal, ASetComputedBeforeADivergenceResetIsNotApplied) {
   EXPECT_GT(largest_motion_m(setup), 0.5e-3);
 }
 
+// A haptic service whose snapshot lags behind a slow FEM answers an older
+// state than the FEM's newest; its set is still where the tool is and is
+// applied. Only a sender gone silent (no newer set for the maximum age)
+// has its last set run out: the tongue is released.
+TEST(StaleRule, ASetAnsweringAnOlderStateIsAppliedUntilTheSenderIsSilent) {
+  StillTongue tongue;
+  FemBodySetup& setup = tongue.setup;
+  ServiceStep step(setup);
+  const std::uint32_t sphere = top_sphere(setup);
+  const std::uint64_t age = setup.settings.max_contact_age_steps;
+  for (std::uint64_t k = 0; k < 3 * age; ++k) step.step();
+  msg::ContactSet lagging = pressing_set(setup, sphere, setup.layout_fingerprint);
+  lagging.fem_step(setup.body->step_index() - 2 * age);
+  step.take(lagging, 1);
+  for (std::uint64_t k = 0; k <= age; ++k) {
+    step.step();
+    EXPECT_TRUE(step.last_report().contacts_applied) << "step " << k << " after it arrived";
+    EXPECT_EQ(step.state().applied_contact_seq(), 1u);
+  }
+  EXPECT_EQ(step.stale_sets(), 0u);
+  EXPECT_GT(largest_motion_m(setup), 0.5e-3);
+  step.step();
+  EXPECT_FALSE(step.last_report().contacts_applied);
+  EXPECT_EQ(step.state().applied_contact_seq(), 0u);
+  EXPECT_EQ(step.stale_sets(), 1u);
+
+  // In real time the age runs on the loop's clock: a FEM catching up runs
+  // many steps back to back within the age, and the set stays applied.
+  const std::int64_t t0 = 1'000'000'000;
+  const auto age_ns =
+      static_cast<std::int64_t>(static_cast<double>(age) * setup.body->time_step_s() * 1e9);
+  step.take(pressing_set(setup, sphere, setup.layout_fingerprint), 2, t0);
+  for (std::uint64_t k = 0; k < 4 * age; ++k) {
+    step.step(t0 + age_ns / 2);
+    EXPECT_TRUE(step.last_report().contacts_applied) << "step " << k << " after it arrived";
+  }
+  step.step(t0 + age_ns + 1);
+  EXPECT_FALSE(step.last_report().contacts_applied);
+  EXPECT_EQ(step.stale_sets(), 2u);
+}
+
 }  // namespace
 }  // namespace fahr::fem_service

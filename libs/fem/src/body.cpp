@@ -422,10 +422,12 @@ bool Body::accept_contacts(const ContactSet* contacts, const SphereLinks* links,
     report.contacts_invalid = true;
     return false;
   }
-  // Unsigned arithmetic: a set from the future wraps to a huge age, so it is
-  // rejected as well (it cannot refer to a state this body has produced).
-  const std::uint64_t age = step_ - contacts->state_step;
-  if (contacts->state_step > step_ || age > settings_.max_contact_age_steps) {
+  // A set from the future cannot refer to a state this body has produced.
+  // The age counts from the later of the state it answers and its arrival
+  // (ContactSet::received_step).
+  const std::uint64_t since = std::max(contacts->state_step, contacts->received_step);
+  if (contacts->state_step > step_ || since > step_ ||
+      step_ - since > settings_.max_contact_age_steps) {
     ++stale_sets_;
     report.contacts_stale = true;
     return false;

@@ -72,8 +72,9 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
     if (duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(duration_s)) break;
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
-    if (in.fetch_newest()) fem_step.take(in.newest(), in.newest_info().seq);
-    fem_step.step();
+    if (in.fetch_newest())
+      fem_step.take(in.newest(), in.newest_info().seq, common::monotonic_now_ns());
+    fem_step.step(common::monotonic_now_ns());
     fem_step.state().header().sim_step(fem_step.setup().body->step_index());
     fem_step.state().header().sim_time_ns(
         static_cast<std::int64_t>(fem_step.last_report().time_s * 1e9));

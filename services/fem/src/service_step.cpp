@@ -30,7 +30,10 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
                                    .compliance_along_normals = setup.compliance_along_normals,
                                    .divergence_limit_m = divergence_limit_m(setup.mesh),
                                    .volume_floor = setup.volume_floor}),
-      layout_check_(setup.layout_fingerprint) {
+      layout_check_(setup.layout_fingerprint),
+      max_age_ns_(
+          static_cast<std::int64_t>(static_cast<double>(setup.settings.max_contact_age_steps) *
+                                    setup.body->time_step_s() * 1e9)) {
   const std::size_t cap = setup.settings.max_compliance_spheres;
   std::vector<const fem::ObstacleField*> anatomy;
   if (setup.enforce_anatomy) {
@@ -46,7 +49,16 @@ ServiceStep::ServiceStep(FemBodySetup& setup)
   state_.compliance_normals().reserve(3 * cap);
 }
 
-void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
+namespace {
+
+std::int64_t body_clock_ns(const fem::Body& body) {
+  return static_cast<std::int64_t>(static_cast<double>(body.step_index()) * body.time_step_s() *
+                                   1e9);
+}
+
+}  // namespace
+
+void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq, std::int64_t received_ns) {
   if (!all_finite(wire)) {
     // Never used, nor the set before it (which it supersedes).
     non_finite_sets_.fetch_add(1, std::memory_order_relaxed);
@@ -75,18 +87,28 @@ void ServiceStep::take(const msg::ContactSet& wire, std::uint64_t seq) {
     return;
   }
   to_fem(wire, contacts_);
+  received_ns_ = received_ns == kBodyClock ? body_clock_ns(*setup_.body) : received_ns;
   have_contacts_ = true;
   applied_contact_seq_ = seq;
 }
 
-void ServiceStep::step() {
-  // A set older than the body allows, or computed on the tongue before a
-  // reset, is ignored and counted (stale): applied to the rested tongue, a
-  // blade placed for the diverged one pushed its nodes tens of millimetres
-  // in one step, and the next step flung them.
+void ServiceStep::step(std::int64_t now_ns) {
+  // A set computed on the tongue before a reset is ignored and counted
+  // (stale): applied to the rested tongue, a blade placed for the diverged
+  // one pushed its nodes tens of millimetres in one step, and the next step
+  // flung them. So is the last set of a haptic service that went silent:
+  // none newer for the maximum age since it arrived, on the caller's clock
+  // (wall time in real time: a FEM catching up runs steps back to back, and
+  // a count of steps would call a live sender silent). A set that answers an
+  // older state but is the newest sent is applied: its planes are where the
+  // tool is, and ignoring it would take the tool off the tongue and empty
+  // the compliance block whenever the haptic side's snapshot lagged behind.
+  const std::int64_t now = now_ns == kBodyClock ? body_clock_ns(*setup_.body) : now_ns;
   const bool usable =
-      have_contacts_ && contacts_.state_step >= reset_step_ &&
-      setup_.body->step_index() <= contacts_.state_step + setup_.settings.max_contact_age_steps;
+      have_contacts_ && contacts_.state_step >= reset_step_ && now - received_ns_ <= max_age_ns_;
+  // The body judges a set by steps (fem::ContactSet::received_step): this
+  // one is current at this step.
+  if (usable) contacts_.received_step = setup_.body->step_index();
   if (have_contacts_ && !usable) ++stale_sets_;
   const std::int64_t start_ns = common::monotonic_now_ns();
   const std::uint64_t solves_before = contact_step_.compliance_solves();

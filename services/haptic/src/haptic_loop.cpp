@@ -25,9 +25,6 @@ constexpr std::size_t kAnatomyContactCapacity = 128;
 // lambda = 0 unless the proxy moves into them): the solve then stops the
 // proxy within the tick instead of one tick late, m. 1 mm: a hand at 1 m/s.
 constexpr double kAnatomyMarginM = 1e-3;
-// How much deeper a contact without W must be than one with W to be the
-// row instead, m (select_rows).
-constexpr double kRowStickinessM = 1e-4;
 
 template <class T>
 void relaxed_store(std::atomic<T>& a, T v) {
@@ -88,7 +85,7 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
       tool_contacts_(kToolContactCapacity),
       order_(kToolContactCapacity, 0),
       row_key_(kToolContactCapacity, 0.0),
-      order_scratch_(setup.response.max_rows, 0),
+      order_scratch_(msg::MAX_COMPLIANCE_SPHERES, 0),
       anatomy_contacts_(kAnatomyContactCapacity),
       anatomy_order_(kAnatomyContactCapacity, 0),
       tissue_row_budget_(std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES - kComplianceRequests,
@@ -146,55 +143,79 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   return d;
 }
 
-// The rows: the deepest contacts (haptic_setup.h RowCompliance: by depth,
-// or with a W sphere's depth taken on its free centre) whose sphere has W in
-// this state, at most the row budget. No constant stands in for the
-// tissue: a contact that would be a row by its depth but whose sphere the
-// FEM sent no W for is counted (rows without tissue compliance) and asked
-// for, a candidate in the next ContactSet, so the FEM's next block has it.
-// order_ ends with the rows first, then the requests; keys are worked out
-// once per contact and partially sorted, allocation-free.
+// The rows: every contact whose sphere has W in this state (the FEM's
+// block holds at most msg::MAX_COMPLIANCE_SPHERES spheres), the deepest
+// first (haptic_setup.h RowCompliance: by depth, or with a W sphere's depth
+// taken on its free centre), at most the row budget. No constant stands in
+// for the tissue: a contact without W is never a row. Those among the
+// budget's deepest contacts are counted (rows without tissue compliance),
+// and the deepest contacts without W are asked for, candidates in the next
+// ContactSet, so the FEM's next block has them.
+//
+// A W sphere is a row whatever the depth of contacts without W around it.
+// Ranked among all contacts, the W spheres (projected onto the blade by the
+// FEM, so shallower than the unprojected spheres between them) fell in and
+// out of the deepest ranks as the proxy moved a fraction of a millimetre,
+// and on one FEM state the row set, and the force, alternated from one tick
+// to the next (12 rows and 1.14 N, 8 rows and 0.61 N, a real-time trace on
+// a 2-core station).
+//
+// order_ ends with the rows first, then the requests; allocation-free.
 void HapticLoop::select_rows(const TissueSnapshot& tissue) {
   const std::size_t n = std::min(tool_contacts_.size(), order_.size());
-  std::iota(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n), 0u);
-  for (std::size_t i = 0; i < n; ++i) {
+  std::size_t with_w = 0;
+  std::size_t without_w = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
     const std::int32_t w = tissue.compliance_index[tool_contacts_[i].sphere_id];
     double key = tool_contacts_[i].depth_m;
     // |c - c_free| stands for (c - c_free) . n, the FEM's shift being along
     // the pushing normals.
     if (w >= 0 && setup_.row_compliance == RowCompliance::kFreeDepth)
       key += double{tissue.free_shift_m[static_cast<std::size_t>(w)]};
-    // A sphere with W keeps its place against one without unless that is
-    // deeper by kRowStickinessM: under a flat blade hundreds of spheres lie
-    // within a few micrometres of each other's depth, and a row set chosen
-    // by depth alone is a new set every tick, none of it in the FEM's block.
-    if (w >= 0) key += kRowStickinessM;
     row_key_[i] = key;
-  }
-  // Twice the budget: rows past a few spheres without W still fill it.
-  const std::size_t sorted = std::min(n, 2 * tissue_row_budget_);
-  std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(sorted),
-                    order_.begin() + static_cast<std::ptrdiff_t>(n),
-                    [&](std::uint32_t a, std::uint32_t b) { return row_key_[a] > row_key_[b]; });
-  row_pick_ = 0;
-  request_count_ = 0;
-  std::size_t without_w = 0;
-  // Requests: the deepest contacts without W, those deep enough to be rows
-  // first, then the next ones down, so W is there before they get that deep.
-  for (std::size_t r = 0; r < sorted; ++r) {
-    const std::uint32_t c = order_[r];
-    if (tissue.compliance_index[tool_contacts_[c].sphere_id] >= 0) {
-      if (row_pick_ < tissue_row_budget_) order_scratch_[row_pick_++] = c;
-      continue;
+    if (w >= 0 && with_w < order_scratch_.size()) {
+      order_scratch_[with_w++] = i;
+    } else {
+      order_[without_w++] = i;
     }
-    if (r < tissue_row_budget_) ++without_w;
-    if (request_count_ < kComplianceRequests) request_of_[request_count_++] = c;
   }
+  const auto deeper = [&](std::uint32_t a, std::uint32_t b) { return row_key_[a] > row_key_[b]; };
+  const auto rows_end = order_scratch_.begin() + static_cast<std::ptrdiff_t>(with_w);
+  row_pick_ = std::min(with_w, tissue_row_budget_);
+  std::partial_sort(order_scratch_.begin(),
+                    order_scratch_.begin() + static_cast<std::ptrdiff_t>(row_pick_), rows_end,
+                    deeper);
+  // Rows without W: contacts without W deeper than the budget-th deepest
+  // contact of all (what a ranking by depth alone would have made rows).
+  const auto others_end = order_.begin() + static_cast<std::ptrdiff_t>(without_w);
+  const std::size_t sorted = std::min(without_w, tissue_row_budget_);
+  std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(sorted),
+                    others_end, deeper);
+  request_count_ = std::min(sorted, kComplianceRequests);
+  std::size_t deep_without_w = 0;
+  if (n <= tissue_row_budget_) {
+    deep_without_w = without_w;
+  } else {
+    // Merge the two descending heads (each sorted as far as the budget)
+    // for the budget deepest contacts.
+    std::size_t a = 0;
+    std::size_t b = 0;
+    for (std::size_t taken = 0; taken < tissue_row_budget_ && (a < row_pick_ || b < sorted);
+         ++taken) {
+      if (a < row_pick_ && (b >= sorted || row_key_[order_scratch_[a]] >= row_key_[order_[b]])) {
+        ++a;
+      } else {
+        ++b;
+        ++deep_without_w;
+      }
+    }
+  }
+  std::copy_n(order_.begin(), request_count_, request_of_.begin());
   std::copy_n(order_scratch_.begin(), row_pick_, order_.begin());
   std::copy_n(request_of_.begin(), request_count_,
               order_.begin() + static_cast<std::ptrdiff_t>(row_pick_));
   relaxed_add<std::uint64_t>(metrics_.rows_dropped, n - row_pick_);
-  rows_without_w_ = without_w;
+  rows_without_w_ = deep_without_w;
 }
 
 void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
@@ -503,9 +524,18 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
 // No usable FEM state for kTissueLossTimeoutNs: the frozen tongue is not
 // rendered. The force ramps from its value at the loss to zero over
 // kLossRampTicks servo ticks, at most kResetSlewN a command, with no local
-// stiffness; the proxy sits at the hand; the ContactSet is empty (no
-// contacts: the FEM, when it comes back, relaxes instead of pressing on a
-// tool it no longer follows).
+// stiffness; the proxy sits at the hand. The ContactSet repeats the last
+// rendered tick's contacts and their forces (no requests): a FEM that is
+// late rather than gone keeps the tongue under the blade where it was and
+// its compliance block whole. An empty set released the tongue from the
+// blade and emptied the block, so every late step of a FEM that missed its
+// rate ended with a state that had W for none of the contacts, no rows and
+// no force, and the force came back in steps (a 2-core station in real
+// time); with the forces zero, the tongue held by the planes alone, it
+// chattered again (1.7-2.0 N a tick in two of four cases of the fault
+// test). A restarted FEM refuses these contacts: they answer a step it has
+// not reached (fem_service ServiceStep::take); one reset since refuses them
+// as stale.
 void HapticLoop::lost_tick(const msg::DevicePose& pose, const contact::DeviceSample& device,
                            const TissueSnapshot& tissue, msg::ForceCommand& command,
                            msg::ContactSet& contacts) {
@@ -547,10 +577,19 @@ void HapticLoop::lost_tick(const msg::DevicePose& pose, const contact::DeviceSam
   contacts.haptic_tick(tick_);
   contacts.fem_step(tissue.fem_step);
   contacts.layout_fingerprint(layout_fingerprint_);
-  contacts.tool_frozen(false);
-  contacts.contacts().clear();
-  common::put(device.position_m, contacts.world_from_tool().position_m());
-  common::put(device.orientation, contacts.world_from_tool().orientation());
+  if (setup_.penalty) {
+    contacts.tool_frozen(false);
+    fill_contacts({penalty_contacts_.data(), penalty_count_}, {}, tool_body_.id,
+                  tissue.tissue_obstacle_body_ids(), contacts);
+  } else {
+    contacts.tool_frozen(response_.tool_frozen());
+    fill_contacts(response_.contacts(), {}, tool_body_.id, tissue.tissue_obstacle_body_ids(),
+                  contacts);
+  }
+  // Where the contacts were found: the last tick's tool.
+  common::put(tool_body_.world_from_body.translation(), contacts.world_from_tool().position_m());
+  common::put(Eigen::Quaterniond(tool_body_.world_from_body.rotation()),
+              contacts.world_from_tool().orientation());
   contacts.header().sim_step(pose.servo_tick());
   contacts.header().sim_time_ns(pose.header().sim_time_ns());
   ++tick_;

@@ -56,8 +56,9 @@ struct BodySettings {
   SolverSettings solver;
   ProjectionSettings projection;
   SleepSettings sleep;
-  // A ContactSet whose state_step is more than this many steps behind the
-  // body's step (or ahead of it) is ignored and counted as stale.
+  // A ContactSet whose state_step and received_step are both more than
+  // this many steps behind the body's step (or whose state_step is ahead of
+  // it) is ignored and counted as stale.
   std::uint64_t max_contact_age_steps = 4;
   std::size_t max_compliance_spheres = 64;  // capacity of compliance()
 };

@@ -39,9 +39,16 @@ struct Contact {
 };
 
 struct ContactSet {
-  // The FEM step whose state the haptic side used; a set older than the
-  // body's maximum age (in steps) is ignored and counted as stale.
+  // The FEM step whose state the haptic side used.
   std::uint64_t state_step = 0;
+  // The body's step when the set arrived (0: when it was computed, i.e.
+  // state_step). A set is stale, ignored and counted, once both are more
+  // than the body's maximum age (in steps) behind: its planes are where the
+  // tool was when it was sent, whatever state it was computed on, so a set
+  // that answers an older state but is the sender's newest is applied
+  // (a late snapshot on the haptic side must not take the tool off the
+  // tongue); only a silent sender's last set runs out.
+  std::uint64_t received_step = 0;
   std::vector<Contact> contacts;  // projected in this order
 };
 

@@ -30,18 +30,27 @@ class ServiceStep {
   // `setup` must outlive this object.
   explicit ServiceStep(FemBodySetup& setup);
 
-  // The newest ContactSet and its sample sequence number; kept until the
-  // next one (a set older than the body's max_contact_age_steps is ignored).
+  // Times passed as kBodyClock are the body's simulated time at its
+  // current step (lockstep, in-process harnesses); a real-time loop passes
+  // its monotonic clock, ns.
+  static constexpr std::int64_t kBodyClock = -1;
+
+  // The newest ContactSet, its sample sequence number and when it arrived;
+  // kept until the next one. It is applied until the scene's
+  // max_contact_age has passed since it arrived with no newer one (the
+  // haptic service silent: the tongue is then released), whatever state it
+  // was computed on, unless that state is older than the body's last
+  // divergence reset.
   // A set of another sphere layout than the body's (layout_check.h) is
   // refused: the steps until the next set apply no contacts.
   // A set with a non-finite number (all_finite), or naming a sphere the
   // layout does not have, is refused and counted the same way: nothing of it
   // is used.
-  void take(const msg::ContactSet& wire, std::uint64_t seq);
+  void take(const msg::ContactSet& wire, std::uint64_t seq, std::int64_t received_ns = kBodyClock);
 
-  // One FEM step and the DeformationState that reports it (the header is
-  // the caller's: its clock and step numbering depend on the mode).
-  void step();
+  // One FEM step at `now_ns` and the DeformationState that reports it (the
+  // header is the caller's: its clock and step numbering depend on the mode).
+  void step(std::int64_t now_ns = kBodyClock);
 
   msg::DeformationState& state() { return state_; }
   const msg::DeformationState& state() const { return state_; }
@@ -118,6 +127,8 @@ class ServiceStep {
   LayoutCheck layout_check_;
   fem::ContactSet contacts_;
   bool have_contacts_ = false;
+  std::int64_t received_ns_ = 0;  // when contacts_ arrived (take's clock)
+  std::int64_t max_age_ns_ = 0;   // the scene's max_contact_age
   std::uint64_t applied_contact_seq_ = 0;
   msg::DeformationState state_;
   fem::StepReport last_report_;

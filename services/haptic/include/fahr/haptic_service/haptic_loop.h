@@ -163,7 +163,7 @@ class HapticLoop {
   std::vector<std::uint32_t>
       order_;                    // indices into tool_contacts_, deepest first when over capacity
   std::vector<double> row_key_;  // per contact: select_rows' key
-  std::vector<std::uint32_t> order_scratch_;                     // select_rows: the rows' contacts
+  std::vector<std::uint32_t> order_scratch_;                     // select_rows: contacts with W
   std::array<std::uint32_t, kComplianceRequests> request_of_{};  // select_rows: requests
   std::array<fem::Contact, kComplianceRequests> requests_{};     // this tick's W requests
   std::size_t row_pick_ = 0;                                     // rows select_rows took
