@@ -70,9 +70,23 @@ struct Child {
   fs::path log;
   pid_t pid = -1;
   int restarts = 0;
+  // Deaths in a row, each within kQuickDeath of its start: the back-off's
+  // exponent, and after kMaxQuickDeaths the supervisor gives up.
+  int quick_deaths = 0;
+  bool restart_due = false;
   std::string state = "not started";
   std::chrono::steady_clock::time_point started;
+  std::chrono::steady_clock::time_point restart_at;
 };
+
+// Restart back-off: a service that dies within a minute of its start is
+// restarted after 0.5 s, then 1, 2, 4 and 8 s if it keeps dying that fast,
+// and the station stops at the sixth such death; one that ran a minute
+// starts the count again. A crash loop then neither spins the machine nor
+// floods the logs, and a one-off death is back within half a second.
+constexpr auto kQuickDeath = std::chrono::seconds(60);
+constexpr int kMaxQuickDeaths = 5;
+constexpr auto kFirstBackOff = std::chrono::milliseconds(500);
 
 pid_t spawn(const Child& child) {
   const pid_t pid = fork();
@@ -441,21 +455,44 @@ int station_up(const Plan& plan, const Station& station, const UpOptions& option
       c.state = "died (" + exit_text(status) + ")";
       std::printf("fahr_lab: %s station %s: service %s died: %s\n", now_text().c_str(),
                   station.name.c_str(), c.name.c_str(), exit_text(status).c_str());
-      const auto ran = std::chrono::steady_clock::now() - c.started;
-      if (station.restart && !(c.restarts >= 5 && ran < 60s)) {
-        ++c.restarts;
-        std::this_thread::sleep_for(1s);
-        c.pid = spawn(c);
-        c.started = std::chrono::steady_clock::now();
-        c.state = "running";
-        std::printf("fahr_lab: %s restarted (pid %d, restart %d)\n", c.name.c_str(), c.pid,
-                    c.restarts);
+      const auto died = std::chrono::steady_clock::now();
+      c.quick_deaths = died - c.started < kQuickDeath ? c.quick_deaths + 1 : 1;
+      if (station.restart && c.quick_deaths <= kMaxQuickDeaths) {
+        const auto delay = kFirstBackOff * (1 << (c.quick_deaths - 1));
+        c.restart_at = died + delay;
+        c.restart_due = true;
+        char text[96];
+        std::snprintf(text, sizeof text, "restarting in %.1f s",
+                      std::chrono::duration<double>(delay).count());
+        c.state += ", " + std::string(text);
+        std::printf("fahr_lab: %s %s (death %d in a row within a minute of its start)\n",
+                    c.name.c_str(), text, c.quick_deaths);
       } else {
-        why_stopped = "service " + c.name + " died";
+        if (station.restart) {
+          why_stopped = "service " + c.name + " died " + std::to_string(c.quick_deaths) +
+                        " times in a row within a minute of its start";
+        } else {
+          why_stopped = "service " + c.name + " died";
+        }
         result = 1;
       }
       write_status(run, station, host.name, result == 0 ? "running" : "stopping", children);
       if (result != 0) break;
+    }
+    // Restarts whose back-off has passed (the loop goes on supervising the
+    // others meanwhile).
+    for (auto& c : children) {
+      if (result != 0 || g_stop.load() || !c.restart_due ||
+          std::chrono::steady_clock::now() < c.restart_at)
+        continue;
+      c.restart_due = false;
+      ++c.restarts;
+      c.pid = spawn(c);
+      c.started = std::chrono::steady_clock::now();
+      c.state = "running";
+      std::printf("fahr_lab: %s restarted (pid %d, restart %d)\n", c.name.c_str(), c.pid,
+                  c.restarts);
+      write_status(run, station, host.name, "running", children);
     }
     std::this_thread::sleep_for(50ms);
   }
