@@ -7,7 +7,8 @@
 # small datagrams. What must hold:
 #   - a->b and b->a: no datagram earlier than delay - jitter; the median near
 #     the delay (up to 1 ms late on a loaded machine); the 5-95 % spread at
-#     least the jitter (uniform: 1.8x) and not far beyond it;
+#     least the jitter (uniform: 1.8x) and not far beyond it (2 ms and the
+#     relay's own lateness, p99, on top of twice the jitter);
 #   - the loss within 4.5 standard deviations of 5 % of the datagrams sent,
 #     for the fragmented ones too (dropping fragments on their own would
 #     lose a quarter of them);
@@ -108,26 +109,33 @@ for f in ab ab_big ba ac; do echo "$f: $(grep expected= "$work/$f.out")"; done
 
 fail() { echo "udp_relay: FAIL: $*" >&2; status=1; }
 get() { grep -o "\b$2=[0-9.]*" "$work/$1.out" | head -1 | cut -d= -f2; }
+# How late the relay sent a link's frames against their schedule, p99, ms
+# (its own end line): time the machine took from it, not jitter it drew.
+late_p99() { sed -n "s/^fahr_udp_relay: $1: .*left late p50 [0-9.]* ms p99 \([0-9.]*\) ms.*/\1/p" "$work/relay.out"; }
 check_impaired() {
-  local f=$1 count=$2
-  local lost min p05 p50 p95
+  local f=$1 count=$2 link=$3
+  local lost min p05 p50 p95 late
   lost=$(get "$f" lost) min=$(get "$f" delay_min_ms) p05=$(get "$f" delay_p05_ms)
   p50=$(get "$f" delay_p50_ms) p95=$(get "$f" delay_p95_ms)
+  late=$(late_p99 "$link")
   [ -n "$lost" ] || { fail "$f: no result"; return; }
   awk -v lost="$lost" -v n="$count" -v p="$loss" -v min="$min" -v p05="$p05" -v p50="$p50" \
-      -v p95="$p95" -v d="$delay_ms" -v j="$jitter_ms" -v f="$f" 'BEGIN {
+      -v p95="$p95" -v d="$delay_ms" -v j="$jitter_ms" -v f="$f" -v late="${late:-0}" 'BEGIN {
     mean = n * p; sd = sqrt(n * p * (1 - p)); bad = 0
     if (lost < mean - 4.5 * sd || lost > mean + 4.5 * sd) {
       printf "%s: %d of %d lost, outside %.0f +- %.0f\n", f, lost, n, mean, 4.5 * sd; bad = 1 }
     if (min < d - j - 0.05) { printf "%s: a datagram after %.3f ms (< %.3f)\n", f, min, d - j; bad = 1 }
     if (p50 < d - 0.3 || p50 > d + 1.0) { printf "%s: median %.3f ms, configured %.3f\n", f, p50, d; bad = 1 }
-    if (p95 - p05 < j || p95 - p05 > 2 * j + 2) {
-      printf "%s: 5-95 %% spread %.3f ms for +-%.3f ms jitter\n", f, p95 - p05, j; bad = 1 }
+    # Beyond twice the jitter, 2 ms plus what the relay itself reports
+    # as its lateness (a loaded machine widens the spread; a relay that drew
+    # too much jitter does not say it was late).
+    if (p95 - p05 < j || p95 - p05 > 2 * j + 2 + late) {
+      printf "%s: 5-95 %% spread %.3f ms for +-%.3f ms jitter (relay late p99 %.3f ms)\n", f, p95 - p05, j, late; bad = 1 }
     exit bad }' >&2 || status=1
 }
-check_impaired ab $n
-check_impaired ab_big $n_big
-check_impaired ba $n
+check_impaired ab $n "a>b"
+check_impaired ab_big $n_big "a>b"
+check_impaired ba $n "b>a"
 lost=$(get ac lost) p50=$(get ac delay_p50_ms)
 [ "${lost:-1}" = 0 ] || fail "a->c (no impairment) lost ${lost:-all}"
 awk -v p="${p50:-99}" 'BEGIN { exit !(p < 0.5) }' || fail "a->c median ${p50:-none} ms (>= 0.5)"
