@@ -312,6 +312,23 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
       const float* f = tissue.free_centres_m.data() + 3 * row.compliance_index;
       row.other_point_m += Eigen::Vector3d(f[0], f[1], f[2]) - tissue.spheres.centres_m()[sphere];
     }
+    if (row.compliance_index < 0) {
+      // No W yet: counted, and asked for as the AIST rows' are (deepest
+      // first), or the baseline's rows would never get any and render
+      // nothing.
+      ++rows_without_w_;
+      if (request_count_ < kComplianceRequests) {
+        fem::Contact& q = requests_[request_count_++];
+        q.sphere_id = sphere;
+        q.kind = fem::ContactKind::kTool;
+        q.state = fem::ContactState::kCandidate;
+        q.normal = c.normal;
+        q.plane_point_m = c.point_m;
+        q.hold_centre_m = tissue.spheres.centres_m()[sphere];
+        q.penetration_m = c.depth_m;
+        q.force_n = 0.0;
+      }
+    }
   }
 }
 
