@@ -218,6 +218,37 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
   rows_without_w_ = deep_without_w;
 }
 
+// The ContactSet's tool contacts: the last response's (the penalty
+// baseline's), then `requests`, then the tissue's obstacle contacts.
+void HapticLoop::fill_tool_contacts(std::span<const fem::Contact> requests,
+                                    const TissueSnapshot& tissue, msg::ContactSet& contacts) const {
+  if (setup_.penalty) {
+    contacts.tool_frozen(false);
+    fill_contacts({penalty_contacts_.data(), penalty_count_}, requests, tool_body_.id,
+                  tissue.tissue_obstacle_body_ids(), contacts);
+  } else {
+    contacts.tool_frozen(response_.tool_frozen());
+    fill_contacts(response_.contacts(), requests, tool_body_.id, tissue.tissue_obstacle_body_ids(),
+                  contacts);
+  }
+}
+
+// A request for a sphere's W: a candidate contact, projected by nobody.
+static fem::Contact compliance_request(std::uint32_t sphere, const Eigen::Vector3d& normal,
+                                       const Eigen::Vector3d& point_m, double depth_m,
+                                       const TissueSnapshot& tissue) {
+  fem::Contact c;
+  c.sphere_id = sphere;
+  c.kind = fem::ContactKind::kTool;
+  c.state = fem::ContactState::kCandidate;
+  c.normal = normal;
+  c.plane_point_m = point_m;
+  c.hold_centre_m = tissue.spheres.centres_m()[sphere];
+  c.penetration_m = depth_m;
+  c.force_n = 0.0;
+  return c;
+}
+
 void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
   select_rows(tissue);
   // Only the rows and the requests get their point and normal
@@ -226,15 +257,7 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
                                row_pick_ + request_count_);
   for (std::size_t q = 0; q < request_count_; ++q) {
     const collision::SphereContact& s = tool_contacts_[order_[row_pick_ + q]];
-    fem::Contact& c = requests_[q];
-    c.sphere_id = s.sphere_id;
-    c.kind = fem::ContactKind::kTool;
-    c.state = fem::ContactState::kCandidate;
-    c.normal = s.normal;
-    c.plane_point_m = s.point_m;
-    c.hold_centre_m = tissue.spheres.centres_m()[s.sphere_id];
-    c.penetration_m = s.depth_m;
-    c.force_n = 0.0;
+    requests_[q] = compliance_request(s.sphere_id, s.normal, s.point_m, s.depth_m, tissue);
   }
   // (The penalty baseline's forces are part of the FEM's step, so it reads
   // the published centres.)
@@ -317,17 +340,9 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
       // first), or the baseline's rows would never get any and render
       // nothing.
       ++rows_without_w_;
-      if (request_count_ < kComplianceRequests) {
-        fem::Contact& q = requests_[request_count_++];
-        q.sphere_id = sphere;
-        q.kind = fem::ContactKind::kTool;
-        q.state = fem::ContactState::kCandidate;
-        q.normal = c.normal;
-        q.plane_point_m = c.point_m;
-        q.hold_centre_m = tissue.spheres.centres_m()[sphere];
-        q.penetration_m = c.depth_m;
-        q.force_n = 0.0;
-      }
+      if (request_count_ < kComplianceRequests)
+        requests_[request_count_++] =
+            compliance_request(sphere, c.normal, c.point_m, c.depth_m, tissue);
     }
   }
 }
@@ -489,16 +504,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   contacts.haptic_tick(tick_);
   contacts.fem_step(tissue.fem_step);
   contacts.layout_fingerprint(layout_fingerprint_);
-  const std::span<const fem::Contact> requests(requests_.data(), request_count_);
-  if (setup_.penalty) {
-    contacts.tool_frozen(false);
-    fill_contacts({penalty_contacts_.data(), penalty_count_}, requests, tool_body_.id,
-                  tissue.tissue_obstacle_body_ids(), contacts);
-  } else {
-    contacts.tool_frozen(response_.tool_frozen());
-    fill_contacts(response_.contacts(), requests, tool_body_.id, tissue.tissue_obstacle_body_ids(),
-                  contacts);
-  }
+  fill_tool_contacts({requests_.data(), request_count_}, tissue, contacts);
   // Where the FEM finds the tool: the proxy after this tick (the penalty
   // baseline's tool is the device).
   common::put(setup_.penalty ? device.position_m : response_.proxy().position_m,
@@ -594,15 +600,7 @@ void HapticLoop::lost_tick(const msg::DevicePose& pose, const contact::DeviceSam
   contacts.haptic_tick(tick_);
   contacts.fem_step(tissue.fem_step);
   contacts.layout_fingerprint(layout_fingerprint_);
-  if (setup_.penalty) {
-    contacts.tool_frozen(false);
-    fill_contacts({penalty_contacts_.data(), penalty_count_}, {}, tool_body_.id,
-                  tissue.tissue_obstacle_body_ids(), contacts);
-  } else {
-    contacts.tool_frozen(response_.tool_frozen());
-    fill_contacts(response_.contacts(), {}, tool_body_.id, tissue.tissue_obstacle_body_ids(),
-                  contacts);
-  }
+  fill_tool_contacts({}, tissue, contacts);
   // Where the contacts were found: the last tick's tool.
   common::put(tool_body_.world_from_body.translation(), contacts.world_from_tool().position_m());
   common::put(Eigen::Quaterniond(tool_body_.world_from_body.rotation()),

@@ -135,6 +135,8 @@ class HapticLoop {
  private:
   contact::DeviceSample device_sample(const msg::DevicePose& pose);
   void collect_tissue_rows(const TissueSnapshot& tissue);
+  void fill_tool_contacts(std::span<const fem::Contact> requests, const TissueSnapshot& tissue,
+                          msg::ContactSet& contacts) const;
   void select_rows(const TissueSnapshot& tissue);
   void collect_triangle_rows(const TissueSnapshot& tissue);
   void collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool);
