@@ -104,10 +104,13 @@ TEST(Allocation, StepAllocatesNothing) {
 // factorisation is unchanged: a changing set of spheres (as the blade
 // slides) then solves only the new ones, in chunks whose CHOLMOD buffers are
 // kept, and allocates nothing once each chunk size has been seen.
-TEST(Allocation, ComplianceOfChangingSpheresAllocatesNothing) {
+class ComplianceAllocation : public testing::TestWithParam<CholmodFactorKind> {};
+
+TEST_P(ComplianceAllocation, OfChangingSpheresAllocatesNothing) {
   test::hook_suitesparse_allocations();
   const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;
+  settings.solver.cholmod.factor = GetParam();
   settings.solver.refactor_period = 0;
   settings.solver.refactor_rotation_rad = 0.0;
   settings.max_compliance_spheres = 16;
@@ -135,6 +138,11 @@ TEST(Allocation, ComplianceOfChangingSpheresAllocatesNothing) {
   EXPECT_EQ(news, 0);
   EXPECT_EQ(suitesparse_allocs, 0);
 }
+
+// Full solves (simplicial) and half solves on the supernodes reached.
+INSTANTIATE_TEST_SUITE_P(Allocation, ComplianceAllocation,
+                         testing::Values(CholmodFactorKind::kSimplicial,
+                                         CholmodFactorKind::kSupernodal));
 
 }  // namespace
 }  // namespace fahr::fem

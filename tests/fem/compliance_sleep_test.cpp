@@ -23,6 +23,16 @@ BodySettings still_settings() {
   return settings;
 }
 
+// Gravity, 10 ms steps, never asleep, a factorisation every step.
+BodySettings sagging_settings(std::size_t spheres, CholmodFactorKind factor) {
+  BodySettings settings;
+  settings.time_step = std::chrono::milliseconds(10);
+  settings.sleep.enabled = false;
+  settings.max_compliance_spheres = spheres;
+  settings.solver.cholmod.factor = factor;
+  return settings;
+}
+
 TEST(Compliance, MatchesTheResponseOfOneStep) {
   // At rest without gravity f = 0, so one step with force F on sphere t
   // (spread as J^T F) moves sphere s by exactly W_st F.
@@ -102,15 +112,56 @@ TEST(Compliance, AlongNormalsIsTheBlocksTimesTheNormals) {
   EXPECT_FALSE(body->compliance_along(spheres, {normals.data(), 2}, links, along));
 }
 
-TEST(Compliance, KeptColumnsGiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
+TEST(Compliance, HalfSolvesOnASupernodalFactorGiveTheBlockOfFullSolves) {
+  // W = h^2 (L^-1 P J^T)^T (L^-1 P J^T) on the supernodes each sphere
+  // reaches, against W = h^2 J A^-1 J^T from full solves on a simplicial
+  // factor of the same A, at rest and after the bar sagged (refactorised),
+  // for spheres near the fixed end, at the tip and between, where the
+  // reaches share little and much.
+  const BodyMesh mesh = test::bar_mesh(3);
+  const BodySettings supernodal = sagging_settings(8, CholmodFactorKind::kSupernodal);
+  const BodySettings simplicial = sagging_settings(8, CholmodFactorKind::kSimplicial);
+  auto half = test::make_body(supernodal, mesh, test::fixed_x0(mesh));
+  auto full = test::make_body(simplicial, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(half, nullptr);
+  ASSERT_NE(full, nullptr);
+  ASSERT_TRUE(half->supernodal_factor());
+  ASSERT_FALSE(full->supernodal_factor());
+  SphereLinks links;
+  const std::array<double, 4> w = {0.1, 0.2, 0.3, 0.4};
+  for (const std::size_t tet : {std::size_t{0}, std::size_t{7}, mesh.tets.size() / 2,
+                                mesh.tets.size() - 1, mesh.tets.size() - 9})
+    ASSERT_EQ(links.add_sphere(mesh.tets[tet], w, 0.001), "");
+  // Four: within the budget of kept columns solved again on a new factor.
+  const std::vector<std::uint32_t> spheres = {3, 0, 4, 1};
+  const std::size_t n = 9 * spheres.size() * spheres.size();
+  std::vector<float> w_half(n), w_full(n);
+  const auto expect_same = [&](const char* when) {
+    ASSERT_TRUE(half->compliance(spheres, links, w_half)) << when;
+    ASSERT_TRUE(full->compliance(spheres, links, w_full)) << when;
+    float largest = 0.0f;
+    for (const float v : w_full) largest = std::max(largest, std::abs(v));
+    ASSERT_GT(largest, 0.0f);
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_NEAR(w_half[i], w_full[i], 1e-5f * largest) << when << " entry " << i;
+  };
+  expect_same("at rest");
+  for (int k = 0; k < 20; ++k) {
+    half->step();
+    full->step();
+  }
+  expect_same("sagged");
+}
+
+class KeptColumns : public testing::TestWithParam<CholmodFactorKind> {};
+
+TEST_P(KeptColumns, GiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
   // A body that solved other spheres before (some of them kept) writes the
   // same block as a body solving these spheres for the first time; after a
-  // refactorisation at a deformed state nothing kept is reused.
+  // refactorisation at a deformed state nothing kept is reused. Full solves
+  // (simplicial) and half solves (supernodal) alike.
   const BodyMesh mesh = test::bar_mesh(2);
-  BodySettings settings;
-  settings.time_step = std::chrono::milliseconds(10);
-  settings.sleep.enabled = false;
-  settings.max_compliance_spheres = 4;
+  const BodySettings settings = sagging_settings(4, GetParam());
   const SphereLinks links = tip_spheres(mesh, 6);
   auto used = test::make_body(settings, mesh, test::fixed_x0(mesh));
   auto fresh = test::make_body(settings, mesh, test::fixed_x0(mesh));
@@ -138,6 +189,10 @@ TEST(Compliance, KeptColumnsGiveTheBlockOfAFreshSolveUntilTheFactorChanges) {
   }
   expect_same({1, 4, 2}, "after refactorisations");
 }
+
+INSTANTIATE_TEST_SUITE_P(Compliance, KeptColumns,
+                         testing::Values(CholmodFactorKind::kSimplicial,
+                                         CholmodFactorKind::kSupernodal));
 
 TEST(Sleep, RestingBodySleepsAndWakesOnTouch) {
   const BodyMesh mesh = test::bar_mesh(2);

@@ -41,6 +41,16 @@ struct CholmodSolver::State {
   std::array<Buffers, CholmodSolver::kColumnCounts> sets{};
   std::uint64_t uses = 0;
   std::uint64_t factorisations = 0;
+  // The supernodal elimination tree (sparse right-hand sides): the
+  // supernode of each column, each supernode's parent (-1 at a root), the
+  // inverse permutation, visit marks and a buffer for one supernode's
+  // below-diagonal update. Built by analyze() for a supernodal analysis.
+  std::vector<int> column_supernode;
+  std::vector<int> parent;
+  std::vector<int> position;  // position[dof] = its row in P b
+  std::vector<std::uint32_t> marks;
+  std::uint32_t mark = 0;
+  std::vector<double> update;
   bool numeric = false;
   std::size_t rows = 0;
 
@@ -131,6 +141,36 @@ struct CholmodSolver::State {
     if (buffers.e != nullptr) cholmod_free_dense(&buffers.e, &common);
   }
 
+  void build_tree() {
+    column_supernode.clear();
+    parent.clear();
+    position.assign(rows, 0);
+    const int* perm = static_cast<const int*>(factor->Perm);
+    for (std::size_t k = 0; k < rows; ++k) position[static_cast<std::size_t>(perm[k])] = int(k);
+    if (factor->is_super == 0) return;
+    const auto nsuper = static_cast<int>(factor->nsuper);
+    const int* super = static_cast<const int*>(factor->super);
+    const int* pi = static_cast<const int*>(factor->pi);
+    const int* srow = static_cast<const int*>(factor->s);
+    column_supernode.assign(rows, 0);
+    std::size_t widest = 0;
+    for (int k = 0; k < nsuper; ++k) {
+      for (int c = super[k]; c < super[k + 1]; ++c) column_supernode[std::size_t(c)] = k;
+    }
+    parent.assign(std::size_t(nsuper), -1);
+    for (int k = 0; k < nsuper; ++k) {
+      const int columns = super[k + 1] - super[k];
+      const int rows_k = pi[k + 1] - pi[k];
+      // The first row below the diagonal block lies in the parent supernode.
+      if (rows_k > columns)
+        parent[std::size_t(k)] = column_supernode[std::size_t(srow[pi[k] + columns])];
+      widest = std::max(widest, std::size_t(rows_k - columns));
+    }
+    marks.assign(std::size_t(nsuper), 0);
+    mark = 0;
+    update.assign(3 * std::max<std::size_t>(widest, 1), 0.0);
+  }
+
   ~State() {
     stop_background();
     if (factor != nullptr) cholmod_free_factor(&factor, &common);
@@ -219,6 +259,7 @@ bool CholmodSolver::analyze(const SparseMatrix& matrix, const CholmodOptions& op
   s.view.packed = 1;
   s.factor = cholmod_analyze(&s.view, &s.common);
   const bool analysed = s.factor != nullptr && s.common.status >= CHOLMOD_OK;
+  if (analysed) s.build_tree();
   return analysed && (!had_background || enable_background());
 }
 
@@ -308,6 +349,95 @@ void CholmodSolver::solve(std::span<const double> b, std::span<double> x) {
 
 void CholmodSolver::solve_columns(std::span<const double> b, std::span<double> x, int columns) {
   state_->solve_dense(b.data(), x.data(), columns);
+}
+
+bool CholmodSolver::sparse_forward_ready() const {
+  const State& s = *state_;
+  return s.numeric && s.factor != nullptr && s.factor->is_super != 0 && s.factor->is_ll != 0 &&
+         !s.parent.empty();
+}
+
+std::size_t CholmodSolver::supernodes() const {
+  return state_->parent.size();
+}
+
+int CholmodSolver::permuted(std::size_t dof) const {
+  return state_->position[dof];
+}
+
+int CholmodSolver::supernode_first(int k) const {
+  return static_cast<const int*>(state_->factor->super)[k];
+}
+
+int CholmodSolver::supernode_end(int k) const {
+  return static_cast<const int*>(state_->factor->super)[k + 1];
+}
+
+std::size_t CholmodSolver::reach(std::span<const std::uint32_t> dofs, std::span<int> out) {
+  State& s = *state_;
+  if (++s.mark == 0) {  // the marks wrapped: start them again
+    std::fill(s.marks.begin(), s.marks.end(), 0u);
+    s.mark = 1;
+  }
+  std::size_t count = 0;
+  for (const std::uint32_t dof : dofs) {
+    int k = s.column_supernode[std::size_t(s.position[dof])];
+    while (k >= 0 && s.marks[std::size_t(k)] != s.mark) {
+      s.marks[std::size_t(k)] = s.mark;
+      out[count++] = k;
+      k = s.parent[std::size_t(k)];
+    }
+  }
+  // Supernodes are numbered children first (CHOLMOD postorders them).
+  std::sort(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(count));
+  return count;
+}
+
+void CholmodSolver::forward3_on_reach(std::span<const int> reach, std::span<double> y) {
+  State& s = *state_;
+  const cholmod_factor& f = *s.factor;
+  const int* super = static_cast<const int*>(f.super);
+  const int* pi = static_cast<const int*>(f.pi);
+  const int* px = static_cast<const int*>(f.px);
+  const int* srow = static_cast<const int*>(f.s);
+  const double* lx = static_cast<const double*>(f.x);
+  double* update = s.update.data();
+  for (const int k : reach) {
+    const int first = super[k];
+    const auto columns = std::size_t(super[k + 1] - first);
+    const auto rows_k = std::size_t(pi[k + 1] - pi[k]);
+    const auto below = rows_k - columns;
+    // The supernode's block, column-major with leading dimension rows_k:
+    // the lower-triangular diagonal block on top, the rows below under it.
+    const double* l = lx + px[k];
+    double* x = y.data() + 3 * std::size_t(first);
+    std::fill(update, update + 3 * below, 0.0);
+    for (std::size_t c = 0; c < columns; ++c) {
+      const double* lc = l + c * rows_k;
+      const double inv = 1.0 / lc[c];
+      const double x0 = x[3 * c] *= inv;
+      const double x1 = x[3 * c + 1] *= inv;
+      const double x2 = x[3 * c + 2] *= inv;
+      for (std::size_t r = c + 1; r < columns; ++r) {
+        x[3 * r] -= lc[r] * x0;
+        x[3 * r + 1] -= lc[r] * x1;
+        x[3 * r + 2] -= lc[r] * x2;
+      }
+      const double* lb = lc + columns;
+      for (std::size_t r = 0; r < below; ++r) {
+        update[3 * r] += lb[r] * x0;
+        update[3 * r + 1] += lb[r] * x1;
+        update[3 * r + 2] += lb[r] * x2;
+      }
+    }
+    const int* below_rows = srow + pi[k] + static_cast<std::ptrdiff_t>(columns);
+    for (std::size_t r = 0; r < below; ++r) {
+      double* target = y.data() + 3 * std::size_t(below_rows[r]);
+      target[0] -= update[3 * r];
+      target[1] -= update[3 * r + 1];
+      target[2] -= update[3 * r + 2];
+    }
+  }
 }
 
 double CholmodSolver::factor_nonzeros() const {

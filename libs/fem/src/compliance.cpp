@@ -47,6 +47,11 @@ void ComplianceBlock::reserve(std::size_t dofs, std::size_t max_spheres) {
   const std::size_t kept = max_spheres + max_spheres / 2;
   slots_.assign(kept, Slot{});
   columns_.assign(dofs * 3 * kept, 0.0);
+  reaches_.assign(dofs * kept, 0);
+  sphere_dofs_.reserve(3 * 16);
+  pairs_.assign(9 * kept * kept, 0.0);
+  pair_known_.assign(kept * kept, 0);
+  half_ = false;
   request_slots_.assign(max_spheres, 0);
   to_solve_.reserve(max_spheres);
   const std::size_t chunk = 3 * std::min(max_spheres, kChunkSpheres.front());
@@ -103,6 +108,86 @@ void ComplianceBlock::solve_chunk(std::span<const std::size_t> slots, const Sphe
   }
 }
 
+void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
+                                 std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor) {
+  Slot& kept = slots_[slot];
+  const auto nodes = links.nodes(kept.sphere);
+  const auto weights = links.weights(kept.sphere);
+  sphere_dofs_.clear();
+  for (const std::uint32_t node : nodes) {
+    for (std::uint32_t d = 0; d < 3; ++d) {
+      const std::uint32_t dof = 3 * node + d;
+      if (fixed_dof[dof] == 0) sphere_dofs_.push_back(dof);
+    }
+  }
+  int* reach = reaches_.data() + dofs_ * slot;
+  kept.reach = factor.reach(sphere_dofs_, {reach, dofs_});
+  const std::span<const int> supernodes{reach, kept.reach};
+  double* y = half(slot);
+  for (const int k : supernodes) {
+    std::fill(y + 3 * std::size_t(factor.supernode_first(k)),
+              y + 3 * std::size_t(factor.supernode_end(k)), 0.0);
+  }
+  // P J_s^T: w_i on node i's DOF d, at that DOF's row in the ordering.
+  for (std::size_t m = 0; m < nodes.size(); ++m) {
+    for (std::size_t d = 0; d < 3; ++d) {
+      const std::size_t dof = 3 * std::size_t{nodes[m]} + d;
+      if (fixed_dof[dof] == 0) y[3 * std::size_t(factor.permuted(dof)) + d] += weights[m];
+    }
+  }
+  factor.forward3_on_reach(supernodes, {y, 3 * dofs_});
+  kept.factorisation = factor.factorisations();
+  kept.valid = true;
+  // Its products with the others are computed again when asked for.
+  const std::size_t count = slots_.size();
+  for (std::size_t other = 0; other < count; ++other) {
+    pair_known_[slot * count + other] = 0;
+    pair_known_[other * count + slot] = 0;
+  }
+}
+
+const double* ComplianceBlock::half_product(std::size_t s, std::size_t t,
+                                            const CholmodSolver& factor) {
+  const std::size_t count = slots_.size();
+  double* block = pairs_.data() + 9 * (s * count + t);
+  if (pair_known_[s * count + t] != 0) return block;
+  // The supernodes both reach: a merge of two ascending lists.
+  const int* a = reach(s);
+  const int* b = reach(t);
+  const int* a_end = a + slots_[s].reach;
+  const int* b_end = b + slots_[t].reach;
+  const double* ys = half(s);
+  const double* yt = half(t);
+  double sum[9] = {};
+  while (a != a_end && b != b_end) {
+    if (*a < *b) {
+      ++a;
+    } else if (*b < *a) {
+      ++b;
+    } else {
+      const auto first = 3 * std::size_t(factor.supernode_first(*a));
+      const auto end = 3 * std::size_t(factor.supernode_end(*a));
+      for (std::size_t j = first; j < end; j += 3) {
+        for (std::size_t d = 0; d < 3; ++d) {
+          for (std::size_t e = 0; e < 3; ++e) sum[3 * d + e] += ys[j + d] * yt[j + e];
+        }
+      }
+      ++a;
+      ++b;
+    }
+  }
+  double* mirror = pairs_.data() + 9 * (t * count + s);
+  for (std::size_t d = 0; d < 3; ++d) {
+    for (std::size_t e = 0; e < 3; ++e) {
+      block[3 * d + e] = sum[3 * d + e];
+      mirror[3 * e + d] = sum[3 * d + e];
+    }
+  }
+  pair_known_[s * count + t] = 1;
+  pair_known_[t * count + s] = 1;
+  return block;
+}
+
 bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const SphereLinks& links,
                               std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
                               WarpedFactor& warp, double time_step_s, std::span<float> out) {
@@ -114,9 +199,12 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
     if (s >= links.size()) return false;
   }
   ++uses_;
-  if (warp.enabled()) {
-    // Q A^-1 Q^T changes with the rotations every step: nothing is kept.
+  const bool half_solves = factor.sparse_forward_ready() && !warp.enabled();
+  if (warp.enabled() || half_solves != half_) {
+    // Q A^-1 Q^T changes with the rotations every step, and half and full
+    // solves do not mix: nothing kept is used.
     for (Slot& slot : slots_) slot.valid = false;
+    half_ = half_solves;
   }
   const std::uint64_t factorisation = factor.factorisations();
   to_solve_.clear();
@@ -145,6 +233,20 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
     const std::uint64_t lag = factorisation - slots_[request_slots_[s]].factorisation;
     oldest_lag_ = std::max<std::uint64_t>(oldest_lag_, lag);
   }
+  const double h2 = time_step_s * time_step_s;
+  if (half_solves) {
+    for (const std::size_t slot : to_solve_) solve_half(slot, links, fixed_dof, factor);
+    for (std::size_t s = 0; s < k; ++s) {
+      for (std::size_t t = 0; t < k; ++t) {
+        const double* block = half_product(request_slots_[s], request_slots_[t], factor);
+        for (std::size_t d = 0; d < 3; ++d) {
+          for (std::size_t e = 0; e < 3; ++e)
+            out[(3 * s + d) * rows + 3 * t + e] = static_cast<float>(h2 * block[3 * d + e]);
+        }
+      }
+    }
+    return true;
+  }
   for (std::size_t done = 0; done < to_solve_.size();) {
     const std::size_t left = to_solve_.size() - done;
     std::size_t chunk = kChunkSpheres.back();
@@ -158,7 +260,6 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
     done += chunk;
   }
   // W = h^2 J X: row 3s + d of J dotted with column 3t + e of X.
-  const double h2 = time_step_s * time_step_s;
   for (std::size_t t = 0; t < rows; ++t) {
     const double* x = column(request_slots_[t / 3], t % 3);
     for (std::size_t s = 0; s < k; ++s) {

@@ -204,6 +204,9 @@ class Body {
   // The fixed DOFs, one flag per DOF, as assembly and compliance take them.
   std::span<const std::uint8_t> fixed_dofs() const { return fixed_dof_; }
   double factor_nonzeros() const { return cholmod_.factor_nonzeros(); }
+  // Whether CHOLMOD chose (or was told) a supernodal factor: compliance
+  // blocks are then half solves (compliance.h).
+  bool supernodal_factor() const { return cholmod_.supernodal(); }
   // Numeric factorisations so far, set-up included.
   std::uint64_t factorisations() const { return cholmod_.factorisations(); }
   // CPU time of the background factorisation thread so far, ns

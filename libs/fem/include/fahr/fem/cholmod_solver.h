@@ -82,6 +82,31 @@ class CholmodSolver {
   // CPU time the background thread has used so far, ns (0 without one).
   std::int64_t background_cpu_ns() const;
 
+  // Solves with sparse right-hand sides (the compliance block, compliance.h).
+  // With a supernodal LL' factor, A = P^T L L^T P, so b^T A^-1 c =
+  // (L^-1 P b)^T (L^-1 P c), and L^-1 P b is non-zero only on the supernodes
+  // of the elimination tree's paths from b's non-zeros to the root: a few of
+  // them, where a dense solve runs over all of L twice.
+  //
+  // True when the factor in use is a numeric supernodal LL' factor.
+  bool sparse_forward_ready() const;
+  std::size_t supernodes() const;
+  // The position of `dof` in the factor's ordering (the row of P b it lands on).
+  int permuted(std::size_t dof) const;
+  // The supernodes L^-1 P b reaches for a b with non-zeros at these DOFs,
+  // ascending (children before parents), into `out` (room for supernodes());
+  // returns their count. No allocation.
+  std::size_t reach(std::span<const std::uint32_t> dofs, std::span<int> out);
+  // The columns [first, last) of supernode k in the factor's ordering.
+  int supernode_first(int k) const;
+  int supernode_end(int k) const;
+  // Y := L^-1 Y, in place, for three columns stored row by row (entry
+  // (j, d) at y[3 j + d], j in the factor's ordering) that hold P B on the
+  // rows of the supernodes in `reach` (the caller zeroes those rows before
+  // scattering B; other rows are neither read nor written). L is read once
+  // for the three. No allocation.
+  void forward3_on_reach(std::span<const int> reach, std::span<double> y);
+
   // Non-zeros of the factor L, for reports.
   double factor_nonzeros() const;
   bool supernodal() const;

@@ -12,6 +12,13 @@
 // one differs by about that much); a budget of spheres a call
 // (refresh_per_call) is solved again on the new factor, the stalest first,
 // so a refactorisation costs no burst of solves for the whole block.
+//
+// With a supernodal LL' factor (the tongue's) a sphere's columns are the
+// half solve Y_s = L^-1 P J_s^T, on the supernodes its DOFs reach only, and
+// W_st = h^2 Y_s^T Y_t, summed over the supernodes both reach (the paths to
+// the root they share): no backward solve, and a forward solve over a
+// fraction of L. Other factors (simplicial, warped) keep full solves
+// X_s = A^-1 J_s^T and W_st = h^2 J_s X_t.
 #pragma once
 
 #include <Eigen/Core>
@@ -74,6 +81,7 @@ class ComplianceBlock {
     std::uint64_t factorisation = 0;  // CholmodSolver::factorisations() when solved
     std::uint64_t last_use = 0;
     bool valid = false;
+    std::size_t reach = 0;  // supernodes of its half solve (reaches_), 0 for full solves
   };
   // The slot holding this sphere's columns for the given factorisation, or
   // a free (least recently used, not in this request) slot marked for it.
@@ -81,14 +89,30 @@ class ComplianceBlock {
   void solve_chunk(std::span<const std::size_t> slots, const SphereLinks& links,
                    std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
                    WarpedFactor& warp);
+  void solve_half(std::size_t slot, const SphereLinks& links,
+                  std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor);
+  // Y_s^T Y_t of two half-solved slots (row-major 3x3), kept until either
+  // is solved again.
+  const double* half_product(std::size_t s, std::size_t t, const CholmodSolver& factor);
   const double* column(std::size_t slot, std::size_t d) const {
     return columns_.data() + dofs_ * (3 * slot + d);
   }
+  double* column(std::size_t slot, std::size_t d) {
+    return columns_.data() + dofs_ * (3 * slot + d);
+  }
+  // A half-solved slot's three columns, row by row (entry (j, d) at 3 j + d).
+  double* half(std::size_t slot) { return columns_.data() + 3 * dofs_ * slot; }
+  const int* reach(std::size_t slot) const { return reaches_.data() + dofs_ * slot; }
 
   std::size_t dofs_ = 0;
   std::size_t max_spheres_ = 0;
   std::vector<Slot> slots_;
   std::vector<double> columns_;             // 3 columns of dofs_ per slot
+  std::vector<int> reaches_;                // per slot, room for dofs_ supernodes
+  std::vector<std::uint32_t> sphere_dofs_;  // the free DOFs of one sphere
+  bool half_ = false;                       // the kept columns are half solves
+  std::vector<double> pairs_;               // Y_s^T Y_t per pair of slots, 9 each
+  std::vector<std::uint8_t> pair_known_;    // whether pairs_ holds that pair's
   std::vector<std::size_t> request_slots_;  // slot of each requested sphere
   std::vector<std::size_t> to_solve_;       // slots to solve this call
   std::vector<double> rhs_;                 // one chunk of right-hand sides
