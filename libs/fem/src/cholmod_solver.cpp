@@ -401,41 +401,52 @@ void CholmodSolver::forward3_on_reach(std::span<const int> reach, std::span<doub
   const int* px = static_cast<const int*>(f.px);
   const int* srow = static_cast<const int*>(f.s);
   const double* lx = static_cast<const double*>(f.x);
-  double* update = s.update.data();
+  const std::size_t n = s.rows;
+  double* y0 = y.data();
+  double* y1 = y0 + n;
+  double* y2 = y1 + n;
+  const std::size_t room = s.update.size() / 3;
+  double* u0 = s.update.data();
+  double* u1 = u0 + room;
+  double* u2 = u1 + room;
   for (const int k : reach) {
-    const int first = super[k];
-    const auto columns = std::size_t(super[k + 1] - first);
+    const auto first = std::size_t(super[k]);
+    const auto columns = std::size_t(super[k + 1]) - first;
     const auto rows_k = std::size_t(pi[k + 1] - pi[k]);
     const auto below = rows_k - columns;
     // The supernode's block, column-major with leading dimension rows_k:
     // the lower-triangular diagonal block on top, the rows below under it.
     const double* l = lx + px[k];
-    double* x = y.data() + 3 * std::size_t(first);
-    std::fill(update, update + 3 * below, 0.0);
+    double* x0 = y0 + first;
+    double* x1 = y1 + first;
+    double* x2 = y2 + first;
+    std::fill(u0, u0 + below, 0.0);
+    std::fill(u1, u1 + below, 0.0);
+    std::fill(u2, u2 + below, 0.0);
     for (std::size_t c = 0; c < columns; ++c) {
       const double* lc = l + c * rows_k;
       const double inv = 1.0 / lc[c];
-      const double x0 = x[3 * c] *= inv;
-      const double x1 = x[3 * c + 1] *= inv;
-      const double x2 = x[3 * c + 2] *= inv;
+      const double a0 = x0[c] *= inv;
+      const double a1 = x1[c] *= inv;
+      const double a2 = x2[c] *= inv;
       for (std::size_t r = c + 1; r < columns; ++r) {
-        x[3 * r] -= lc[r] * x0;
-        x[3 * r + 1] -= lc[r] * x1;
-        x[3 * r + 2] -= lc[r] * x2;
+        x0[r] -= lc[r] * a0;
+        x1[r] -= lc[r] * a1;
+        x2[r] -= lc[r] * a2;
       }
       const double* lb = lc + columns;
       for (std::size_t r = 0; r < below; ++r) {
-        update[3 * r] += lb[r] * x0;
-        update[3 * r + 1] += lb[r] * x1;
-        update[3 * r + 2] += lb[r] * x2;
+        u0[r] += lb[r] * a0;
+        u1[r] += lb[r] * a1;
+        u2[r] += lb[r] * a2;
       }
     }
     const int* below_rows = srow + pi[k] + static_cast<std::ptrdiff_t>(columns);
     for (std::size_t r = 0; r < below; ++r) {
-      double* target = y.data() + 3 * std::size_t(below_rows[r]);
-      target[0] -= update[3 * r];
-      target[1] -= update[3 * r + 1];
-      target[2] -= update[3 * r + 2];
+      const auto row = std::size_t(below_rows[r]);
+      y0[row] -= u0[r];
+      y1[row] -= u1[r];
+      y2[row] -= u2[r];
     }
   }
 }

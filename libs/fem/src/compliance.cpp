@@ -123,19 +123,17 @@ void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
   int* reach = reaches_.data() + dofs_ * slot;
   kept.reach = factor.reach(sphere_dofs_, {reach, dofs_});
   const std::span<const int> supernodes{reach, kept.reach};
-  double* y = half(slot);
-  for (const int k : supernodes) {
-    std::fill(y + 3 * std::size_t(factor.supernode_first(k)),
-              y + 3 * std::size_t(factor.supernode_end(k)), 0.0);
-  }
-  // P J_s^T: w_i on node i's DOF d, at that DOF's row in the ordering.
-  for (std::size_t m = 0; m < nodes.size(); ++m) {
-    for (std::size_t d = 0; d < 3; ++d) {
+  for (std::size_t d = 0; d < 3; ++d) {
+    double* y = column(slot, d);
+    for (const int k : supernodes)
+      std::fill(y + factor.supernode_first(k), y + factor.supernode_end(k), 0.0);
+    // P J_s^T along d: w_i on node i's DOF d, at that DOF's row in the ordering.
+    for (std::size_t m = 0; m < nodes.size(); ++m) {
       const std::size_t dof = 3 * std::size_t{nodes[m]} + d;
-      if (fixed_dof[dof] == 0) y[3 * std::size_t(factor.permuted(dof)) + d] += weights[m];
+      if (fixed_dof[dof] == 0) y[factor.permuted(dof)] += weights[m];
     }
   }
-  factor.forward3_on_reach(supernodes, {y, 3 * dofs_});
+  factor.forward3_on_reach(supernodes, {column(slot, 0), 3 * dofs_});
   kept.factorisation = factor.factorisations();
   kept.valid = true;
   // Its products with the others are computed again when asked for.
@@ -156,8 +154,12 @@ const double* ComplianceBlock::half_product(std::size_t s, std::size_t t,
   const int* b = reach(t);
   const int* a_end = a + slots_[s].reach;
   const int* b_end = b + slots_[t].reach;
-  const double* ys = half(s);
-  const double* yt = half(t);
+  const double* ys[3] = {column(s, 0), column(s, 1), column(s, 2)};
+  const double* yt[3] = {column(t, 0), column(t, 1), column(t, 2)};
+  // Partial sums in kLanes interleaved lanes (vector registers), added in a
+  // fixed order at the end: the same bits on every run.
+  constexpr std::size_t kLanes = 4;
+  double lanes[9][kLanes] = {};
   double sum[9] = {};
   while (a != a_end && b != b_end) {
     if (*a < *b) {
@@ -165,16 +167,28 @@ const double* ComplianceBlock::half_product(std::size_t s, std::size_t t,
     } else if (*b < *a) {
       ++b;
     } else {
-      const auto first = 3 * std::size_t(factor.supernode_first(*a));
-      const auto end = 3 * std::size_t(factor.supernode_end(*a));
-      for (std::size_t j = first; j < end; j += 3) {
+      const auto first = std::size_t(factor.supernode_first(*a));
+      const auto end = std::size_t(factor.supernode_end(*a));
+      std::size_t j = first;
+      for (; j + kLanes <= end; j += kLanes) {
         for (std::size_t d = 0; d < 3; ++d) {
-          for (std::size_t e = 0; e < 3; ++e) sum[3 * d + e] += ys[j + d] * yt[j + e];
+          for (std::size_t e = 0; e < 3; ++e) {
+            for (std::size_t q = 0; q < kLanes; ++q)
+              lanes[3 * d + e][q] += ys[d][j + q] * yt[e][j + q];
+          }
+        }
+      }
+      for (; j < end; ++j) {
+        for (std::size_t d = 0; d < 3; ++d) {
+          for (std::size_t e = 0; e < 3; ++e) sum[3 * d + e] += ys[d][j] * yt[e][j];
         }
       }
       ++a;
       ++b;
     }
+  }
+  for (std::size_t i = 0; i < 9; ++i) {
+    for (std::size_t q = 0; q < kLanes; ++q) sum[i] += lanes[i][q];
   }
   double* mirror = pairs_.data() + 9 * (t * count + s);
   for (std::size_t d = 0; d < 3; ++d) {

@@ -100,11 +100,11 @@ class CholmodSolver {
   // The columns [first, last) of supernode k in the factor's ordering.
   int supernode_first(int k) const;
   int supernode_end(int k) const;
-  // Y := L^-1 Y, in place, for three columns stored row by row (entry
-  // (j, d) at y[3 j + d], j in the factor's ordering) that hold P B on the
-  // rows of the supernodes in `reach` (the caller zeroes those rows before
-  // scattering B; other rows are neither read nor written). L is read once
-  // for the three. No allocation.
+  // Y := L^-1 Y, in place, for three columns of A.rows() entries each,
+  // one after the other in `y`, in the factor's ordering, that hold P B on
+  // the rows of the supernodes in `reach` (the caller zeroes those rows
+  // before scattering B; other rows are neither read nor written). L is
+  // read once for the three. No allocation.
   void forward3_on_reach(std::span<const int> reach, std::span<double> y);
 
   // Non-zeros of the factor L, for reports.

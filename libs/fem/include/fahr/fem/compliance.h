@@ -100,8 +100,6 @@ class ComplianceBlock {
   double* column(std::size_t slot, std::size_t d) {
     return columns_.data() + dofs_ * (3 * slot + d);
   }
-  // A half-solved slot's three columns, row by row (entry (j, d) at 3 j + d).
-  double* half(std::size_t slot) { return columns_.data() + 3 * dofs_ * slot; }
   const int* reach(std::size_t slot) const { return reaches_.data() + dofs_ * slot; }
 
   std::size_t dofs_ = 0;
