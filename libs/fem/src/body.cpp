@@ -156,6 +156,13 @@ std::string Body::configure_background_factor() {
   factor_latency_steps_ = 0;
   if (!(solver.background_factor_latency_s > 0.0) || solver.refactor_period == 1) return {};
   if (!cholmod_.enable_background()) return "CHOLMOD background factorisation failed to start";
+  // The job's copies (set-up: these allocate).
+  job_assembly_ = assembly_;
+  job_deformations_.assign(deformations_.size(), Eigen::Matrix3d::Zero());
+  job_rotations_.assign(rotations_.size(), Eigen::Matrix3d::Identity());
+  job_scales_.assign(stiffening_scales_.size(), 1.0);
+  job_supports_.assign(supports_.size(), NodeSupport{});
+  job_support_count_ = 0;
   factor_latency_steps_ = static_cast<std::uint64_t>(
       std::max(1.0, std::ceil(solver.background_factor_latency_s / h_ - 1e-9)));
   return {};
@@ -167,6 +174,21 @@ void Body::cancel_background_factor() {
 }
 
 void Body::assemble_system() {
+  assemble_into(assembly_, deformations_, rotations_, stiffening_scales_,
+                {supports_.data(), support_count_}, support_ratio_);
+}
+
+void Body::assemble_job(void* body, std::span<double> values) {
+  Body& b = *static_cast<Body*>(body);
+  b.assemble_into(b.job_assembly_, b.job_deformations_, b.job_rotations_, b.job_scales_,
+                  {b.job_supports_.data(), b.job_support_count_}, b.job_support_ratio_);
+  const SparseMatrix& a = b.job_assembly_.matrix();
+  std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), values.begin());
+}
+
+void Body::assemble_into(SystemAssembly& out, std::span<const Eigen::Matrix3d> deformations,
+                         std::span<const Eigen::Matrix3d> rotations, std::span<const double> scales,
+                         std::span<const NodeSupport> supports, double support_ratio) {
   const double alpha = settings_.material.rayleigh_mass_per_s;
   const double beta = settings_.material.rayleigh_stiffness_s;
   if (snh_) {
@@ -176,27 +198,26 @@ void Body::assemble_system() {
     // An element whose F has moved less than tangent_reuse_change since its
     // tangent was computed keeps that tangent (a lag far below the refresh
     // trigger's); the others are computed again.
-    assembly_.zero();
+    out.zero();
     const double stiffness_scale = h_ * beta + h_ * h_;
     const double reuse = settings_.solver.tangent_reuse_change;
     const double reuse_squared = reuse * reuse;
     for (std::size_t e = 0; e < rest_.size(); ++e) {
-      const Eigen::Matrix3d& f = deformations_[e];
+      const Eigen::Matrix3d& f = deformations[e];
       if (!((f - tangent_deformations_[e]).squaredNorm() <= reuse_squared) || !(reuse > 0.0)) {
         element_tangents_[e] = element_stiffness(shape_gradients(rest_.dm_inv[e]),
                                                  rest_.volume_m3[e], snh_->projected_hessian(f));
         tangent_deformations_[e] = f;
       }
-      assembly_.add_element(e, element_tangents_[e], stiffness_scale);
+      out.add_element(e, element_tangents_[e], stiffness_scale);
     }
-    assembly_.add_mass(mass_per_dof_, 1.0 + h_ * alpha);
+    out.add_mass(mass_per_dof_, 1.0 + h_ * alpha);
   } else {
-    assembly_.assemble(rest_, rotations_, lame_, mass_per_dof_, 1.0 + h_ * alpha,
-                       h_ * beta + h_ * h_, stiffening_scales_);
+    out.assemble(rest_, rotations, lame_, mass_per_dof_, 1.0 + h_ * alpha, h_ * beta + h_ * h_,
+                 scales);
   }
-  for (std::size_t i = 0; i < support_count_; ++i) {
-    assembly_.add_normal_stiffness(supports_[i].node, supports_[i].normal, support_ratio_);
-  }
+  for (const NodeSupport& support : supports)
+    out.add_normal_stiffness(support.node, support.normal, support_ratio);
 }
 
 void Body::assemble_current(SystemAssembly& out) const {
@@ -550,11 +571,23 @@ void Body::prepare_system(StepReport& report) {
   // way waits for it (the triggers then compare against its state).
   const bool begin = factor_due && factor_needed && !factor_pending_;
   // CG multiplies with the current A; the direct solve only needs A when it
-  // refactorises.
-  if (cg || begin) assemble_system();
+  // refactorises, and in the background the job assembles it from a copy
+  // of this step's state (the same A, off this thread).
+  const bool job_assembles = begin && !cg && background_factor();
+  if (cg || (begin && !job_assembles)) assemble_system();
   if (begin && background_factor()) {
     mark_factor_state();
-    factor_pending_ = cholmod_.begin_factorize();
+    if (job_assembles) {
+      std::copy(deformations_.begin(), deformations_.end(), job_deformations_.begin());
+      std::copy(rotations_.begin(), rotations_.end(), job_rotations_.begin());
+      std::copy(stiffening_scales_.begin(), stiffening_scales_.end(), job_scales_.begin());
+      std::copy_n(supports_.begin(), support_count_, job_supports_.begin());
+      job_support_count_ = support_count_;
+      job_support_ratio_ = support_ratio_;
+      factor_pending_ = cholmod_.begin_factorize(&Body::assemble_job, this);
+    } else {
+      factor_pending_ = cholmod_.begin_factorize();
+    }
     factor_install_step_ = step_ + factor_latency_steps_;
   } else if (begin) {
     report.refactorised = refactorise();

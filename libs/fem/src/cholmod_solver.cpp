@@ -68,6 +68,8 @@ struct CholmodSolver::State {
     clockid_t cpu_clock{};
     std::mutex mutex;
     std::condition_variable wake;
+    FillValues fill = nullptr;  // writes `values` on the thread, or null
+    void* fill_context = nullptr;
     bool job = false;      // a factorisation was asked for and not taken yet
     bool running = false;  // begun and not finished or cancelled
     bool ok = false;
@@ -85,7 +87,10 @@ struct CholmodSolver::State {
     for (;;) {
       b.wake.wait(lock, [&] { return b.job || b.stop; });
       if (b.stop) return;
+      const FillValues fill = b.fill;
+      void* const context = b.fill_context;
       lock.unlock();
+      if (fill != nullptr) fill(context, b.values);
       const int ok = cholmod_factorize(&b.view, b.factor, &b.common);
       const bool good = ok != 0 && b.common.status == CHOLMOD_OK;
       lock.lock();
@@ -288,14 +293,16 @@ bool CholmodSolver::enable_background() {
   return true;
 }
 
-bool CholmodSolver::begin_factorize() {
+bool CholmodSolver::begin_factorize(FillValues fill, void* context) {
   State& s = *state_;
   if (!s.background) return false;
   State::Background& b = *s.background;
   {
     std::lock_guard lock(b.mutex);
     if (b.running) return false;
-    std::memcpy(b.values.data(), s.view.x, sizeof(double) * b.values.size());
+    b.fill = fill;
+    b.fill_context = context;
+    if (fill == nullptr) std::memcpy(b.values.data(), s.view.x, sizeof(double) * b.values.size());
     b.running = true;
     b.job = true;
     b.ok = false;

@@ -241,6 +241,14 @@ class Body {
                              StepReport& report);
   void finish_step(StepReport& report);
   void assemble_system();
+  // A from the given per-element state and supports into `out`; the
+  // hyperelastic tangents kept in element_tangents_ are used and updated.
+  void assemble_into(SystemAssembly& out, std::span<const Eigen::Matrix3d> deformations,
+                     std::span<const Eigen::Matrix3d> rotations, std::span<const double> scales,
+                     std::span<const NodeSupport> supports, double support_ratio);
+  // The background factorisation's own assembly (CholmodSolver::FillValues):
+  // A at the state copied when the job began, off the step's thread.
+  static void assemble_job(void* body, std::span<double> values);
   bool refactorise();
   // What refactorise() records of the state A was assembled at (the
   // triggers compare against it), without the factorisation.
@@ -294,6 +302,17 @@ class Body {
   std::vector<Eigen::Matrix3d> tangent_deformations_;
 
   SystemAssembly assembly_;
+  // The background job's copies: its assembly (the same pattern), and the
+  // state of the step that began it (the step goes on changing its own).
+  // The job owns them, and element_tangents_, until it is installed or
+  // cancelled. Used with the direct solve; CG assembles every step itself.
+  SystemAssembly job_assembly_;
+  std::vector<Eigen::Matrix3d> job_deformations_;
+  std::vector<Eigen::Matrix3d> job_rotations_;
+  std::vector<double> job_scales_;
+  std::vector<NodeSupport> job_supports_;
+  std::size_t job_support_count_ = 0;
+  double job_support_ratio_ = 0.0;
   CholmodSolver cholmod_;
   WarpedFactor warp_;
   CgSolver cg_;

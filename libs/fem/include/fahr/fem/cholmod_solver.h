@@ -75,8 +75,14 @@ class CholmodSolver {
   // definite, makes it the factor solves use (a factorisation counted);
   // false if it failed, the factor before then stays. cancel_factorize()
   // waits and throws the result away (before a synchronous factorize()).
+  //
+  // begin_factorize(fill, context) has the thread write the values itself
+  // first: fill(context, values) with one entry per non-zero of the
+  // analysed pattern (the caller's assembly, off its own thread); the
+  // caller keeps what fill reads unchanged until finish or cancel.
+  using FillValues = void (*)(void* context, std::span<double> values);
   bool enable_background();
-  bool begin_factorize();
+  bool begin_factorize(FillValues fill = nullptr, void* context = nullptr);
   bool finish_factorize();
   void cancel_factorize();
   // CPU time the background thread has used so far, ns (0 without one).
