@@ -13,6 +13,9 @@
 #     for the fragmented ones too (dropping fragments on their own would
 #     lose a quarter of them);
 #   - a->c: nothing lost, the median under 0.5 ms.
+# A measurement during which the relay itself was starved (it reports
+# sending some link's frames more than 5 ms late at p99) says nothing of the
+# relay: if it failed, it is taken once more.
 #
 #   tests/lab/udp_relay.sh BUILD_DIR
 #
@@ -61,83 +64,104 @@ for h in "${hosts[@]}"; do
   ip -n "$tag-$h" link set lab0 up
   ports+=(--port "$h=$tag$h")
 done
-ip netns exec "$tag-sw" timeout 60 "$relay" "${ports[@]}" --seed 7 --rt-priority 10 \
-  --link "a-b:delay_ms=$delay_ms,jitter_ms=$jitter_ms,loss=$loss" >"$work/relay.out" 2>&1 &
-relay_pid=$!
-for _ in $(seq 100); do
-  grep -q "ready" "$work/relay.out" && break
-  sleep 0.05
-done
-grep -q "ready" "$work/relay.out" || { echo "udp_relay: the relay did not start:" >&2; cat "$work/relay.out" >&2; exit 1; }
-
-# Every host speaks once (ARP, and the relay learns where each one is).
-for h in a b c; do
-  for to in 1 2 3; do
-    ip netns exec "$tag-$h" timeout 5 "$probe" send "10.78.0.$to" 9 --count 2 --rate-hz 100 >/dev/null 2>&1 || true
+# One measurement: the relay started afresh, every probe at once, the
+# relay's end line, the checks. Sets status (0: all held) and stalled (the
+# relay reports it sent some link's frames more than stall_ms late at p99:
+# the machine took the CPU from it, so the measurement says nothing of the
+# relay).
+stall_ms=5
+measure() {
+  status=0
+  stalled=0
+  ip netns exec "$tag-sw" timeout 60 "$relay" "${ports[@]}" --seed 7 --rt-priority 10 \
+    --link "a-b:delay_ms=$delay_ms,jitter_ms=$jitter_ms,loss=$loss" >"$work/relay.out" 2>&1 &
+  relay_pid=$!
+  for _ in $(seq 100); do
+    grep -q "ready" "$work/relay.out" && break
+    sleep 0.05
   done
-done
-sleep 0.3
+  grep -q "ready" "$work/relay.out" || { echo "udp_relay: the relay did not start:" >&2; cat "$work/relay.out" >&2; exit 1; }
 
-n=2000 n_big=1500
-in_ns() { local h=$1; shift; ip netns exec "$tag-$h" timeout 60 "$@"; }
-in_ns b "$probe" receive 5001 --count $n >"$work/ab.out" 2>&1 &
-r1=$!
-in_ns b "$probe" receive 5002 --count $n_big --size 8000 >"$work/ab_big.out" 2>&1 &
-r2=$!
-in_ns a "$probe" receive 5003 --count $n >"$work/ba.out" 2>&1 &
-r3=$!
-in_ns c "$probe" receive 5004 --count $n >"$work/ac.out" 2>&1 &
-r4=$!
-for f in ab ab_big ba ac; do
-  for _ in $(seq 100); do grep -q listening "$work/$f.out" 2>/dev/null && break; sleep 0.05; done
-done
-in_ns a "$probe" send 10.78.0.2 5001 --count $n --rate-hz 1000 >/dev/null &
-s1=$!
-in_ns a "$probe" send 10.78.0.2 5002 --count $n_big --rate-hz 500 --size 8000 >/dev/null &
-s2=$!
-in_ns b "$probe" send 10.78.0.1 5003 --count $n --rate-hz 1000 >/dev/null &
-s3=$!
-in_ns a "$probe" send 10.78.0.3 5004 --count $n --rate-hz 1000 >/dev/null &
-s4=$!
-status=0
-for p in $s1 $s2 $s3 $s4 $r1 $r2 $r3 $r4; do wait "$p" || status=1; done
-kill -TERM "$relay_pid"
-wait "$relay_pid" || status=1
-relay_pid=""
-cat "$work/relay.out"
-for f in ab ab_big ba ac; do echo "$f: $(grep expected= "$work/$f.out")"; done
+  # Every host speaks once (ARP, and the relay learns where each one is).
+  for h in a b c; do
+    for to in 1 2 3; do
+      ip netns exec "$tag-$h" timeout 5 "$probe" send "10.78.0.$to" 9 --count 2 --rate-hz 100 >/dev/null 2>&1 || true
+    done
+  done
+  sleep 0.3
 
-fail() { echo "udp_relay: FAIL: $*" >&2; status=1; }
-get() { grep -o "\b$2=[0-9.]*" "$work/$1.out" | head -1 | cut -d= -f2; }
-# How late the relay sent a link's frames against their schedule, p99, ms
-# (its own end line): time the machine took from it, not jitter it drew.
-late_p99() { sed -n "s/^fahr_udp_relay: $1: .*left late p50 [0-9.]* ms p99 \([0-9.]*\) ms.*/\1/p" "$work/relay.out"; }
-check_impaired() {
-  local f=$1 count=$2 link=$3
-  local lost min p05 p50 p95 late
-  lost=$(get "$f" lost) min=$(get "$f" delay_min_ms) p05=$(get "$f" delay_p05_ms)
-  p50=$(get "$f" delay_p50_ms) p95=$(get "$f" delay_p95_ms)
-  late=$(late_p99 "$link")
-  [ -n "$lost" ] || { fail "$f: no result"; return; }
-  awk -v lost="$lost" -v n="$count" -v p="$loss" -v min="$min" -v p05="$p05" -v p50="$p50" \
-      -v p95="$p95" -v d="$delay_ms" -v j="$jitter_ms" -v f="$f" -v late="${late:-0}" 'BEGIN {
-    mean = n * p; sd = sqrt(n * p * (1 - p)); bad = 0
-    if (lost < mean - 4.5 * sd || lost > mean + 4.5 * sd) {
-      printf "%s: %d of %d lost, outside %.0f +- %.0f\n", f, lost, n, mean, 4.5 * sd; bad = 1 }
-    if (min < d - j - 0.05) { printf "%s: a datagram after %.3f ms (< %.3f)\n", f, min, d - j; bad = 1 }
-    if (p50 < d - 0.3 || p50 > d + 1.0) { printf "%s: median %.3f ms, configured %.3f\n", f, p50, d; bad = 1 }
-    # Beyond twice the jitter, 2 ms plus what the relay itself reports
-    # as its lateness (a loaded machine widens the spread; a relay that drew
-    # too much jitter does not say it was late).
-    if (p95 - p05 < j || p95 - p05 > 2 * j + 2 + late) {
-      printf "%s: 5-95 %% spread %.3f ms for +-%.3f ms jitter (relay late p99 %.3f ms)\n", f, p95 - p05, j, late; bad = 1 }
-    exit bad }' >&2 || status=1
+  n=2000 n_big=1500
+  in_ns() { local h=$1; shift; ip netns exec "$tag-$h" timeout 60 "$@"; }
+  in_ns b "$probe" receive 5001 --count $n >"$work/ab.out" 2>&1 &
+  r1=$!
+  in_ns b "$probe" receive 5002 --count $n_big --size 8000 >"$work/ab_big.out" 2>&1 &
+  r2=$!
+  in_ns a "$probe" receive 5003 --count $n >"$work/ba.out" 2>&1 &
+  r3=$!
+  in_ns c "$probe" receive 5004 --count $n >"$work/ac.out" 2>&1 &
+  r4=$!
+  for f in ab ab_big ba ac; do
+    for _ in $(seq 100); do grep -q listening "$work/$f.out" 2>/dev/null && break; sleep 0.05; done
+  done
+  in_ns a "$probe" send 10.78.0.2 5001 --count $n --rate-hz 1000 >/dev/null &
+  s1=$!
+  in_ns a "$probe" send 10.78.0.2 5002 --count $n_big --rate-hz 500 --size 8000 >/dev/null &
+  s2=$!
+  in_ns b "$probe" send 10.78.0.1 5003 --count $n --rate-hz 1000 >/dev/null &
+  s3=$!
+  in_ns a "$probe" send 10.78.0.3 5004 --count $n --rate-hz 1000 >/dev/null &
+  s4=$!
+  status=0
+  for p in $s1 $s2 $s3 $s4 $r1 $r2 $r3 $r4; do wait "$p" || status=1; done
+  kill -TERM "$relay_pid"
+  wait "$relay_pid" || status=1
+  relay_pid=""
+  cat "$work/relay.out"
+  for f in ab ab_big ba ac; do echo "$f: $(grep expected= "$work/$f.out")"; done
+
+  fail() { echo "udp_relay: FAIL: $*" >&2; status=1; }
+  get() { grep -o "\b$2=[0-9.]*" "$work/$1.out" | head -1 | cut -d= -f2; }
+  # How late the relay sent a link's frames against their schedule, p99, ms
+  # (its own end line): time the machine took from it, not jitter it drew.
+  late_p99() { sed -n "s/^fahr_udp_relay: $1: .*left late p50 [0-9.]* ms p99 \([0-9.]*\) ms.*/\1/p" "$work/relay.out"; }
+  check_impaired() {
+    local f=$1 count=$2 link=$3
+    local lost min p05 p50 p95 late
+    lost=$(get "$f" lost) min=$(get "$f" delay_min_ms) p05=$(get "$f" delay_p05_ms)
+    p50=$(get "$f" delay_p50_ms) p95=$(get "$f" delay_p95_ms)
+    late=$(late_p99 "$link")
+    [ -n "$lost" ] || { fail "$f: no result"; return; }
+    awk -v lost="$lost" -v n="$count" -v p="$loss" -v min="$min" -v p05="$p05" -v p50="$p50" \
+        -v p95="$p95" -v d="$delay_ms" -v j="$jitter_ms" -v f="$f" -v late="${late:-0}" 'BEGIN {
+      mean = n * p; sd = sqrt(n * p * (1 - p)); bad = 0
+      if (lost < mean - 4.5 * sd || lost > mean + 4.5 * sd) {
+        printf "%s: %d of %d lost, outside %.0f +- %.0f\n", f, lost, n, mean, 4.5 * sd; bad = 1 }
+      if (min < d - j - 0.05) { printf "%s: a datagram after %.3f ms (< %.3f)\n", f, min, d - j; bad = 1 }
+      if (p50 < d - 0.3 || p50 > d + 1.0) { printf "%s: median %.3f ms, configured %.3f\n", f, p50, d; bad = 1 }
+      # Beyond twice the jitter, 2 ms plus what the relay itself reports
+      # as its lateness (a loaded machine widens the spread; a relay that drew
+      # too much jitter does not say it was late).
+      if (p95 - p05 < j || p95 - p05 > 2 * j + 2 + late) {
+        printf "%s: 5-95 %% spread %.3f ms for +-%.3f ms jitter (relay late p99 %.3f ms)\n", f, p95 - p05, j, late; bad = 1 }
+      exit bad }' >&2 || status=1
+  }
+  check_impaired ab $n "a>b"
+  check_impaired ab_big $n_big "a>b"
+  check_impaired ba $n "b>a"
+  lost=$(get ac lost) p50=$(get ac delay_p50_ms)
+  [ "${lost:-1}" = 0 ] || fail "a->c (no impairment) lost ${lost:-all}"
+  awk -v p="${p50:-99}" 'BEGIN { exit !(p < 0.5) }' || fail "a->c median ${p50:-none} ms (>= 0.5)"
+  for link in "a>b" "b>a" "a>c"; do
+    awk -v l="$(late_p99 "$link")" -v s="$stall_ms" 'BEGIN { exit !(l + 0 > s) }' && stalled=1
+  done
+  return 0
 }
-check_impaired ab $n "a>b"
-check_impaired ab_big $n_big "a>b"
-check_impaired ba $n "b>a"
-lost=$(get ac lost) p50=$(get ac delay_p50_ms)
-[ "${lost:-1}" = 0 ] || fail "a->c (no impairment) lost ${lost:-all}"
-awk -v p="${p50:-99}" 'BEGIN { exit !(p < 0.5) }' || fail "a->c median ${p50:-none} ms (>= 0.5)"
+
+# A measurement the relay itself marks void (stalled) is taken again, once.
+measure
+if [ "$status" != 0 ] && [ "$stalled" = 1 ]; then
+  echo "udp_relay: the machine stalled the relay (late p99 over $stall_ms ms): measuring again" >&2
+  measure
+fi
 echo "udp_relay: status $status"
 exit "$status"
