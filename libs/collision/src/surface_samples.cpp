@@ -167,43 +167,35 @@ SurfaceQueryStats query_surface_samples(const SurfaceSamples& samples,
       stack[top++] = node.first + 1;
       continue;
     }
-    // Leaf: its deepest sample.
-    double deepest = std::numeric_limits<double>::infinity();
-    Eigen::Vector3d deepest_body = Eigen::Vector3d::Zero();
-    Eigen::Vector3d deepest_tool = Eigen::Vector3d::Zero();
+    // Leaf: each of its samples within the margin.
     for (std::int32_t i = node.first; i < node.first + node.count; ++i) {
       const Eigen::Vector3d p = body_from_tool * points[i];
       const double di = sdf.grid_distance(p);
       ++stats.points_tested;
-      if (di < deepest) {
-        deepest = di;
-        deepest_body = p;
-        deepest_tool = points[i];
+      if (!(di < margin_m)) continue;
+      // The field's gradient by central differences of half a cell.
+      const double step = 0.5 * sdf.cell_size_m();
+      Eigen::Vector3d gradient;
+      for (int axis = 0; axis < 3; ++axis) {
+        const Eigen::Vector3d e = step * Eigen::Vector3d::Unit(axis);
+        gradient[axis] = sdf.grid_distance(p + e) - sdf.grid_distance(p - e);
       }
+      const double norm = gradient.norm();
+      if (!(norm > 0.0)) continue;  // a flat spot of the field (deep inside): no direction to push
+      const Eigen::Vector3d n_body = gradient / norm;
+      ++stats.contacts;
+      if (count >= out.size()) {
+        stats.overflowed = true;
+        continue;
+      }
+      SurfaceContact& c = out[count++];
+      c.sample = static_cast<std::uint32_t>(i);
+      c.body_id = body.id;
+      c.tool_point_m = world_from_tool * points[i];
+      c.surface_point_m = body.world_from_body * Eigen::Vector3d(p - di * n_body);
+      c.normal = body.world_from_body.linear() * n_body;
+      c.depth_m = -di;
     }
-    if (!(deepest < margin_m)) continue;
-    // The field's gradient by central differences of half a cell.
-    const double step = 0.5 * sdf.cell_size_m();
-    Eigen::Vector3d gradient;
-    for (int axis = 0; axis < 3; ++axis) {
-      const Eigen::Vector3d e = step * Eigen::Vector3d::Unit(axis);
-      gradient[axis] = sdf.grid_distance(deepest_body + e) - sdf.grid_distance(deepest_body - e);
-    }
-    const double norm = gradient.norm();
-    if (!(norm > 0.0)) continue;  // a flat spot of the field (deep inside): no direction to push
-    const Eigen::Vector3d n_body = gradient / norm;
-    ++stats.contacts;
-    if (count >= out.size()) {
-      stats.overflowed = true;
-      continue;
-    }
-    SurfaceContact& c = out[count++];
-    c.leaf = static_cast<std::uint32_t>(index);
-    c.body_id = body.id;
-    c.tool_point_m = world_from_tool * deepest_tool;
-    c.surface_point_m = body.world_from_body * Eigen::Vector3d(deepest_body - deepest * n_body);
-    c.normal = body.world_from_body.linear() * n_body;
-    c.depth_m = -deepest;
   }
   return stats;
 }

@@ -18,9 +18,9 @@ namespace {
 // margin add as many again. 1024 leaves headroom, and a full buffer is
 // counted, not fatal.
 constexpr std::size_t kToolContactCapacity = 1024;
-// Leaves of the tool's surface samples near the anatomy in one tick: the
-// blade lying along the palate touches a few dozen.
-constexpr std::size_t kAnatomyContactCapacity = 128;
+// Tool surface samples near the anatomy in one tick (1.5 mm apart): the
+// blade lying along the palate brings a few hundred within the margin.
+constexpr std::size_t kAnatomyContactCapacity = 512;
 // Tool samples within this distance of the anatomy become rows (separated,
 // lambda = 0 unless the proxy moves into them): the solve then stops the
 // proxy within the tick instead of one tick late, m. 1 mm: a hand at 1 m/s.
@@ -362,9 +362,9 @@ void HapticLoop::collect_anatomy_rows(const Eigen::Isometry3d& world_from_tool) 
     const collision::SurfaceContact& c = anatomy_contacts_[anatomy_order_[r]];
     contact::ContactRow& row = rows_[row_count_++];
     row.kind = contact::RowKind::kObstacle;
-    // (body, leaf) keys the warm start: body ids are small scene indices,
-    // leaves fewer than 2^20.
-    row.id = (c.body_id << 20) | c.leaf;
+    // (body, sample) keys the warm start: body ids are small scene indices,
+    // samples fewer than 2^20.
+    row.id = (c.body_id << 20) | c.sample;
     // From the tool toward the anatomy: moving the tool into it deepens the row.
     row.normal = -c.normal;
     row.tool_point_m = c.tool_point_m;

@@ -71,9 +71,9 @@ class SurfaceSamples {
   int depth_ = 0;
 };
 
-// The tool touching (or within the margin of) a rigid body at one leaf.
+// The tool touching (or within the margin of) a rigid body at one sample.
 struct SurfaceContact {
-  std::uint32_t leaf = 0;     // node index of the leaf: stable across ticks
+  std::uint32_t sample = 0;   // index of the sample in points_m(): stable across ticks
   std::uint32_t body_id = 0;  // RigidBody::id
   Eigen::Vector3d tool_point_m = Eigen::Vector3d::Zero();     // the deepest sample, world frame
   Eigen::Vector3d surface_point_m = Eigen::Vector3d::Zero();  // nearest surface point, world frame
@@ -89,8 +89,11 @@ struct SurfaceQueryStats {
 };
 
 // Appends to out[count..] the contacts of the tool at `world_from_tool` with
-// `body`, one per leaf, for samples with signed distance below margin_m.
-// Allocation-free, noexcept.
+// `body`, one per sample with signed distance below margin_m. (One per leaf,
+// its deepest sample, made a leaf's row jump between two samples whose
+// normals differ, a lip's edge under the blade: one plane on one tick, the
+// other on the next, the proxy hopping between them; a row per sample keeps
+// both planes.) Allocation-free, noexcept.
 SurfaceQueryStats query_surface_samples(const SurfaceSamples& samples,
                                         const Eigen::Isometry3d& world_from_tool,
                                         const RigidBody& body, double margin_m,

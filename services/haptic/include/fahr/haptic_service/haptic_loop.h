@@ -83,8 +83,8 @@ struct TickPhases {
   collision::QueryStats tissue_query;  // the AIST query's work (zero with the triangle baseline)
 };
 
-// Rows the tool may have against rigid anatomy per tick: one per sample
-// leaf touching (~5 mm of blade each), the deepest kept.
+// Rows the tool may have against rigid anatomy per tick: one per tool
+// sample within the margin, the deepest kept.
 inline constexpr std::size_t kMaxAnatomyRows = 16;
 // Spheres a tick may ask the FEM's compliance for beyond its rows (contacts
 // deep enough to be rows whose sphere has no W yet): candidates at the end
