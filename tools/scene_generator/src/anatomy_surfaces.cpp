@@ -166,6 +166,13 @@ TriangleMesh make_hyoid(const HyoidParameters& p, const FloorParameters& floor,
 TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
   constexpr double kCheekSweepBackMm = 6.0;  // outer rim lies this far behind the lips
   constexpr double kLipBulgeWidth = 0.15;    // radial fraction over which the lips bulge
+  // The lips' free margin is round in section, not a wall meeting the lips'
+  // faces at right angles: a half ellipse as deep as the lips are thick,
+  // reaching into the opening by half that thickness. Its tangent meets the
+  // faces' (both run radially at the rim), so a field's normal turns smoothly
+  // around it; a square rim turned it by 90 degrees within one field cell and
+  // a blade sliding over it was pushed along two planes in turn.
+  const double rim_round_mm = 0.5 * (p.thickness_mm + p.lip_protrusion_mm);
   const RectangleLoop loop{cells_for(p.face_half_width_mm - p.mouth_half_width_mm, resolution_mm),
                            cells_for(p.thickness_mm, 0.5 * resolution_mm)};
   const auto map = [&](double around, double loop_fraction) {
@@ -173,11 +180,13 @@ TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
     const auto [radial, axial] = loop.at(loop_index(loop_fraction, loop.size()));
     // Quadratic spacing from the rim outwards: the lips get more rings than the cheeks.
     const double r = radial * radial;
-    const Eigen::Vector2d inner(p.mouth_half_width_mm * std::cos(a),
-                                p.mouth_half_height_mm * std::sin(a));
+    // The faces start outside the opening by the rim's reach, so the round
+    // margin's innermost line is the opening the parameters give.
+    const Eigen::Vector2d inner((p.mouth_half_width_mm + rim_round_mm) * std::cos(a),
+                                (p.mouth_half_height_mm + rim_round_mm) * std::sin(a));
     const Eigen::Vector2d outer(p.face_half_width_mm * std::cos(a),
                                 p.face_half_height_mm * std::sin(a));
-    const Eigen::Vector2d zy = inner + r * (outer - inner);
+    Eigen::Vector2d zy = inner + r * (outer - inner);
     // Cheeks sweep back at the sides only; above and below the mouth the face
     // stays in front of the gums.
     const double dish = kCheekSweepBackMm * r * r * std::cos(a) * std::cos(a);
@@ -185,7 +194,14 @@ TriangleMesh make_face(const FaceParameters& p, double resolution_mm) {
         p.lip_protrusion_mm * std::exp(-(r / kLipBulgeWidth) * (r / kLipBulgeWidth));
     const double back = p.back_x_mm - dish;
     const double front = p.back_x_mm + p.thickness_mm + lips - dish;
-    return Vec3(back + (front - back) * axial, p.mouth_centre_y_mm + zy.y(), zy.x());
+    double x = back + (front - back) * axial;
+    if (radial == 0.0) {
+      // The margin: axial runs from the back face (0) round to the front (1).
+      const double turn = kPi * axial;
+      x = back + (front - back) * 0.5 * (1.0 - std::cos(turn));
+      zy -= rim_round_mm * std::sin(turn) * (outer - inner).normalized();
+    }
+    return Vec3(x, p.mouth_centre_y_mm + zy.y(), zy.x());
   };
   const int n_around = cells_for(2.0 * kPi * p.mouth_half_width_mm, 0.5 * resolution_mm, 24);
   return make_param_torus(map, n_around, loop.size());
