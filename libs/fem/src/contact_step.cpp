@@ -113,6 +113,7 @@ void ContactStep::add_sphere_force(const Contact& c) {
 void ContactStep::collect(const ContactSet* contacts) {
   std::copy(carry_n_.begin(), carry_n_.end(), force_n_.begin());
   std::fill(carry_n_.begin(), carry_n_.end(), 0.0);
+  tool_force_n_.setZero();
   if (fixed_spheres_) {
     std::fill(lambda_n_.begin(), lambda_n_.end(), 0.0);
   } else {
@@ -139,6 +140,7 @@ void ContactStep::collect(const ContactSet* contacts) {
     }
     if (!settings_.apply_contact_forces || !carries_force(c)) continue;
     add_sphere_force(c);
+    tool_force_n_ += c.force_n * c.normal;
     if (slot == kNoSlot) continue;
     const auto i = static_cast<std::size_t>(slot);
     if (lambda_n_[i] == 0.0) {
@@ -253,6 +255,7 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
   if (obstacles_) obstacles_->begin_step();
   int volume_below = 0;
   int volume_unresolved = 0;
+  Eigen::Vector3d tool_push = Eigen::Vector3d::Zero();
   for (int round = 0; round < rounds; ++round) {
     // After a round: whether the anatomy's last pass left nothing to redo.
     bool settled = round > 0;
@@ -260,6 +263,7 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
       projection_ = project_contacts(*contacts, links_, inverse_mass, projection_settings_,
                                      projected_, start_positions_);
       sweeps += projection_.sweeps;
+      tool_push += projection_.tool_push_kg_m;
       // It moved nothing the tool constraints needed (with a floor: nor
       // squeezed a tet below it, checked after the floor's pass).
       settled = settled && projection_.sweeps <= 1 && projection_.converged;
@@ -281,6 +285,7 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
       break;
   }
   projection_.sweeps = sweeps;
+  projection_.tool_push_kg_m = tool_push;
   projection_.volume_floor_below = volume_below;
   projection_.volume_floor_unresolved = volume_unresolved;
   projection_.obstacle_rounds = anatomy.obstacle_rounds;
@@ -296,6 +301,7 @@ void ContactStep::project(const ContactSet* contacts) {
   std::copy(free_positions_.begin(), free_positions_.end(), projected_.begin());
   alternate_with_anatomy(contacts);
   const double h2 = body_.time_step_s() * body_.time_step_s();
+  tool_reaction_n_ = tool_force_n_ + projection_.tool_push_kg_m / h2;
   const auto mass = body_.mass_kg();
   for (std::size_t n = 0; n < body_.node_count(); ++n) {
     const Eigen::Vector3d moved(projected_[3 * n] - free_positions_[3 * n],
@@ -321,6 +327,7 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   update_compliance(report.refactorised);
   update_free_centres();
   projection_ = {};
+  tool_reaction_n_ = tool_force_n_;  // project() adds the tool projection's push
   if (obstacles_ || volume_floor_ || (contacts != nullptr && !contacts->contacts.empty())) {
     project(contacts);
   }

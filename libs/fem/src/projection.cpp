@@ -27,7 +27,7 @@ bool contact_is_projected(const Contact& contact, const ProjectionSettings& sett
 
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
                         std::span<const double> inverse_mass_per_node, const Eigen::Vector3d& dc_m,
-                        std::span<double> positions_m) {
+                        std::span<double> positions_m, Eigen::Vector3d* push_kg_m) {
   const auto nodes = links.nodes(sphere);
   const auto weights = links.weights(sphere);
   double denominator = 0.0;  // sum_j w_j^2 / m_j, 1/kg
@@ -36,6 +36,7 @@ bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
   }
   if (!(denominator > 0.0)) return false;
   const Eigen::Vector3d scaled = dc_m / denominator;
+  if (push_kg_m != nullptr) *push_kg_m += scaled;
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     const double share = weights[k] * inverse_mass_per_node[nodes[k]];
     Eigen::Map<Eigen::Vector3d>(positions_m.data() + 3 * std::size_t{nodes[k]}) += share * scaled;
@@ -80,7 +81,9 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
         if (gap >= 0.0) continue;  // inequality satisfied: no correction
         dc = -gap * n;
       }
-      if (!move_sphere_centre(contact.sphere_id, links, inverse_mass_per_node, dc, positions_m)) {
+      Eigen::Vector3d* push = contact.kind == ContactKind::kTool ? &report.tool_push_kg_m : nullptr;
+      if (!move_sphere_centre(contact.sphere_id, links, inverse_mass_per_node, dc, positions_m,
+                              push)) {
         ++report.unmovable;
         continue;
       }

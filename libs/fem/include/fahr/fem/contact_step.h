@@ -116,6 +116,12 @@ class ContactStep {
   // Positions after the implicit step, before the projection (3 per node, m).
   std::span<const double> free_positions_m() const { return free_positions_; }
   const ProjectionReport& projection() const { return projection_; }
+  // The newest step's push on the tissue from the tool, N: the tool and
+  // force-only contacts' applied forces plus the tool projection's moves
+  // over h^2 (projection().tool_push_kg_m / h^2). Its length is the
+  // reaction on the held tool as the FEM sees it, whatever the haptic side
+  // meant to send.
+  Eigen::Vector3d tool_reaction_n() const { return tool_reaction_n_; }
   // Steps that reused the previous block, and blocks solved.
   std::uint64_t compliance_reuses() const { return compliance_reuses_; }
   std::uint64_t compliance_solves() const { return compliance_solves_; }
@@ -160,6 +166,8 @@ class ContactStep {
   std::unique_ptr<ObstacleSupport> supports_;  // with obstacles_ and a ratio > 0
   std::unique_ptr<VolumeFloor> volume_floor_;  // with a floor ratio > 0
   ProjectionReport projection_;
+  Eigen::Vector3d tool_force_n_ = Eigen::Vector3d::Zero();  // this step's applied tool forces
+  Eigen::Vector3d tool_reaction_n_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace fahr::fem

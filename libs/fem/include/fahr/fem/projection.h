@@ -2,6 +2,7 @@
 // constraints are projected on positions by Gauss-Seidel, in the given order.
 #pragma once
 
+#include <Eigen/Core>
 #include <span>
 
 #include "fahr/fem/contact_set.h"
@@ -47,6 +48,10 @@ struct ProjectionReport {
   // found below it, and those its last pass left below.
   int volume_floor_below = 0;
   int volume_floor_unresolved = 0;
+  // The tool constraints' moves, each sphere's centre correction dc over
+  // J M^-1 J^T (its impulse times h, kg m), summed over sweeps and rounds:
+  // divided by h^2, the force the projection put on the tissue.
+  Eigen::Vector3d tool_push_kg_m = Eigen::Vector3d::Zero();
 };
 
 // Whether the contact is projected, and how. Obstacles are always hard: a
@@ -69,9 +74,10 @@ ProjectionReport project_contacts(const ContactSet& contacts, const SphereLinks&
                                   std::span<const double> step_start_m);
 
 // The correction of one sphere, exposed for tests: returns false if all of
-// its nodes are fixed (nothing can move).
+// its nodes are fixed (nothing can move). With `push_kg_m`, adds the move's
+// mass-weighted size dc / (J M^-1 J^T) to it.
 bool move_sphere_centre(std::size_t sphere, const SphereLinks& links,
                         std::span<const double> inverse_mass_per_node, const Eigen::Vector3d& dc_m,
-                        std::span<double> positions_m);
+                        std::span<double> positions_m, Eigen::Vector3d* push_kg_m = nullptr);
 
 }  // namespace fahr::fem
