@@ -23,7 +23,8 @@
 // the tool's contacts.
 //
 // --check: exit 1 unless the force-aware run meets the targets
-// (no NaN, no inverted tet, the tool's push on the tissue as the FEM
+// (no NaN, no inverted tet, the device lost track for at least 4 s of the
+// 5 s hold, the tool's push on the tissue as the FEM
 // applied it within the limit + 5 % while lost track, the tissue reaching
 // at most 0.5 mm deeper into the held blade than when it froze, no strain
 // growth from 1x to 3x, the published gap equal to
@@ -661,7 +662,10 @@ int main(int argc, char** argv) {
     expect(fa.finite && fa.divergence_resets == 0,
            "force-aware: every force and gap finite, no FEM step diverged");
     expect(fa.max_inverted == 0, "force-aware: no inverted tet");
-    expect(fa.lost_ticks > 0, "force-aware: the hand pushed past the limit (lost track)");
+    // The hold is 5 s (kHoldEndS); the figure is the paper's regime only if
+    // the device was lost for most of it.
+    expect(fa.lost_ticks >= 4000,
+           "force-aware: the device lost track for at least 4 s (the hold is 5 s)");
     expect(fa.max_fem_reaction_lost_ratio <= 1.05,
            "force-aware: the tool's push on the tissue (FEM side) <= 1.05 x limit while lost "
            "track");
