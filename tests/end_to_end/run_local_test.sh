@@ -14,7 +14,7 @@ trap 'rm -f "$out"' EXIT
 # run_local.sh enters a namespace itself as root; the flag says this one
 # already is, so the test's bound (FAHR_NETNS_TIMEOUT) covers the whole run.
 status=0
-FAHR_NETNS_TIMEOUT=55 FAHR_RUN_LOCAL_IN_NETNS=1 \
+FAHR_NETNS_TIMEOUT=100 FAHR_RUN_LOCAL_IN_NETNS=1 \
   "$repo/tests/run_in_netns.sh" bash "$repo/deployment/run_local.sh" "$build" \
   --dds cyclonedds --domain 77 --duration-s 8 >"$out" 2>&1 || status=$?
 cat "$out"
