@@ -344,7 +344,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
   bool seen_1x = false, was_lost = false, reengaged = false, left = false;
   std::uint64_t reengaged_step = 0, left_step = 0;
   Eigen::Vector3d freeze_proxy = Eigen::Vector3d::Zero(), previous_force = Eigen::Vector3d::Zero();
-  double depth_at_freeze_m = -1.0;  // < 0: not measured yet in this lost-track spell
+  double depth_at_freeze_m = 0.0;  // set when a lost-track spell begins
   Eigen::Vector3d previous_hand = Eigen::Vector3d::Zero(),
                   previous_hand_v = Eigen::Vector3d::Zero();
   const auto steps = static_cast<std::uint64_t>((kScriptEndS + 1.5) * 1000.0);

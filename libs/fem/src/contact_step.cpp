@@ -301,7 +301,6 @@ void ContactStep::project(const ContactSet* contacts) {
   std::copy(free_positions_.begin(), free_positions_.end(), projected_.begin());
   alternate_with_anatomy(contacts);
   const double h2 = body_.time_step_s() * body_.time_step_s();
-  tool_reaction_n_ = tool_force_n_ + projection_.tool_push_kg_m / h2;
   const auto mass = body_.mass_kg();
   for (std::size_t n = 0; n < body_.node_count(); ++n) {
     const Eigen::Vector3d moved(projected_[3 * n] - free_positions_[3 * n],
@@ -327,10 +326,11 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   update_compliance(report.refactorised);
   update_free_centres();
   projection_ = {};
-  tool_reaction_n_ = tool_force_n_;  // project() adds the tool projection's push
   if (obstacles_ || volume_floor_ || (contacts != nullptr && !contacts->contacts.empty())) {
     project(contacts);
   }
+  const double h = body_.time_step_s();
+  tool_reaction_n_ = tool_force_n_ + projection_.tool_push_kg_m / (h * h);
   if (supports_ && supports_->update(*obstacles_, start_positions_, free_positions_)) {
     body_.set_supports(supports_->supports(), obstacles_->settings().support_stiffness_ratio);
   }
