@@ -27,7 +27,6 @@
 // the shadow's current state, for the leading 1, 8, 32 and 64 spheres; the
 // largest and RMS difference of the force sent to the device (N); the most
 // inverted tets.
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -39,6 +38,7 @@
 #include <vector>
 
 #include "fahr/bench_support/results_file.h"
+#include "fahr/cli/cli.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/solver_threads.h"
@@ -310,21 +310,21 @@ int main(int argc, char** argv) try {
   fahr::common::run_solver_libraries_on_one_thread(argv);
   using namespace fahr;
   bench_support::MarkdownResults markdown(argc, argv);
-  CLI::App app{
+  fahr::cli::App app{
       "FEM solvers on the pressed neonatal tongue against the exact step, in the whole loop"};
   app.footer(bench_support::kMarkdownHelp);
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
   double seconds = 8.0;
   std::string config_list = "shipped,lagged,pcg-it8";
   app.add_option("--scene", scene_path, "scene file");
-  app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
+  app.add_option("--seconds", seconds, "simulated time, s")->check(fahr::cli::Range(0.001, 3600.0));
   bool no_reference = false;
   app.add_flag("--no-reference", no_reference,
                "do not add the exact run: the first configuration listed is the reference "
                "(profiling one configuration)");
   std::string script = "intubation";
   app.add_option("--script", script, "the simulated hand's script (overshoot: to 3x the limit)")
-      ->check(CLI::IsMember({"intubation", "overshoot"}));
+      ->check(fahr::cli::IsMember({"intubation", "overshoot"}));
   double support_ratio = -1.0;
   app.add_option("--support-ratio", support_ratio,
                  "the FEM's anatomy support springs over the node's diagonal of A (0: off); "
@@ -332,7 +332,7 @@ int main(int argc, char** argv) try {
   app.add_option("--configs", config_list,
                  "comma-separated: exact, shipped, lagged, pcg-rot, pcg-rest, pcg-itN (the exact "
                  "run is always made)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     markdown.begin("fem-tongue-press");

@@ -30,7 +30,6 @@
 // growth from 1x to 3x, the published gap equal to
 // (commanded - limit) / K_c, the re-engagement force step within the
 // bound, the tongue within 1 mm of rest 1 s after the blade leaves it).
-#include <CLI/CLI.hpp>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -43,6 +42,7 @@
 #include <vector>
 
 #include "fahr/bench_support/results_file.h"
+#include "fahr/cli/cli.h"
 #include "fahr/common/solver_threads.h"
 #include "fahr/common/wire_eigen.h"
 #include "fahr/fem/strain.h"
@@ -511,7 +511,7 @@ Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunCho
 int main(int argc, char** argv) {
   fahr::common::run_solver_libraries_on_one_thread(argv);
   fahr::bench_support::MarkdownResults results(argc, argv);
-  CLI::App app{"fahr overshoot benchmark (paper Figure 7, neonatal tongue)"};
+  fahr::cli::App app{"fahr overshoot benchmark (paper Figure 7, neonatal tongue)"};
   app.footer(fahr::bench_support::kMarkdownHelp);
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
   RunChoices choices;
@@ -523,55 +523,55 @@ int main(int argc, char** argv) {
                  "no tet ends a FEM step below this share of its rest volume "
                  "(solver.volume_floor_ratio); 0: off "
                  "(default: the scene's)")
-      ->check(CLI::Range(0.0, 0.9));
+      ->check(fahr::cli::Range(0.0, 0.9));
   app.add_option(
          "--fem-anatomy-rounds", choices.fem_anatomy_rounds,
          "the FEM's tool/anatomy alternation rounds per step (libs/fem obstacle_projection.h "
          "max_rounds); default the FEM's")
-      ->check(CLI::Range(1, 1000));
+      ->check(fahr::cli::Range(1, 1000));
   app.add_option("--response", response, "which response to run")
-      ->check(CLI::IsMember({"both", "force-aware", "penalty"}));
+      ->check(fahr::cli::IsMember({"both", "force-aware", "penalty"}));
   app.add_option("--fem-anatomy", fem_anatomy,
                  "the FEM keeps its nodes out of the anatomy itself; off: the haptic side finds "
                  "the tongue's obstacle contacts (a comparison)")
-      ->check(CLI::IsMember({"on", "off"}));
+      ->check(fahr::cli::IsMember({"on", "off"}));
   app.add_option(
          "--fem-support", choices.support_ratio,
          "the FEM's anatomy support springs, stiffness over the node's diagonal of A; 0: off "
          "(default: the service's)")
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(fahr::cli::Range(0.0, 1e6));
   app.add_option("--tool-stops", choices.tool_stops,
                  "the tool stops at the rigid anatomy (default: as the scene says)")
-      ->check(CLI::IsMember({"scene", "on", "off"}));
+      ->check(fahr::cli::IsMember({"scene", "on", "off"}));
   app.add_option("--youngs-pa", choices.youngs_pa,
                  "overrides the deformable body's Young's modulus, Pa (default: the scene's)")
-      ->check(CLI::Range(1.0, 1e9));
+      ->check(fahr::cli::Range(1.0, 1e9));
   app.add_option("--stiffening", choices.stiffening,
                  "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(fahr::cli::Range(0.0, 100.0));
   app.add_option("--trace", choices.trace_path, "per-FEM-step CSV, FILE.<response>.csv");
   app.add_option("--tick-trace", choices.tick_trace_path,
                  "per-tick CSV (force, hand, proxy, gap), FILE.<response>.csv");
   app.add_option("--factor", choices.factor,
                  "overshoot: the hand's pull as a multiple of the device's peak force")
-      ->check(CLI::Range(1.0, 10.0));
+      ->check(fahr::cli::Range(1.0, 10.0));
   app.add_option("--held-proxy", choices.held_proxy,
                  "while the device has lost track: load (stay, the tissue held by the limited "
                  "load, force only) or stay (stay, the spheres frozen: the paper's c' = c), the "
                  "scene's contact.held_proxy; limit (a comparison: back off to keep the tissue "
                  "at the limit); default the scene's")
-      ->check(CLI::IsMember({"scene", "load", "stay", "limit"}));
+      ->check(fahr::cli::IsMember({"scene", "load", "stay", "limit"}));
   app.add_option("--candidate-margin-mm", choices.candidate_margin_mm,
                  "the haptic tick's candidate margin (HapticSetup::candidate_margin_m), mm; "
                  "default the service's 1")
-      ->check(CLI::Range(0.0, 5.0));
+      ->check(fahr::cli::Range(0.0, 5.0));
   app.add_option("--w-normals", choices.w_normals,
                  "W along the normals for this many spheres (the scene's "
                  "solver.compliance_columns: normals and "
                  "max_candidate_contacts); 0: the scene's")
-      ->check(CLI::Range(0, 64));
+      ->check(fahr::cli::Range(0, 64));
   app.add_flag("--check", check, "exit 1 unless the force-aware run meets the targets");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     results.begin("overshoot");

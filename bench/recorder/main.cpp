@@ -20,7 +20,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -33,6 +32,7 @@
 #include <vector>
 
 #include "fahr/bench_support/results_file.h"
+#include "fahr/cli/cli.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/service_reporter.h"
@@ -384,7 +384,7 @@ int run(int argc, char** argv) {
                    cases[std::stoi(argv[4])], std::stod(argv[5]));
   }
   bench_support::MarkdownResults results(argc, argv);
-  CLI::App app{"fahr_bench_recorder: MCAP writer and recorder throughput"};
+  fahr::cli::App app{"fahr_bench_recorder: MCAP writer and recorder throughput"};
   bool writer = false, dds = false;
   double seconds = 3;
   std::string dir = fs::temp_directory_path().string();
@@ -405,7 +405,7 @@ int run(int argc, char** argv) {
   int logger_cpu = -1;
   app.add_option("--logger-cpu", logger_cpu, "pin the logger to this CPU (for --overhead-s)");
   app.footer(bench_support::kMarkdownHelp);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   if (overhead_s > 0) {
     results.begin("recorder-overhead");
     return bench_overhead(vendor, domain, overhead_s, window_s, logger, dir, logger_cpu);

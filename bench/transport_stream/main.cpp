@@ -17,7 +17,6 @@
 // reader's clock, one host) and the longest gap between arrivals.
 #include <time.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -29,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/participant.h"
 #include "fahr/common/publisher.h"
@@ -164,7 +164,7 @@ int measure(const std::string& role, double seconds,
 int main(int argc, char** argv) {
   using namespace fahr;
   using namespace fahr::bench;
-  CLI::App app{"fahr_transport_stream: the station's streams at their rates"};
+  fahr::cli::App app{"fahr_transport_stream: the station's streams at their rates"};
   std::string role;
   std::string dds;
   std::string domain;
@@ -181,7 +181,7 @@ int main(int argc, char** argv) {
   app.add_option("--state-kb", state_kb, "DeformationState size, KiB");
   app.add_option("--state-hz", state_hz, "DeformationState rate");
   app.add_option("--contacts", contacts, "contacts per ContactSet");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   if (role != "gateway" && role != "haptic" && role != "fem") {
     std::fprintf(stderr, "fahr_transport_stream: --role must be gateway, haptic or fem\n");
     return 2;

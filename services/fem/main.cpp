@@ -6,10 +6,10 @@
 //
 //   fahr_fem_service --scene FILE [--dds V] [--domain N] [--dds-profile F]
 //                    [--duration-s S] [--mode realtime|lockstep] [--cpus LIST]
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/solver_threads.h"
 #include "fahr/common/stop_signal.h"
@@ -27,10 +27,10 @@ namespace fahr::fem_service {
 int run(int argc, char** argv) {
   using namespace std::chrono_literals;
   // Options.
-  CLI::App app{"fahr FEM deformation service"};
+  fahr::cli::App app{"fahr FEM deformation service"};
   runtime::ServiceOptions options;
   runtime::add_service_options(app, options);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   runtime::pin_to_cpus(options.cpus);
 
   // Set-up: the scene's deformable body, the transport, the status reporter.

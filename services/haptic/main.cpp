@@ -8,12 +8,12 @@
 //   fahr_haptic_service --scene FILE [--dds V] [--domain N] [--dds-profile F]
 //                       [--duration-s S] [--mode realtime|lockstep] [--collision aist|triangle]
 //                       [--spin] [--rt-priority N] [--cpus LIST]
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <memory>
 #include <string>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/service_reporter.h"
 #include "fahr/common/stop_signal.h"
@@ -36,7 +36,7 @@ using namespace std::chrono_literals;
 
 int run(int argc, char** argv) {
   // Options.
-  CLI::App app{"fahr haptic/contact service"};
+  fahr::cli::App app{"fahr haptic/contact service"};
   runtime::ServiceOptions options;
   runtime::add_service_options(app, options);
   WaitPolicy wait;
@@ -45,13 +45,13 @@ int run(int argc, char** argv) {
   app.add_option("--rt-priority", wait.rt_priority,
                  "real time: SCHED_FIFO priority 1-99 for the tick thread (needs CAP_SYS_NICE; "
                  "refused gracefully)")
-      ->check(CLI::Range(0, 99));
+      ->check(fahr::cli::Range(0, 99));
   std::string collision = "aist";
   app.add_option("--collision", collision,
                  "tool-tissue collision: aist (the paper's spheres) or triangle (the baseline it "
                  "is measured against)")
-      ->check(CLI::IsMember({"aist", "triangle"}));
-  CLI11_PARSE(app, argc, argv);
+      ->check(fahr::cli::IsMember({"aist", "triangle"}));
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   runtime::pin_to_cpus(options.cpus);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // log lines reach a launcher's log file as they happen
 

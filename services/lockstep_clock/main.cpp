@@ -14,7 +14,6 @@
 //
 // Exit status: 0 when every step was granted and completed, 1 on a stall
 // (a participant made no progress within the timeout), 2 on bad flags.
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -22,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/config_error.h"
 #include "fahr/common/lockstep.h"
 #include "fahr/common/participant.h"
@@ -31,7 +31,7 @@ namespace {
 
 int run(int argc, char** argv) {
   using namespace fahr;
-  CLI::App app{"fahr lockstep coordinator"};
+  fahr::cli::App app{"fahr lockstep coordinator"};
   std::string participants_csv, dds, domain, profile;
   std::uint64_t steps = 0;
   double base_period_ms = 1.0;
@@ -40,14 +40,16 @@ int run(int argc, char** argv) {
   app.add_option("--participants", participants_csv,
                  "comma-separated lockstep names (device_gateway, fem, haptic)")
       ->required();
-  app.add_option("--steps", steps, "base steps to grant")->required()->check(CLI::PositiveNumber);
+  app.add_option("--steps", steps, "base steps to grant")
+      ->required()
+      ->check(fahr::cli::PositiveNumber);
   app.add_option("--base-period-ms", base_period_ms, "simulated time of one base step, ms")
-      ->check(CLI::PositiveNumber);
+      ->check(fahr::cli::PositiveNumber);
   app.add_option("--stall-timeout-s", stall_timeout_s, "fail when nothing progresses this long")
-      ->check(CLI::PositiveNumber);
+      ->check(fahr::cli::PositiveNumber);
   app.add_option("--pace", pace,
                  "at most this many simulated seconds per wall second (default: unpaced)")
-      ->check(CLI::PositiveNumber);
+      ->check(fahr::cli::PositiveNumber);
   app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds, inprocess");
   app.add_option("--domain", domain, "DDS domain id 0-230");
   app.add_option("--dds-profile", profile, "vendor XML configuration");
@@ -55,7 +57,7 @@ int run(int argc, char** argv) {
   app.add_option("--security", security,
                  "DDS Security: the station's folder "
                  "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
 
   std::vector<std::string> names;

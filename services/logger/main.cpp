@@ -10,7 +10,6 @@
 //               [--decimate TOPIC=N]... [--scene FILE]
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -19,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/logger_service/recorder.h"
@@ -51,7 +51,7 @@ void print_table(const Recorder& recorder) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_logger: record every fahr topic to MCAP"};
+  fahr::cli::App app{"fahr_logger: record every fahr topic to MCAP"};
   RecorderOptions options;
   options.path = default_name();
   std::string dds, domain, profile, scene, compression = "zstd";
@@ -74,14 +74,14 @@ int run(int argc, char** argv) {
                  "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   app.add_option("--duration-s", duration_s, "stop after this long (0: at SIGINT/SIGTERM)");
   app.add_option("--compression", compression, "chunk compression")
-      ->check(CLI::IsMember({"zstd", "lz4", "none"}));
-  app.add_option("--chunk-kib", chunk_kib, "chunk size, KiB")->check(CLI::Range(1, 1 << 20));
+      ->check(fahr::cli::IsMember({"zstd", "lz4", "none"}));
+  app.add_option("--chunk-kib", chunk_kib, "chunk size, KiB")->check(fahr::cli::Range(1, 1 << 20));
   app.add_option("--split-mib", split_mib, "start a new file past this size, MiB (0: never)");
   app.add_option("--split-s", split_s, "start a new file after this long, s (0: never)");
   app.add_option("--queue-mib", queue_mib,
                  "queue to the writer thread, MiB; beyond it samples "
                  "are dropped and counted")
-      ->check(CLI::Range(1, 1 << 16));
+      ->check(fahr::cli::Range(1, 1 << 16));
   app.add_flag("--no-fsync", no_fsync,
                "do not fdatasync each chunk (faster; a power loss may "
                "lose more than the open chunk)");
@@ -90,14 +90,14 @@ int run(int argc, char** argv) {
                  "fahr/DeformationState=10); the rest count as skipped");
   app.add_option("--writer-nice", writer_nice,
                  "nice value of the writer thread (compression, disk): >0 yields to the services")
-      ->check(CLI::Range(-20, 19));
+      ->check(fahr::cli::Range(-20, 19));
   app.add_flag("--lockstep", lockstep,
                "a lockstep run: read the streams reliably (the services write them reliable and "
                "transient local)");
   app.add_option("--scene", scene, "scene file: its text goes into the recording's metadata");
   app.add_option("--writer-delay-us", writer_delay_us,
                  "testing: the writer thread sleeps this long per message (forces queue drops)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
 
   options.mcap.compression = compression == "none" ? "" : compression;
   options.mcap.chunk_size = chunk_kib * 1024;

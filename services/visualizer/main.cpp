@@ -13,7 +13,6 @@
 // fahr/RemoteInput, which the gateway reads with --backend remote. With the
 // scene's glottic_view section it scores the glottic view (POGO) and
 // publishes fahr/GlotticView.
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -21,6 +20,7 @@
 #include <string>
 #include <thread>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/scene/load_scene.h"
@@ -32,7 +32,7 @@ namespace fahr::visualizer_service {
 namespace {
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_visualizer: the run in a browser, live or replayed; Foxglove WebSocket"};
+  fahr::cli::App app{"fahr_visualizer: the run in a browser, live or replayed; Foxglove WebSocket"};
   ServerOptions options;
   options.web_root = FAHR_VISUALIZER_WEB_ROOT;
   std::string dds, domain, profile, replay_path;
@@ -50,18 +50,18 @@ int run(int argc, char** argv) {
   app.add_option("--address", options.address, "address to listen on (default 127.0.0.1)");
   app.add_option("--port", options.port, "port (default 8765; 0: any free port)");
   app.add_option("--rate-hz", options.rate_hz, "most frames per second per client")
-      ->check(CLI::Range(1.0, 240.0));
+      ->check(fahr::cli::Range(1.0, 240.0));
   app.add_option("--client-buffer-kib", buffer_kib,
                  "a client's send queue; beyond it its oldest frame is dropped")
-      ->check(CLI::Range(16, 1 << 20));
+      ->check(fahr::cli::Range(16, 1 << 20));
   app.add_option("--scene", scene_path, "scene file: the rigid bodies' meshes");
   app.add_option("--replay", replay_path, "replay this MCAP recording instead of a live run");
-  app.add_option("--speed", speed, "replay speed (0.05-4)")->check(CLI::Range(0.05, 4.0));
+  app.add_option("--speed", speed, "replay speed (0.05-4)")->check(fahr::cli::Range(0.05, 4.0));
   app.add_flag("--allow-remote-input", options.allow_remote_input,
                "accept the page's mouse device and Foxglove publishing on fahr/RemoteInput");
   app.add_option("--duration-s", duration_s, "stop after this long (0: at SIGINT/SIGTERM)");
   app.add_option("--web-root", options.web_root, "the built page's folder");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   options.client_buffer_bytes = buffer_kib << 10;
 
   std::shared_ptr<const scene::Scene> scene;

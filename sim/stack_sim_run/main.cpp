@@ -11,7 +11,6 @@
 // (libs/fem compression_stiffening.h; 0: off), instead of the scene's.
 // --w-normals N: W along the ContactSet's normals for N spheres (the
 // scene's solver.compliance_columns: normals), with rows by free depth.
-#include <CLI/CLI.hpp>
 #include <Eigen/Core>
 #include <algorithm>
 #include <chrono>
@@ -21,6 +20,7 @@
 #include <memory>
 #include <vector>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/solver_threads.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
@@ -29,33 +29,33 @@
 int main(int argc, char** argv) try {
   fahr::common::run_solver_libraries_on_one_thread(argv);
   using namespace fahr;
-  CLI::App app{"fahr in-process lockstep run"};
+  fahr::cli::App app{"fahr in-process lockstep run"};
   std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
   std::string script = "intubation";
   double seconds = 4.0;
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--script", script, "the simulated hand's script")
-      ->check(CLI::IsMember({"intubation", "overshoot"}));
+      ->check(fahr::cli::IsMember({"intubation", "overshoot"}));
   std::string collision = "aist";
   app.add_option("--collision", collision, "the haptic service's collision method")
-      ->check(CLI::IsMember({"aist", "triangle"}));
+      ->check(fahr::cli::IsMember({"aist", "triangle"}));
   double stiffening = -1.0;
   app.add_option("--stiffening", stiffening,
                  "the tongue's compression stiffening, Yeoh C20/C10; 0: off (default: the scene's)")
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(fahr::cli::Range(0.0, 100.0));
   double volume_floor = -1.0;
   app.add_option("--volume-floor", volume_floor,
                  "no tet ends a FEM step below this share of its rest volume "
                  "(solver.volume_floor_ratio); 0: off "
                  "(default: the scene's)")
-      ->check(CLI::Range(0.0, 0.9));
+      ->check(fahr::cli::Range(0.0, 0.9));
   int w_normals = 0;
   app.add_option("--w-normals", w_normals,
                  "W along the normals for this many spheres (solver.compliance_columns: normals, "
                  "max_candidate_contacts); 0: the scene's")
-      ->check(CLI::Range(0, 64));
-  app.add_option("--seconds", seconds, "simulated time, s")->check(CLI::Range(0.001, 3600.0));
-  CLI11_PARSE(app, argc, argv);
+      ->check(fahr::cli::Range(0, 64));
+  app.add_option("--seconds", seconds, "simulated time, s")->check(fahr::cli::Range(0.001, 3600.0));
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     stack_sim::StackOptions options;

@@ -4,9 +4,10 @@
 # fahr_lockstep_clock, 4 s of simulated time (the blade enters the mouth and
 # touches the tongue), run on Fast DDS and on Cyclone DDS. Every service's
 # output hash must be the same on both: the runs are identical bit for bit,
-# whatever the vendor and the load, so lockstep runs are reproducible. The
-# same run in one process (fahr_stack_sim_run: the services' step code
-# without transport) must give the same hashes too. Then once more with W
+# whatever the vendor and the load, so lockstep runs are reproducible. They
+# must be the pinned hashes of the same run in one process
+# (tests/determinism: fahr_stack_sim_run, the services' step code without
+# transport), which stack_sim_pinned_hashes checks. Then once more with W
 # along the normals (solver.compliance_columns: normals, 64 spheres, whose
 # columns and normals cross DDS in DeformationState.compliance_normals),
 # on Cyclone DDS against the same in one process.
@@ -18,7 +19,8 @@
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 build="${1:?usage: stack_lockstep_test.sh BUILD_DIR}"
-export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+# The BLAS kernel and threads the pinned hashes were recorded with.
+export OPENBLAS_CORETYPE=Haswell OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 tmp=$(mktemp -d /tmp/fahr-stack-lockstep-XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
 
@@ -44,10 +46,8 @@ if ! diff "$tmp/cyclonedds.hashes" "$tmp/fastdds.hashes"; then
   echo "FAIL: the two vendors' lockstep runs differ"
   exit 1
 fi
-"$build/sim/stack_sim_run/fahr_stack_sim_run" --seconds 4 | tee "$tmp/inprocess.txt"
-grep "^lockstep_clock: hash" "$tmp/inprocess.txt" | sort >"$tmp/inprocess.hashes"
-if ! diff "$tmp/cyclonedds.hashes" "$tmp/inprocess.hashes"; then
-  echo "FAIL: the in-process run differs from the DDS runs"
+if ! diff "$tmp/cyclonedds.hashes" "$repo/tests/determinism/neonatal_4s.hashes"; then
+  echo "FAIL: the DDS runs differ from the pinned in-process hashes (tests/determinism)"
   exit 1
 fi
 # The haptic service answered with contact: the blade reached the tongue.
@@ -72,4 +72,4 @@ if diff -q "$tmp/blocks.hashes" "$tmp/cyclonedds.hashes" >/dev/null; then
   echo "FAIL: W along the normals gave the same hashes as the 3x3 blocks"
   exit 1
 fi
-echo "PASS: identical hashes on both vendors and in one process, with W as blocks and along the normals"
+echo "PASS: identical hashes on both vendors and the pinned in-process ones, with W as blocks and along the normals"

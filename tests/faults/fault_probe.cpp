@@ -9,7 +9,6 @@
 //
 // The DevicePose's rendered force is what the device got on that servo
 // tick, so consecutive servo ticks give the force step per tick.
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -18,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/common/subscriber.h"
@@ -39,7 +39,7 @@ struct Line {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"fault_test's listener: DevicePose and ForceCommand, one line each"};
+  fahr::cli::App app{"fault_test's listener: DevicePose and ForceCommand, one line each"};
   std::string dds, domain, out_path;
   double duration_s = 10;
   app.add_option("--duration-s", duration_s, "how long to listen");
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
                  "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
   bool with_states = false;
   app.add_flag("--states", with_states, "also a line per DeformationState");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   common::Participant participant(
       common::transport_config_from(dds, domain, "", "fault_probe", security));
   std::mutex mutex;

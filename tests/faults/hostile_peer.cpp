@@ -18,7 +18,6 @@
 // compare the station's rates with and without it, interleaved.
 //
 //   hostile_peer --seconds S [--dds V] [--domain N] [--rate-hz R] [--on-off-s T]
-#include <CLI/CLI.hpp>
 #include <array>
 #include <chrono>
 #include <cstdint>
@@ -29,6 +28,7 @@
 #include <string>
 #include <thread>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/participant.h"
 #include "fahr/common/publisher.h"
@@ -67,7 +67,7 @@ constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"a participant that sends hostile samples on the station's streams"};
+  fahr::cli::App app{"a participant that sends hostile samples on the station's streams"};
   std::string dds, domain;
   double seconds = 5, rate_hz = 0;
   app.add_option("--seconds", seconds, "how long");
@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
   app.add_option("--rate-hz", rate_hz, "samples per second in all (0: as fast as it can)");
   double on_off_s = 0;
   app.add_option("--on-off-s", on_off_s, "flood this long, rest this long, and so on (0: always)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     common::Participant participant(common::transport_config_from(dds, domain, "", "hostile_peer"));

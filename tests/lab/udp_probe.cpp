@@ -16,7 +16,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
@@ -25,6 +24,8 @@
 #include <exception>
 #include <string>
 #include <vector>
+
+#include "fahr/cli/cli.h"
 
 namespace fahr::lab_probe {
 namespace {
@@ -164,7 +165,7 @@ int receive_probe(int port, std::uint64_t count, std::size_t size, double timeou
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_udp_probe: one-way delay and loss between two namespaces"};
+  fahr::cli::App app{"fahr_udp_probe: one-way delay and loss between two namespaces"};
   app.require_subcommand(1);
   std::string address;
   int port = 0;
@@ -173,16 +174,16 @@ int run(int argc, char** argv) {
   std::size_t size = 200;
   auto* send = app.add_subcommand("send", "send stamped datagrams");
   send->add_option("address", address, "IPv4 address")->required();
-  send->add_option("port", port, "UDP port")->required()->check(CLI::Range(1, 65535));
+  send->add_option("port", port, "UDP port")->required()->check(fahr::cli::Range(1, 65535));
   send->add_option("--count", count, "datagrams");
-  send->add_option("--rate-hz", rate_hz, "datagrams a second")->check(CLI::Range(1.0, 1e5));
-  send->add_option("--size", size, "bytes each")->check(CLI::Range(24, 65000));
+  send->add_option("--rate-hz", rate_hz, "datagrams a second")->check(fahr::cli::Range(1.0, 1e5));
+  send->add_option("--size", size, "bytes each")->check(fahr::cli::Range(24, 65000));
   auto* receive = app.add_subcommand("receive", "receive and measure");
-  receive->add_option("port", port, "UDP port")->required()->check(CLI::Range(1, 65535));
+  receive->add_option("port", port, "UDP port")->required()->check(fahr::cli::Range(1, 65535));
   receive->add_option("--count", count, "datagrams expected");
-  receive->add_option("--size", size, "bytes each")->check(CLI::Range(24, 65000));
+  receive->add_option("--size", size, "bytes each")->check(fahr::cli::Range(24, 65000));
   receive->add_option("--timeout-s", timeout_s, "end after this long without a datagram");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   if (send->parsed()) return send_probe(address, port, count, rate_hz, size);
   return receive_probe(port, count, size, timeout_s);
 }

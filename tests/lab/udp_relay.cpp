@@ -34,7 +34,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <array>
 #include <atomic>
 #include <cerrno>
@@ -49,6 +48,7 @@
 #include <string>
 #include <vector>
 
+#include "fahr/cli/cli.h"
 #include "fahr/metrics/duration_histogram.h"
 
 namespace fahr::lab_relay {
@@ -258,7 +258,7 @@ bool parse_model(const std::string& text, LinkModel& m, std::string& error) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_udp_relay: a switch between network namespaces that delays and drops"};
+  fahr::cli::App app{"fahr_udp_relay: a switch between network namespaces that delays and drops"};
   std::vector<std::string> port_specs, link_specs;
   std::uint64_t seed = 1;
   int rt_priority = 0;
@@ -268,9 +268,10 @@ int run(int argc, char** argv) {
                  "A-B:delay_ms=..,jitter_ms=..,jitter=uniform|normal,loss=..");
   app.add_option("--seed", seed, "seed of every link's generator");
   app.add_option("--rt-priority", rt_priority, "SCHED_FIFO priority (0: none)")
-      ->check(CLI::Range(0, 99));
-  app.add_option("--capacity", capacity, "frames held at once")->check(CLI::Range(64, 1 << 20));
-  CLI11_PARSE(app, argc, argv);
+      ->check(fahr::cli::Range(0, 99));
+  app.add_option("--capacity", capacity, "frames held at once")
+      ->check(fahr::cli::Range(64, 1 << 20));
+  if (const auto exit = app.parse(argc, argv)) return *exit;
 
   std::vector<Port> ports;
   std::map<std::string, int> by_name;

@@ -11,7 +11,6 @@
 //   participant would send), and prints "command: writer <id> wrote N,
 //   matched readers M" — or "command: refused: <why>" when its participant
 //   or writer is not allowed to exist.
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -24,23 +23,24 @@
 #include <string>
 #include <thread>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/publisher.h"
 #include "fahr/common/subscriber.h"
 
 int main(int argc, char** argv) {
   using namespace fahr;
-  CLI::App app{"a participant of the DDS Security tests"};
+  fahr::cli::App app{"a participant of the DDS Security tests"};
   std::string mode, dds, domain, security, identity;
   double seconds = 5;
   app.add_option("mode", mode, "listen or command")
       ->required()
-      ->check(CLI::IsMember({"listen", "command"}));
+      ->check(fahr::cli::IsMember({"listen", "command"}));
   app.add_option("--seconds", seconds, "how long");
   app.add_option("--dds", dds, "DDS vendor");
   app.add_option("--domain", domain, "DDS domain id");
   app.add_option("--security", security, "the station's security folder");
   app.add_option("--identity", identity, "identity in that folder (default: the mode's name)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   try {

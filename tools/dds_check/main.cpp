@@ -11,7 +11,6 @@
 // participant joining a running station: "every reader matched in S s")
 // and, after --listen-s, the writers matched and samples received: zero
 // when the probe sits in another station's partition on the same domain.
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -20,6 +19,7 @@
 #include <thread>
 #include <tuple>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/config_error.h"
 #include "fahr/common/participant.h"
 #include "fahr/common/subscriber.h"
@@ -80,7 +80,7 @@ struct StationProbe {
 
 // A function-try-block: what the set-up before the inner try throws ends in a message too.
 int main(int argc, char** argv) try {
-  CLI::App app{"Join a fahr DDS domain and report what is there"};
+  fahr::cli::App app{"Join a fahr DDS domain and report what is there"};
   std::string dds, domain, profile;
   double listen_s = 2.0;
   app.add_option("--dds", dds, "DDS vendor (default: $FAHR_DDS, else fastdds)");
@@ -94,7 +94,7 @@ int main(int argc, char** argv) try {
   bool station = false;
   app.add_flag("--station", station,
                "probe every station topic: discovery time, endpoints matched, samples");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   try {
     auto config =
         fahr::common::transport_config_from(dds, domain, profile, "fahr_dds_check", security);

@@ -22,7 +22,6 @@
 // A line per view: "view <label>: rays R % (seen/facing samples, its wall
 // time), pixels P % (seen/drawn), difference D points". Exit 0, or 1 on an
 // error (named).
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -33,6 +32,7 @@
 
 #include "contact_setPubSubTypes.h"
 #include "deformation_statePubSubTypes.h"
+#include "fahr/cli/cli.h"
 #include "fahr/common/cdr_bytes.h"
 #include "fahr/glottic_view/blade_from_contacts.h"
 #include "fahr/glottic_view/scene_view.h"
@@ -234,7 +234,7 @@ int run_recording(glottic_view::SceneGlotticView& view, const SceneMeshes& meshe
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_glottic_score: the glottic view score by lines of sight and by pixels"};
+  fahr::cli::App app{"fahr_glottic_score: the glottic view score by lines of sight and by pixels"};
   std::string scene_path = FAHR_DEFAULT_SCENE, pose_text, eye_text, around_text, png, recording,
               png_prefix;
   std::size_t samples = 1024;
@@ -250,13 +250,14 @@ int run(int argc, char** argv) {
   app.add_flag("--anatomy-only", anatomy_only,
                "only the rigid anatomy in the view: no soft body, no tool (the eye stays)");
   app.add_option("--png", png, "write the laryngoscopist's picture here");
-  app.add_option("--samples", samples, "samples on the opening")->check(CLI::Range(16, 1 << 20));
+  app.add_option("--samples", samples, "samples on the opening")
+      ->check(fahr::cli::Range(16, 1 << 20));
   app.add_option("--recording", recording, "score the FEM states of this MCAP recording");
   app.add_option("--every-ms", every_ms, "score a recording this often")
-      ->check(CLI::Range(1.0, 1e6));
+      ->check(fahr::cli::Range(1.0, 1e6));
   app.add_option("--png-prefix", png_prefix,
                  "a recording's pictures: PREFIX_rest/_pressed/_best/_last.png");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
 
   const auto scene = scene::load_scene(scene_path);
   glottic_view::SceneGlotticView view = glottic_view::glottic_view_from_scene(*scene, samples);

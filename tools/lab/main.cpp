@@ -9,10 +9,10 @@
 //
 // Exit status: 0 done; 1 failed (a service died, not running); 2 a bad lab
 // file or command line; 3 (status) running with a service down.
-#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 
+#include "fahr/cli/cli.h"
 #include "fahr/lab_plan/lab.h"
 #include "fahr/lab_plan/plan.h"
 #include "fahr/lab_plan/profiles.h"
@@ -20,7 +20,7 @@
 
 int main(int argc, char** argv) try {
   using namespace fahr::lab;
-  CLI::App app{"fahr_lab: a lab file's plan, configuration and station launcher"};
+  fahr::cli::App app{"fahr_lab: a lab file's plan, configuration and station launcher"};
   app.require_subcommand(1);
   std::string lab_file, station, host, out_dir, run_root;
   bool detach = false;
@@ -44,7 +44,7 @@ int main(int argc, char** argv) try {
   auto* status = app.add_subcommand("status", "report a station's services on this host");
   status->add_option("STATION", station, "station name")->required();
   status->add_option("--run-root", run_root, "run folders' parent (default $FAHR_RUN_ROOT)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
 
   const std::filesystem::path root =
       run_root.empty() ? default_run_root() : std::filesystem::path(run_root);

@@ -7,11 +7,11 @@
 //                             left by a killed recorder): every complete chunk
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <string>
 
+#include "fahr/cli/cli.h"
 #include "fahr/mcap/reader.h"
 
 namespace {
@@ -80,7 +80,7 @@ int recover(const std::string& path, const std::string& output) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_mcap: inspect and repair MCAP recordings"};
+  fahr::cli::App app{"fahr_mcap: inspect and repair MCAP recordings"};
   app.require_subcommand(1);
   std::string path, output;
   auto* info_cmd = app.add_subcommand("info", "what the file holds; exit 1 if not valid");
@@ -89,7 +89,7 @@ int run(int argc, char** argv) {
       app.add_subcommand("recover", "rebuild a valid file from a torn one (e.g. NAME.mcap.part)");
   recover_cmd->add_option("file", path, "torn MCAP file")->required();
   recover_cmd->add_option("-o,--output", output, "output (default: FILE without .part)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   if (info_cmd->parsed()) return info(path);
   return recover(path, output);
 }

@@ -14,7 +14,6 @@
 // writer id (the transport's stamp); seq runs 1, 2, ... as the gateway's did.
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -30,6 +29,7 @@
 #include "contact_setPubSubTypes.h"
 #include "deformation_statePubSubTypes.h"
 #include "device_posePubSubTypes.h"
+#include "fahr/cli/cli.h"
 #include "fahr/common/cdr_bytes.h"
 #include "fahr/common/clock.h"
 #include "fahr/common/lockstep.h"
@@ -149,16 +149,16 @@ int replay_lockstep(const std::string& path, common::Participant& participant) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_replay: publish a recording's samples again"};
+  fahr::cli::App app{"fahr_replay: publish a recording's samples again"};
   std::string path, mode = "realtime", topics_csv = "fahr/DevicePose", dds, domain, profile;
   double speed = 1.0;
   app.add_option("file", path, "fahr recording (MCAP)")->required();
   app.add_option("--mode", mode, "realtime (original timing) or lockstep (as the device gateway)")
-      ->check(CLI::IsMember({"realtime", "lockstep"}));
+      ->check(fahr::cli::IsMember({"realtime", "lockstep"}));
   app.add_option("--topics", topics_csv,
                  "realtime: comma-separated topics (fahr/DevicePose, fahr/ForceCommand, "
                  "fahr/ContactSet, fahr/DeformationState, fahr/SceneDescription)");
-  app.add_option("--speed", speed, "realtime: playback speed")->check(CLI::PositiveNumber);
+  app.add_option("--speed", speed, "realtime: playback speed")->check(fahr::cli::PositiveNumber);
   app.add_option("--dds", dds, "DDS vendor: fastdds, cyclonedds");
   app.add_option("--domain", domain, "DDS domain 0-230");
   app.add_option("--dds-profile", profile, "vendor XML profile");
@@ -166,7 +166,7 @@ int run(int argc, char** argv) {
   app.add_option("--security", security,
                  "DDS Security: the station's folder "
                  "(deployment/security/make_station_security.sh; default $FAHR_DDS_SECURITY)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   common::install_stop_handlers();
   common::Participant participant(

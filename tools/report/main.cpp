@@ -7,7 +7,6 @@
 //   fahr_report FILE.mcap [-o report.html]
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +18,7 @@
 #include <vector>
 
 #include "device_posePubSubTypes.h"
+#include "fahr/cli/cli.h"
 #include "fahr/common/cdr_bytes.h"
 #include "fahr/mcap/reader.h"
 #include "force_commandPubSubTypes.h"
@@ -80,9 +80,15 @@ Series thin(Series s, std::size_t limit = 3000) {
 
 std::string series_json(const Series& s) {
   std::string j = "{\"name\":" + quoted(s.name) + ",\"x\":[";
-  for (std::size_t i = 0; i < s.x.size(); ++i) j += (i ? "," : "") + number(s.x[i]);
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    if (i) j += ',';
+    j += number(s.x[i]);
+  }
   j += "],\"y\":[";
-  for (std::size_t i = 0; i < s.y.size(); ++i) j += (i ? "," : "") + number(s.y[i]);
+  for (std::size_t i = 0; i < s.y.size(); ++i) {
+    if (i) j += ',';
+    j += number(s.y[i]);
+  }
   return j + "]}";
 }
 
@@ -99,7 +105,8 @@ std::string plot_json(const Plot& p) {
                   ",\"xlabel\":" + quoted(p.xlabel) + ",\"ylabel\":" + quoted(p.ylabel) +
                   (p.y_from_zero ? ",\"y0\":0" : "") + ",\"series\":[";
   for (std::size_t i = 0; i < p.series.size(); ++i) {
-    j += (i ? "," : "") + series_json(thin(p.series[i]));
+    if (i) j += ',';
+    j += series_json(thin(p.series[i]));
   }
   j += "],\"bandName\":" + quoted(p.band_name) + ",\"bands\":[";
   for (std::size_t i = 0; i < p.bands.size(); ++i) {
@@ -109,11 +116,11 @@ std::string plot_json(const Plot& p) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_report: a recording as one self-contained HTML page of plots"};
+  fahr::cli::App app{"fahr_report: a recording as one self-contained HTML page of plots"};
   std::string path, output;
   app.add_option("file", path, "fahr recording (MCAP)")->required();
   app.add_option("-o,--output", output, "the page (default: FILE with .html)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   if (output.empty()) output = path + ".html";
   const bool tty = isatty(STDERR_FILENO) != 0;
 

@@ -13,7 +13,6 @@
 // --tick-spans FILE: also writes every tick span the services report
 // (ServiceEvents: a service's per-tick wall start, wall duration and thread
 // CPU time) to FILE as CSV, so a bench can split one run's ticks by time.
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -27,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/cli/cli.h"
 #include "fahr/common/config_error.h"
 #include "fahr/common/stop_signal.h"
 #include "fahr/common/subscriber.h"
@@ -188,7 +188,7 @@ void print(const Tally& t, double duration_s) {
 
 // A function-try-block: what the set-up before the inner try throws ends in a message too.
 int main(int argc, char** argv) try {
-  CLI::App app{"Summarise a running fahr co-simulation"};
+  fahr::cli::App app{"Summarise a running fahr co-simulation"};
   std::string dds, domain, profile;
   double duration_s = 10;
   app.add_option("--duration-s", duration_s, "how long to listen (0: until SIGINT or SIGTERM)");
@@ -203,7 +203,7 @@ int main(int argc, char** argv) try {
   app.add_option("--tick-spans", spans_path,
                  "write every reported tick span to this CSV file "
                  "(service,tick,start_ns,duration_ns,cpu_ns)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   common::install_stop_handlers();
   // Closed at exit; written under the tally's mutex, off every service's loop.
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> spans_file(nullptr, &std::fclose);

@@ -16,7 +16,6 @@
 // late periods.
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -30,6 +29,7 @@
 
 #include "deformation_statePubSubTypes.h"
 #include "device_posePubSubTypes.h"
+#include "fahr/cli/cli.h"
 #include "fahr/common/cdr_bytes.h"
 #include "fahr/common/wire_header.h"
 #include "fahr/mcap/reader.h"
@@ -330,14 +330,14 @@ void print_felt(const std::map<std::uint64_t, Pose>& poses, const std::vector<Co
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"fahr_trace: a recording as a Chrome trace, and its latency figures"};
+  fahr::cli::App app{"fahr_trace: a recording as a Chrome trace, and its latency figures"};
   std::string path, output;
   app.add_option("file", path, "fahr recording (MCAP)")->required();
   app.add_option("-o,--output", output, "trace JSON (default: FILE with .trace.json)");
   std::string clock_file;
   app.add_option("--clock", clock_file,
                  "fahr_lab's clock.txt from the recorder's host: the writers' clocks against it");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit = app.parse(argc, argv)) return *exit;
   const Clocks clocks = read_clocks(clock_file);
   if (output.empty()) output = path + ".trace.json";
   const bool tty = isatty(STDERR_FILENO) != 0;

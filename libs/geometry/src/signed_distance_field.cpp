@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "sdf_cache.h"
+
 namespace fahr::geometry {
 namespace {
 
@@ -90,7 +92,71 @@ SignedDistanceField::SignedDistanceField(const SurfaceMesh& surface, const SdfOp
     }
     dims_[axis] = static_cast<int>(cells) + 1;
   }
+  if (options.cache_dir.empty()) {
+    fill_grid();
+  } else {
+    fill_grid_cached(surface, options.cache_dir);
+  }
+}
+
+double SignedDistanceField::exact_node(const Eigen::Vector3d& p, double bound) const {
+  BvhClosestPoint hit = bvh_.closest_point(p, bound * bound);
+  if (hit.triangle < 0) {
+    hit = bvh_.closest_point(p, std::numeric_limits<double>::infinity());
+  }
+  const double distance = std::sqrt(hit.distance_squared);
+  return signed_ ? sign_of(p, hit) * distance : distance;
+}
+
+void SignedDistanceField::fill_grid_cached(const SurfaceMesh& surface,
+                                           const std::filesystem::path& dir) {
+  detail::SdfGridIdentity identity;
+  identity.vertices = surface.vertices();
+  identity.triangles = surface.triangles();
+  identity.cell_size_m = cell_size_m_;
+  identity.band_m = band_m_;
+  identity.signed_field = signed_;
+  identity.origin = origin_;
+  identity.dims = dims_;
+  const std::uint64_t key = detail::sdf_grid_key(identity);
+  const std::size_t count = static_cast<std::size_t>(dims_.x()) *
+                            static_cast<std::size_t>(dims_.y()) *
+                            static_cast<std::size_t>(dims_.z());
+  std::string why;
+  if (detail::read_sdf_grid(dir, key, count, values_, why)) {
+    // Recompute a spread of nodes: a grid from code that changed without
+    // bumping the grid version, or a file that is someone else's with our
+    // name and checksum, is caught here. The bounded and the open search may
+    // reach the closest point through different triangles of a shared edge,
+    // so the comparison allows rounding.
+    constexpr std::size_t kChecks = 64;
+    bool agrees = true;
+    for (std::size_t n = 0; n < kChecks && agrees; ++n) {
+      const std::size_t index = (n * 2654435761ULL + n * n * 40503ULL) % count;
+      const int i = static_cast<int>(index % static_cast<std::size_t>(dims_.x()));
+      const int j = static_cast<int>((index / static_cast<std::size_t>(dims_.x())) %
+                                     static_cast<std::size_t>(dims_.y()));
+      const int k = static_cast<int>(
+          index / (static_cast<std::size_t>(dims_.x()) * static_cast<std::size_t>(dims_.y())));
+      const Eigen::Vector3d p = origin_ + cell_size_m_ * Eigen::Vector3d(i, j, k);
+      const double fresh = exact_node(p, std::numeric_limits<double>::infinity());
+      agrees = std::abs(fresh - values_[index]) <= 1e-12 * (1.0 + std::abs(fresh));
+    }
+    if (agrees) {
+      grid_source_ = SdfGridSource::kCacheHit;
+      return;
+    }
+    why = detail::sdf_cache_file(dir, key).string() +
+          ": its values differ from freshly computed nodes (stale grid code?)";
+  }
   fill_grid();
+  std::string write_why;
+  if (detail::write_sdf_grid(dir, key, values_, write_why)) {
+    grid_source_ = SdfGridSource::kBuiltAndCached;
+  } else {
+    why += (why.empty() ? "" : "; ") + write_why;
+  }
+  if (!why.empty()) cache_note_ = "field cache: " + why;
 }
 
 void SignedDistanceField::fill_grid() {
@@ -105,13 +171,8 @@ void SignedDistanceField::fill_grid() {
         const Eigen::Vector3d p = origin_ + cell_size_m_ * Eigen::Vector3d(i, j, k);
         // |d| changes by at most one cell between neighbours: a tight search bound.
         const double bound = (std::abs(previous) + cell_size_m_) * (1.0 + kBoundSlack);
-        BvhClosestPoint hit = bvh_.closest_point(p, bound * bound);
-        if (hit.triangle < 0) {
-          hit = bvh_.closest_point(p, std::numeric_limits<double>::infinity());
-        }
-        const double distance = std::sqrt(hit.distance_squared);
-        previous = distance;
-        values_[index] = signed_ ? sign_of(p, hit) * distance : distance;
+        values_[index] = exact_node(p, bound);
+        previous = values_[index];
       }
     }
   }

@@ -1,6 +1,7 @@
 // Rigid scene bodies' fields, and which of them a deformable body meets.
 #include "fahr/runtime/rigid_field.h"
 
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -16,12 +17,44 @@ Eigen::Isometry3d RigidField::world_from_body() const {
   return pose;
 }
 
+std::filesystem::path field_cache_dir() {
+  if (const char* dir = std::getenv("FAHR_CACHE_DIR"); dir != nullptr && *dir != '\0') {
+    if (std::string(dir) == "off") return {};
+    return std::filesystem::path(dir) / "fields";
+  }
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg == '/') {
+    return std::filesystem::path(xdg) / "fahr" / "fields";
+  }
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home == '/') {
+    return std::filesystem::path(home) / ".cache" / "fahr" / "fields";
+  }
+  return {};
+}
+
+std::string describe_field_sources(const std::vector<const RigidField*>& fields) {
+  int read = 0;
+  int built = 0;
+  std::string notes;
+  for (const RigidField* field : fields) {
+    if (field == nullptr || !field->sdf) continue;
+    if (field->sdf->grid_source() == geometry::SdfGridSource::kCacheHit) {
+      ++read;
+    } else {
+      ++built;
+    }
+    if (!field->sdf->cache_note().empty()) notes += "; " + field->sdf->cache_note();
+  }
+  return "fields: " + std::to_string(read) + " read from the cache, " + std::to_string(built) +
+         " built" + notes;
+}
+
 std::unique_ptr<RigidField> load_rigid_field(const scene::Body& body) {
   auto field = std::make_unique<RigidField>();
   field->scene_body = &body;
   field->surface = geometry::load_surface(body.mesh_path, body.mesh_scale);
   geometry::SdfOptions options;
   options.cell_size_m = body.rigid ? body.rigid->sdf_cell_m : options.cell_size_m;
+  options.cache_dir = field_cache_dir();
   try {
     field->sdf = std::make_unique<geometry::SignedDistanceField>(field->surface, options);
   } catch (const std::exception& e) {

@@ -13,7 +13,7 @@ double ServiceOptions::duration_or_scene_s(const scene::Scene& scene) const {
   return duration_s < 0 ? std::chrono::duration<double>(scene.run.duration).count() : duration_s;
 }
 
-void add_service_options(CLI::App& app, ServiceOptions& o) {
+void add_service_options(fahr::cli::App& app, ServiceOptions& o) {
   app.add_option("--scene", o.scene_path, "scene file")->required();
   app.add_option("--dds", o.dds, "DDS vendor: fastdds, cyclonedds, inprocess");
   app.add_option("--domain", o.domain, "DDS domain id 0-230");
@@ -25,7 +25,7 @@ void add_service_options(CLI::App& app, ServiceOptions& o) {
       "--duration-s", o.duration_s,
       "stop after this long; 0 runs until SIGINT/SIGTERM (default: the scene's run.duration_s)");
   app.add_option("--mode", o.mode, "realtime or lockstep (default: the scene's run.mode)")
-      ->check(CLI::IsMember({"realtime", "lockstep"}));
+      ->check(fahr::cli::IsMember({"realtime", "lockstep"}));
   app.add_option("--cpus", o.cpus,
                  "run on these CPUs only, e.g. 0 or 0-1 (default: wherever the kernel puts it)");
 }

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "fahr/common/lockstep.h"
 #include "fahr/common/publisher.h"
@@ -130,16 +131,26 @@ int run_lockstep(common::Participant& participant, ServiceStep& fem_step, const 
   return 0;
 }
 
+namespace {
+
+std::string field_sources(const FemBodySetup& setup) {
+  std::vector<const runtime::RigidField*> fields;
+  for (const auto& anatomy : setup.anatomy) fields.push_back(&anatomy->field());
+  return runtime::describe_field_sources(fields);
+}
+
+}  // namespace
+
 void print_start_line(const common::Participant& participant, const FemBodySetup& setup,
                       const scene::Scene& scene, bool lockstep) {
   std::printf(
       "fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres, layout "
-      "0x%016llx), %.0f Hz, %s\n",
+      "0x%016llx), %.0f Hz, %s, %s\n",
       std::string(common::vendor_name(participant.vendor())).c_str(),
       setup.scene_body->name.c_str(), setup.mesh.node_count(), setup.mesh.tet_count(),
       setup.fixed_nodes.size(), setup.links.size(),
       static_cast<unsigned long long>(setup.layout_fingerprint), scene.rates.fem_hz,
-      lockstep ? "lockstep" : "realtime");
+      lockstep ? "lockstep" : "realtime", field_sources(setup).c_str());
 }
 
 void print_end_line(const ServiceStep& fem_step) {

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "fahr/common/background_publisher.h"
 #include "fahr/common/clock.h"
@@ -217,18 +219,29 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
   return 0;
 }
 
+namespace {
+
+std::string field_sources(const HapticSetup& setup) {
+  std::vector<const runtime::RigidField*> fields{setup.tool.get()};
+  for (const auto& field : setup.anatomy) fields.push_back(field.get());
+  return runtime::describe_field_sources(fields);
+}
+
+}  // namespace
+
 void print_ready_line(const common::Participant& participant, const HapticSetup& setup,
                       const std::string& collision, bool lockstep, double setup_s) {
   std::printf(
       "fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres, layout 0x%016llx), "
       "tool '%s' (%zu surface samples), "
-      "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s\n",
+      "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s (%s)\n",
       std::string(common::vendor_name(participant.vendor())).c_str(),
       setup.deformable->name.c_str(), setup.mesh.node_count(), setup.layout.size(),
       static_cast<unsigned long long>(setup.layout.fingerprint()),
       setup.tool->scene_body->name.c_str(), setup.tool_samples.points_m().size(),
       setup.tissue_obstacles.size(), setup.tool_obstacles.size(), collision.c_str(),
-      setup.scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s);
+      setup.scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s,
+      field_sources(setup).c_str());
 }
 
 void print_end_line(const HapticLoop& loop) {

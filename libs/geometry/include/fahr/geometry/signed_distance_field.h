@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include "fahr/geometry/surface_mesh.h"
@@ -27,6 +29,19 @@ struct SdfOptions {
   bool unsigned_mode = false;
   // Grids with more nodes are refused (memory: 8 bytes per node).
   std::size_t max_grid_nodes = std::size_t{64} << 20;
+  // Where grids are kept between runs (empty: not kept). A grid is read back
+  // only for the same surface (every vertex and triangle), the same options
+  // and the same grid code; a damaged, foreign or stale file is rebuilt and
+  // replaced. The values are the computed ones bit for bit, so a cached field
+  // answers exactly as a built one.
+  std::filesystem::path cache_dir;
+};
+
+// How a field got its grid.
+enum class SdfGridSource {
+  kBuilt,          // computed (no cache directory)
+  kCacheHit,       // read from the cache directory
+  kBuiltAndCached  // computed and written to the cache directory
 };
 
 struct SdfSample {
@@ -60,6 +75,10 @@ class SignedDistanceField {
   double band_m() const { return band_m_; }
   Eigen::Vector3i grid_dimensions() const { return dims_; }  // nodes per axis
   Eigen::Vector3d grid_origin_m() const { return origin_; }
+  SdfGridSource grid_source() const { return grid_source_; }
+  // Why the cache was not used although asked for (a file refused or not
+  // writable); empty otherwise. For the caller's set-up log.
+  const std::string& cache_note() const { return cache_note_; }
   const TriangleBvh& bvh() const { return bvh_; }
 
  private:
@@ -72,7 +91,9 @@ class SignedDistanceField {
   const Eigen::Vector3d& pseudo_normal(const BvhClosestPoint& hit) const noexcept;
   double sign_of(const Eigen::Vector3d& p, const BvhClosestPoint& hit) const noexcept;
   SdfSample exact_from(const Eigen::Vector3d& p, const BvhClosestPoint& hit) const noexcept;
+  double exact_node(const Eigen::Vector3d& p, double bound) const;
   void fill_grid();
+  void fill_grid_cached(const SurfaceMesh& surface, const std::filesystem::path& dir);
 
   // The surface's normals are kept (not the mesh) for the sign test.
   std::vector<Triangle> triangles_;
@@ -88,6 +109,8 @@ class SignedDistanceField {
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
   Eigen::Vector3i dims_ = Eigen::Vector3i::Zero();
   std::vector<double> values_;  // m, x fastest
+  SdfGridSource grid_source_ = SdfGridSource::kBuilt;
+  std::string cache_note_;
 };
 
 }  // namespace fahr::geometry

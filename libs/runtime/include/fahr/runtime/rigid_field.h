@@ -6,7 +6,9 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <filesystem>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "fahr/geometry/signed_distance_field.h"
@@ -26,9 +28,19 @@ struct RigidField {
   Eigen::Isometry3d world_from_body() const;
 };
 
+// Where fields are kept between runs (geometry::SdfOptions::cache_dir):
+// $FAHR_CACHE_DIR/fields; else $XDG_CACHE_HOME/fahr/fields; else
+// $HOME/.cache/fahr/fields. FAHR_CACHE_DIR=off (or no HOME) keeps none.
+std::filesystem::path field_cache_dir();
+
 // Loads the body's surface (its unit) and builds its field on the body's
-// sdf_cell_m grid. Throws std::runtime_error naming the body and the file.
+// sdf_cell_m grid, or reads it from field_cache_dir(). Throws
+// std::runtime_error naming the body and the file.
 std::unique_ptr<RigidField> load_rigid_field(const scene::Body& body);
+
+// For a service's set-up line: "fields: 3 read from the cache, 6 built" and
+// any cache problem met (a refused file, an unwritable directory).
+std::string describe_field_sources(const std::vector<const RigidField*>& fields);
 
 // The obstacle bodies (indices into scene.bodies) the deformable body
 // `deformable` (an index too) is held out of: the scene plan's hard pairs.

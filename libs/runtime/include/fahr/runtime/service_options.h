@@ -3,9 +3,9 @@
 // once so the services spell and document them the same way.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <string>
 
+#include "fahr/cli/cli.h"
 #include "fahr/scene/scene.h"
 
 namespace fahr::runtime {
@@ -28,6 +28,6 @@ struct ServiceOptions {
 
 // Adds --scene (required), --dds, --domain, --dds-profile, --security, --duration-s, --mode,
 // --cpus.
-void add_service_options(CLI::App& app, ServiceOptions& options);
+void add_service_options(fahr::cli::App& app, ServiceOptions& options);
 
 }  // namespace fahr::runtime
