@@ -13,6 +13,7 @@
 //   or writer is not allowed to exist.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -81,15 +82,18 @@ int main(int argc, char** argv) {
     msg::ForceCommand command;
     command.device_id(1);
     std::uint64_t wrote = 0;
-    // From the first pose it hears (discovery can take a second): zero for
-    // 0.1 s (the gateway's engage rule wants a small force), then up to 2 N
-    // over a second: what a hostile participant that knows the rules would
-    // send.
+    // From the first pose it hears (discovery can take a second), over and
+    // over: zero for 0.3 s (the gateway's engage rule wants 50 ticks of a
+    // small force), up to 2 N over 0.5 s, held for 0.4 s. What a hostile
+    // participant that knows the rules would send; repeated, because a
+    // gateway that stalls (a starved machine) drops the force and must
+    // engage again.
     std::optional<std::chrono::steady_clock::time_point> start;
     while (std::chrono::steady_clock::now() < end) {
       const auto now = std::chrono::steady_clock::now();
       const double t = start ? std::chrono::duration<double>(now - *start).count() : 0.0;
-      command.force_n().y(std::clamp(2.0 * (t - 0.1), 0.0, 2.0));
+      const double phase = std::fmod(t, 1.2);
+      command.force_n().y(std::clamp(4.0 * (phase - 0.3), 0.0, 2.0));
       if (poses.fetch_newest()) {
         if (!start) start = now;
         command.answered_pose_seq(poses.newest().header().seq());
