@@ -1,6 +1,8 @@
 // Signed distance field grids kept on disk: a second build reads the grid and
 // answers bit for bit as a built one; a damaged, stale or foreign file is
 // rebuilt and replaced; an unwritable directory only costs the caching.
+#include "sdf_cache.h"  // private to fahr::geometry: the white-box cases
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,7 +14,6 @@
 #include <vector>
 
 #include "fahr/geometry/signed_distance_field.h"
-#include "sdf_cache.h"  // private to fahr::geometry: the white-box cases
 #include "test_support.h"
 
 namespace fahr::geometry {

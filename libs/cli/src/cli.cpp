@@ -84,8 +84,7 @@ Option* App::add_option(const std::string& names, unsigned& target, const std::s
 Option* App::add_option(const std::string& names, long& target, const std::string& help) {
   return keep(app_->add_option(names, target, help));
 }
-Option* App::add_option(const std::string& names, unsigned long& target,
-                        const std::string& help) {
+Option* App::add_option(const std::string& names, unsigned long& target, const std::string& help) {
   return keep(app_->add_option(names, target, help));
 }
 Option* App::add_option(const std::string& names, long long& target, const std::string& help) {
@@ -95,8 +94,7 @@ Option* App::add_option(const std::string& names, unsigned long long& target,
                         const std::string& help) {
   return keep(app_->add_option(names, target, help));
 }
-Option* App::add_option(const std::string& names, unsigned short& target,
-                        const std::string& help) {
+Option* App::add_option(const std::string& names, unsigned short& target, const std::string& help) {
   return keep(app_->add_option(names, target, help));
 }
 Option* App::add_option(const std::string& names, std::vector<std::string>& target,
@@ -126,9 +124,13 @@ App* App::footer(const std::string& text) {
   return this;
 }
 
-bool App::parsed() const { return app_->parsed(); }
+bool App::parsed() const {
+  return app_->parsed();
+}
 
-std::size_t App::count(const std::string& name) const { return app_->count(name); }
+std::size_t App::count(const std::string& name) const {
+  return app_->count(name);
+}
 
 std::optional<int> App::parse(int argc, const char* const* argv) {
   try {

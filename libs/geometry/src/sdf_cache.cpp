@@ -118,8 +118,8 @@ std::filesystem::path sdf_cache_file(const std::filesystem::path& dir, std::uint
   return dir / name;
 }
 
-bool read_sdf_grid(const std::filesystem::path& dir, std::uint64_t key,
-                   std::size_t expected_count, std::vector<double>& values, std::string& why) {
+bool read_sdf_grid(const std::filesystem::path& dir, std::uint64_t key, std::size_t expected_count,
+                   std::vector<double>& values, std::string& why) {
   why.clear();
   const std::filesystem::path file = sdf_cache_file(dir, key);
   std::ifstream in(file, std::ios::binary);

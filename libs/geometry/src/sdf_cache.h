@@ -5,13 +5,12 @@
 // reader never sees half a file. Private to fahr::geometry.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "fahr/geometry/mesh_types.h"
 
@@ -42,8 +41,8 @@ std::filesystem::path sdf_cache_file(const std::filesystem::path& dir, std::uint
 // Reads the grid stored under `key`; returns false (and says why in `why`,
 // empty when there is simply no file) when it is absent, of another
 // version or key, truncated, or its checksum does not match.
-bool read_sdf_grid(const std::filesystem::path& dir, std::uint64_t key,
-                   std::size_t expected_count, std::vector<double>& values, std::string& why);
+bool read_sdf_grid(const std::filesystem::path& dir, std::uint64_t key, std::size_t expected_count,
+                   std::vector<double>& values, std::string& why);
 
 // Writes the grid; returns false and says why when the directory or file
 // cannot be written (the field is then simply not cached).

@@ -66,8 +66,7 @@ class App {
   Option* add_option(const std::string& names, long& target, const std::string& help);
   Option* add_option(const std::string& names, unsigned long& target, const std::string& help);
   Option* add_option(const std::string& names, long long& target, const std::string& help);
-  Option* add_option(const std::string& names, unsigned long long& target,
-                     const std::string& help);
+  Option* add_option(const std::string& names, unsigned long long& target, const std::string& help);
   Option* add_option(const std::string& names, unsigned short& target, const std::string& help);
   Option* add_option(const std::string& names, std::vector<std::string>& target,
                      const std::string& help);
