@@ -13,7 +13,13 @@ Validator Range(double low, double high) {
   return v;
 }
 
-const Validator PositiveNumber{Validator::Kind::kPositive, 0.0, 0.0, {}};
+Validator Range(int low, int high) {
+  Validator v = Range(static_cast<double>(low), static_cast<double>(high));
+  v.integral = true;
+  return v;
+}
+
+const Validator PositiveNumber{Validator::Kind::kPositive, 0.0, 0.0, false, {}};
 
 Validator IsMember(std::vector<std::string> members) {
   Validator v;
@@ -30,7 +36,12 @@ Option* Option::required() {
 Option* Option::check(const Validator& validator) {
   switch (validator.kind) {
     case Validator::Kind::kRange:
-      option_->check(CLI::Range(validator.low, validator.high));
+      if (validator.integral) {
+        option_->check(CLI::Range(static_cast<long long>(validator.low),
+                                  static_cast<long long>(validator.high)));
+      } else {
+        option_->check(CLI::Range(validator.low, validator.high));
+      }
       break;
     case Validator::Kind::kPositive:
       option_->check(CLI::PositiveNumber);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -166,10 +167,12 @@ bool write_sdf_grid(const std::filesystem::path& dir, std::uint64_t key,
     return false;
   }
   const std::filesystem::path file = sdf_cache_file(dir, key);
-  // One temporary name per process: two services building the same field at
-  // once each write their own and the last rename wins, with equal contents.
+  // One temporary name per writer (process and call): two services, or two
+  // threads, building the same field at once each write their own and the
+  // last rename wins, with equal contents.
+  static std::atomic<unsigned> writes{0};
   std::filesystem::path temporary = file;
-  temporary += ".tmp" + std::to_string(::getpid());
+  temporary += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(writes.fetch_add(1));
   Header header;
   header.key = key;
   header.count = values.size();

@@ -28,11 +28,14 @@ struct Validator {
   Kind kind = Kind::kRange;
   double low = 0.0;
   double high = 0.0;
+  bool integral = false;
   std::vector<std::string> members;
 };
 
-// The value must lie in [low, high].
+// The value must lie in [low, high] (the help names an INT range for
+// integer bounds, a FLOAT range for floating-point ones).
 Validator Range(double low, double high);
+Validator Range(int low, int high);
 // The value must be > 0.
 extern const Validator PositiveNumber;
 // The value must be one of these words.
