@@ -114,8 +114,11 @@ FAHR_RUN_LOCAL_IN_NETNS=1 FAHR_RUN_LOG_DIR="$out/run" bash "$repo/deployment/run
   echo "security_test: run_local failed:"; tail -n 30 "$out/run.txt"; fail=1; }
 commands=$(awk -F'|' '$2 ~ /^ ForceCommand samples $/ { gsub(/ /, "", $3); print $3 }' "$out/run.txt")
 fem_states=$(sed -n 's/.*fahr_haptic_service: [0-9]* ticks on \([0-9]*\) FEM states.*/\1/p' "$out/run.txt" | tail -n 1)
-check "the secured station ran: ForceCommand samples ${commands:-none}" [ "${commands:-0}" -gt 1000 ]
-# (Any state proves the secured path: a loaded machine starves the FEM.)
+# Commands and states flowed through the secured path. A rate is not judged
+# here: a virtual machine whose timers wake late starves the 1 kHz services
+# (701 ForceCommands in 6 s on one, 1144 on another), and any state proves the
+# path.
+check "the secured station ran: ForceCommand samples ${commands:-none}" [ "${commands:-0}" -gt 100 ]
 check "the secured station's haptic service used FEM states: ${fem_states:-none}" [ "${fem_states:-0}" -gt 0 ]
 [ "$fail" = 0 ] && echo "security_test: passed ($vendor)"
 exit "$fail"
