@@ -39,7 +39,7 @@ struct SdfOptions {
 
 // How a field got its grid.
 enum class SdfGridSource {
-  kBuilt,          // computed (no cache directory)
+  kBuilt,          // computed, not kept (no cache directory, or it could not be written)
   kCacheHit,       // read from the cache directory
   kBuiltAndCached  // computed and written to the cache directory
 };
