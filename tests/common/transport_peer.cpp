@@ -4,7 +4,8 @@
 //       to fahr/test/pong/<T>, unchanged but for the writer's header stamp.
 //   transport_peer writer <vendor> <domain> <period_ms> <deadline_ms> <lease_ms>
 //                         <total_ms> <silent_at_ms> <silent_ms>
-//       writes DevicePose on fahr/test/qos every period, silent for a while.
+//       writes DevicePose on fahr/test/qos every period, silent for a while;
+//       the clock starts once a reader has matched (within 20 s).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -67,6 +68,16 @@ int run_writer(Participant& participant, char** argv) {
   Publisher<msg::DevicePose> publisher(participant, test::qos_under_test(deadline_ms, lease_ms),
                                        test::kQosTopic);
   msg::DevicePose pose;
+  // A starved machine can take seconds to discover the reader: the schedule
+  // (and its silence) counts from the match, not from the process start.
+  const auto match_by = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (publisher.matched_readers() == 0) {
+    if (std::chrono::steady_clock::now() > match_by) {
+      std::fprintf(stderr, "transport_peer: no reader matched within 20 s\n");
+      return 3;
+    }
+    std::this_thread::sleep_for(milliseconds(5));
+  }
   const auto start = std::chrono::steady_clock::now();
   auto next = start;
   for (int tick = 0;; ++tick) {

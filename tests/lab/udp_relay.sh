@@ -15,7 +15,10 @@
 #   - a->c: nothing lost, the median under 0.5 ms.
 # A measurement during which the relay itself was starved (it reports
 # sending some link's frames more than 5 ms late at p99) says nothing of the
-# relay: if it failed, it is taken once more.
+# relay's timing: if it failed, it is taken once more, and if the machine
+# starves that one too, its timing (median, spread, a->c median) is printed
+# but not judged. What a late machine cannot change is judged every time:
+# the losses, fragments dropped together, nothing before delay - jitter.
 #
 #   tests/lab/udp_relay.sh BUILD_DIR
 #
@@ -71,6 +74,7 @@ done
 # relay).
 stall_ms=5
 measure() {
+  local judge_stalled=$1  # 0: timing not judged if the relay says it was starved
   status=0
   stalled=0
   ip netns exec "$tag-sw" timeout 60 "$relay" "${ports[@]}" --seed 7 --rt-priority 10 \
@@ -120,10 +124,21 @@ measure() {
   for f in ab ab_big ba ac; do echo "$f: $(grep expected= "$work/$f.out")"; done
 
   fail() { echo "udp_relay: FAIL: $*" >&2; status=1; }
-  get() { grep -o "\b$2=[0-9.]*" "$work/$1.out" | head -1 | cut -d= -f2; }
   # How late the relay sent a link's frames against their schedule, p99, ms
   # (its own end line): time the machine took from it, not jitter it drew.
   late_p99() { sed -n "s/^fahr_udp_relay: $1: .*left late p50 [0-9.]* ms p99 \([0-9.]*\) ms.*/\1/p" "$work/relay.out"; }
+  for link in "a>b" "b>a" "a>c"; do
+    awk -v l="$(late_p99 "$link")" -v s="$stall_ms" 'BEGIN { exit !(l + 0 > s) }' && stalled=1
+  done
+  judge=1
+  if [ "$stalled" = 1 ] && [ "$judge_stalled" = 0 ]; then
+    judge=0
+    echo "udp_relay: the relay was starved again: its timing is printed, not judged" >&2
+  fi
+  timing_fail() {
+    if [ "$judge" = 1 ]; then fail "$*"; else echo "udp_relay: not judged: $*" >&2; fi
+  }
+  get() { grep -o "\b$2=[0-9.]*" "$work/$1.out" | head -1 | cut -d= -f2; }
   check_impaired() {
     local f=$1 count=$2 link=$3
     local lost min p05 p50 p95 late
@@ -132,17 +147,21 @@ measure() {
     late=$(late_p99 "$link")
     [ -n "$lost" ] || { fail "$f: no result"; return; }
     awk -v lost="$lost" -v n="$count" -v p="$loss" -v min="$min" -v p05="$p05" -v p50="$p50" \
-        -v p95="$p95" -v d="$delay_ms" -v j="$jitter_ms" -v f="$f" -v late="${late:-0}" 'BEGIN {
+        -v p95="$p95" -v d="$delay_ms" -v j="$jitter_ms" -v f="$f" -v late="${late:-0}" \
+        -v judge="$judge" 'BEGIN {
       mean = n * p; sd = sqrt(n * p * (1 - p)); bad = 0
       if (lost < mean - 4.5 * sd || lost > mean + 4.5 * sd) {
         printf "%s: %d of %d lost, outside %.0f +- %.0f\n", f, lost, n, mean, 4.5 * sd; bad = 1 }
       if (min < d - j - 0.05) { printf "%s: a datagram after %.3f ms (< %.3f)\n", f, min, d - j; bad = 1 }
-      if (p50 < d - 0.3 || p50 > d + 1.0) { printf "%s: median %.3f ms, configured %.3f\n", f, p50, d; bad = 1 }
+      tag = judge ? "" : "not judged: "
+      if (p50 < d - 0.3 || p50 > d + 1.0) {
+        printf "%s%s: median %.3f ms, configured %.3f\n", tag, f, p50, d; bad = bad || judge }
       # Beyond twice the jitter, 2 ms plus what the relay itself reports
       # as its lateness (a loaded machine widens the spread; a relay that drew
       # too much jitter does not say it was late).
       if (p95 - p05 < j || p95 - p05 > 2 * j + 2 + late) {
-        printf "%s: 5-95 %% spread %.3f ms for +-%.3f ms jitter (relay late p99 %.3f ms)\n", f, p95 - p05, j, late; bad = 1 }
+        printf "%s%s: 5-95 %% spread %.3f ms for +-%.3f ms jitter (relay late p99 %.3f ms)\n", tag, f, p95 - p05, j, late
+        bad = bad || judge }
       exit bad }' >&2 || status=1
   }
   check_impaired ab $n "a>b"
@@ -150,18 +169,15 @@ measure() {
   check_impaired ba $n "b>a"
   lost=$(get ac lost) p50=$(get ac delay_p50_ms)
   [ "${lost:-1}" = 0 ] || fail "a->c (no impairment) lost ${lost:-all}"
-  awk -v p="${p50:-99}" 'BEGIN { exit !(p < 0.5) }' || fail "a->c median ${p50:-none} ms (>= 0.5)"
-  for link in "a>b" "b>a" "a>c"; do
-    awk -v l="$(late_p99 "$link")" -v s="$stall_ms" 'BEGIN { exit !(l + 0 > s) }' && stalled=1
-  done
+  awk -v p="${p50:-99}" 'BEGIN { exit !(p < 0.5) }' || timing_fail "a->c median ${p50:-none} ms (>= 0.5)"
   return 0
 }
 
 # A measurement the relay itself marks void (stalled) is taken again, once.
-measure
+measure 1
 if [ "$status" != 0 ] && [ "$stalled" = 1 ]; then
   echo "udp_relay: the machine stalled the relay (late p99 over $stall_ms ms): measuring again" >&2
-  measure
+  measure 0
 fi
 echo "udp_relay: status $status"
 exit "$status"

@@ -19,7 +19,8 @@
 #         participant's traffic) and the recorder's queue is 64 KiB with a
 #         slowed writer, so both gaps and recorder drops happen; the books
 #         must still close exactly.
-# kill:   fahr_logger with the gateway alone, SIGKILLed after SECONDS; then
+# kill:   fahr_logger with the gateway alone, SIGKILLed SECONDS after its
+#         first chunk reached the disk; then
 #         fahr_mcap recover rebuilds the .part, which must hold every
 #         DevicePose older than one chunk plus 1 s at the kill.
 # replay: a lockstep run of SECONDS of simulated time recorded (and read
@@ -140,6 +141,16 @@ case "$mode" in
     "$build/services/device_gateway/fahr_device_gateway" --dds "$vendor" --domain 43 \
       --backend simulated --script intubation --duration-s $((seconds + 5)) >"$out/gateway.log" 2>&1 &
     gateway=$!
+    # SECONDS of recording count from the first chunk on disk (a starved
+    # machine may take seconds to start the gateway and match it).
+    part="$out/killed.mcap.part"
+    empty=$(stat -c %s "$part" 2>/dev/null || echo 0)
+    for _ in $(seq 600); do
+      [ "$(stat -c %s "$part" 2>/dev/null || echo 0)" -gt "$empty" ] && break
+      sleep 0.1
+    done
+    [ "$(stat -c %s "$part" 2>/dev/null || echo 0)" -gt "$empty" ] || {
+      echo "record_run_test: the recorder wrote nothing within 60 s" >&2; cat "$out/logger.log" >&2; exit 1; }
     sleep "$seconds"
     kill_ns=$(date +%s%N)
     kill -KILL "$logger"

@@ -72,6 +72,32 @@ TEST(LiveState, KeepsTheNewestSamplePerTopicAndKeyAndCountsMalformedBytes) {
   EXPECT_EQ(live.collect(slots), LiveState::kMaxSlots - 2);
 }
 
+TEST(LiveState, ASeeksClearAndRefillAreOneChange) {
+  LiveState live;
+  msg::DevicePose pose;
+  test::fill(pose, 1, 2);
+  pose.device_id(3);
+  put(live, kDevicePose, pose);
+  std::vector<Slot> slots;
+  ASSERT_EQ(live.collect(slots), 1U);
+  {
+    const LiveState::Batch batch(live);
+    live.clear_streams();
+    EXPECT_EQ(live.collect(slots), 0U) << "the emptied store was collected mid-seek";
+    EXPECT_FALSE(slots[0].bytes.empty());
+    put(live, kDevicePose, pose);
+    EXPECT_EQ(live.collect(slots), 0U);
+  }
+  // The refill, not the empty slot in between.
+  EXPECT_EQ(live.collect(slots), 1U);
+  EXPECT_FALSE(slots[0].bytes.empty());
+  // Without a batch the emptied slot is a change of its own (a live stream
+  // that restarts).
+  live.clear_streams();
+  EXPECT_EQ(live.collect(slots), 1U);
+  EXPECT_TRUE(slots[0].bytes.empty());
+}
+
 TEST(PageModel, TheRestStateHasNoStrainAndAStretchHasSome) {
   // One tet, nodes at the unit corners (1 cm).
   msg::SceneDescription d;
@@ -356,11 +382,12 @@ TEST(Server, ASlowClientLosesItsOldestFramesWhileAnotherKeepsItsRate) {
     }
   });
   // 300 KiB FEM states at 100 Hz for 3 s: the slow client's socket fills
-  // within a second. The source's put() must stay quick throughout.
+  // with the first. The source's put() must stay quick throughout.
   msg::DeformationState s;
   s.body_id(1);
   std::vector<float> positions(3 * 25000, 0.01f);
   std::int64_t worst_put_ns = 0;
+  std::int64_t worst_wake_ns = 0;  // how late this thread's own sleeps woke
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < 300; ++i) {
     positions[0] = static_cast<float>(i);
@@ -370,7 +397,12 @@ TEST(Server, ASlowClientLosesItsOldestFramesWhileAnotherKeepsItsRate) {
     const std::int64_t t0 = common::monotonic_now_ns();
     f.live.put(kDeformationState, bytes, common::wall_now_ns());
     worst_put_ns = std::max(worst_put_ns, common::monotonic_now_ns() - t0);
-    std::this_thread::sleep_until(start + (i + 1) * 10ms);
+    const auto due = start + (i + 1) * 10ms;
+    std::this_thread::sleep_until(due);
+    worst_wake_ns = std::max<std::int64_t>(
+        worst_wake_ns,
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - due)
+            .count());
   }
   stop = true;
   const int received = fast_messages.load();
@@ -379,12 +411,25 @@ TEST(Server, ASlowClientLosesItsOldestFramesWhileAnotherKeepsItsRate) {
   const ServerStats stats = f.server->stats();
   std::printf(
       "slow client: %llu frames dropped; the reading client got %d of 300 states in 3 s "
-      "(%.0f/s); worst put %.1f us; %llu ticks\n",
+      "(%.0f/s); %llu ticks, %llu frames out; worst put %.1f us, worst wake-up %.1f ms late\n",
       static_cast<unsigned long long>(stats.frames_dropped), received, received / 3.0,
-      static_cast<double>(worst_put_ns) * 1e-3, static_cast<unsigned long long>(stats.ticks));
+      static_cast<unsigned long long>(stats.ticks),
+      static_cast<unsigned long long>(stats.frames_sent), static_cast<double>(worst_put_ns) * 1e-3,
+      static_cast<double>(worst_wake_ns) * 1e-6);
   EXPECT_GT(stats.frames_dropped, 0U);
-  EXPECT_GE(received, 90);  // >= 30/s despite the slow client
-  EXPECT_LT(worst_put_ns, 20'000'000);
+  // The server kept its ticks although one socket stayed full from the
+  // first frame (a write waiting on it would have stopped them there), and
+  // the reading client got a frame on most of them: at 60 Hz with a state
+  // every 10 ms each tick has a new one, unless the machine starved this
+  // source too. Judged against the ticks the machine gave the server, not
+  // against 60/s, so a starved machine measures the same thing.
+  EXPECT_GE(stats.ticks, 30U) << "the server stopped ticking";
+  EXPECT_GE(received, static_cast<int>(stats.ticks) / 2)
+      << "the reading client was held back by the slow one";
+  // put() copies into a slot under a short lock: it never waits on a client.
+  // A machine that holds this thread past its wake-up time can hold it
+  // mid-put as long.
+  EXPECT_LT(worst_put_ns, 20'000'000 + worst_wake_ns);
 }
 
 }  // namespace

@@ -58,6 +58,7 @@ void LiveState::put(std::size_t topic, std::span<const std::uint8_t> cdr, std::i
 
 std::size_t LiveState::collect(std::vector<Slot>& out) const {
   std::lock_guard lock(mutex_);
+  if (batches_.load() > 0) return 0;  // a seek's refill under way: its end is the change
   if (out.size() < slots_.size()) out.resize(slots_.size());
   std::size_t changed = 0;
   for (std::size_t i = 0; i < slots_.size(); ++i) {

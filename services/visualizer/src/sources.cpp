@@ -166,8 +166,13 @@ void ReplaySource::run() {
         if (cursor_ >= reader_.end_time()) finished_ = true;
       }
     }
-    if (refill) live_.clear_streams();
-    if (end > begin) fill(begin, end);
+    if (refill) {
+      const LiveState::Batch batch(live_);
+      live_.clear_streams();
+      fill(begin, end);
+    } else if (end > begin) {
+      fill(begin, end);
+    }
   }
 }
 

@@ -42,6 +42,15 @@ window.fahrStats = stats;
 // --- three.js scene ------------------------------------------------------
 const view = document.getElementById("view");
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+// Drawn on demand: a frame when something shown may have changed (a frame
+// from the server, a toggle, the camera, the window), not every display
+// refresh. A paused replay or a quiet run then costs no drawing, which on a
+// machine drawing in software (a lab PC without a GPU driver, CI's
+// SwiftShader) is a core kept for the simulation beside it.
+let needsRender = true;
+function invalidate() {
+  needsRender = true;
+}
 renderer.setPixelRatio(1);
 renderer.setClearColor(0x1d2024);
 view.appendChild(renderer.domElement);
@@ -50,6 +59,7 @@ const camera = new THREE.PerspectiveCamera(40, 1, 0.001, 10);
 camera.position.set(0.06, 0.05, 0.16);
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.target.set(-0.03, 0, 0);
+controls.addEventListener("change", invalidate);
 controls.update();
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 1.6));
 const sun = new THREE.DirectionalLight(0xffffff, 1.4);
@@ -62,6 +72,7 @@ function resize() {
   renderer.setSize(w, h);
   camera.aspect = w / h;
   camera.updateProjectionMatrix();
+  invalidate();
 }
 window.addEventListener("resize", resize);
 resize();
@@ -255,6 +266,7 @@ function makeSphereToggles() {
 }
 let lastPositions = null;
 function updateSphereVisibility() {
+  invalidate();
   for (const set of sphereSets) set.mesh.visible = show.spheres && sphereLevelShown(set.name);
   placeSpheres(lastPositions);
 }
@@ -421,6 +433,7 @@ const frozenMat = new THREE.MeshBasicMaterial({ color: 0x30a0ff });
 // --- camera presets --------------------------------------------------------
 function setCamera(name) {
   stats.camera = name;
+  invalidate();
   if (name === "blade" && stats.glottic) {
     // The laryngoscopist's view: from the scene's eye point on the blade
     // (glottic_view.eye_in_tool_m) towards the glottic opening, the eye the
@@ -451,6 +464,7 @@ for (const name of ["overview", "side", "top", "front", "blade"]) {
 const toggleButtons = {};
 function setShow(key, on) {
   if (!(key in show)) return;
+  invalidate();
   show[key] = on;
   toggleButtons[key].className = on ? "on" : "";
   sphereGroup.visible = show.spheres;
@@ -488,6 +502,7 @@ function connect() {
     setTimeout(connect, 1000);
   };
   ws.onmessage = (ev) => {
+    invalidate();
     if (typeof ev.data !== "string") {
       const kind = new Uint32Array(ev.data, 0, 1)[0];
       if (kind === SCENE_FRAME) {
@@ -613,7 +628,10 @@ function tongueRect() {
 }
 function frame() {
   controls.update();
-  renderer.render(scene, camera);
+  if (needsRender) {
+    needsRender = false;
+    renderer.render(scene, camera);
+  }
   stats.tongueRect = tongueRect();
   stats.ghostRect = tool && tool.ghost.visible
     ? screenRect(tool.ghost.geometry.boundingBox.clone().applyMatrix4(tool.ghost.matrix))

@@ -65,6 +65,21 @@ class LiveState {
   // Forgets every sample but the scene's (a replay seek).
   void clear_streams();
 
+  // A replay seek's clear and refill as one change: while a Batch lives,
+  // collect() reports nothing, so the server never sends the emptied store
+  // (a page would read "no ForceCommand yet" there) and its next tick sends
+  // the refilled one.
+  class Batch {
+   public:
+    explicit Batch(LiveState& live) : live_(live) { live_.batches_.fetch_add(1); }
+    ~Batch() { live_.batches_.fetch_sub(1); }
+    Batch(const Batch&) = delete;
+    Batch& operator=(const Batch&) = delete;
+
+   private:
+    LiveState& live_;
+  };
+
   struct Stats {
     std::uint64_t received = 0, malformed = 0, slots_full = 0;
   };
@@ -75,6 +90,7 @@ class LiveState {
   std::vector<Slot> slots_;
   std::uint64_t next_version_ = 1;
   std::atomic<std::uint64_t> received_{0}, malformed_{0}, slots_full_{0};
+  std::atomic<int> batches_{0};
 };
 
 }  // namespace fahr::visualizer_service
