@@ -9,13 +9,20 @@
 namespace fahr::contact {
 namespace {
 
-// One entry per FEM rate, so the shards of the CTest entry share them.
+// The FEM's own static stiffness under the punch: one solve a process.
+double fem_static_npm() {
+  static const double npm = sim::fem_static_stiffness(0.005);
+  return npm;
+}
+
+// One entry per FEM rate, so the shards of the CTest entry share them (the
+// 1 kHz run costs as much as the other four tests: it is listed where
+// GoogleTest's round-robin puts it beside the shortest).
 class FlatPunch : public testing::TestWithParam<double> {};
 
 TEST_P(FlatPunch, MatchesBoussinesq) {
   const double hz = GetParam();
-  const double fem_static_npm = sim::fem_static_stiffness(0.005);
-  const sim::PunchResult r = sim::run_punch_experiment(hz, 0.005, 0.001, fem_static_npm);
+  const sim::PunchResult r = sim::run_punch_experiment(hz, 0.005, 0.001, fem_static_npm());
   EXPECT_TRUE(r.finite);
   EXPECT_LT(std::abs(r.haptic_error), 0.10)
       << hz << " Hz: haptic " << r.haptic_force_n << " N, Boussinesq " << r.boussinesq_n << " N";
@@ -23,7 +30,7 @@ TEST_P(FlatPunch, MatchesBoussinesq) {
   EXPECT_LT(std::abs(r.haptic_vs_fem), 0.03) << hz << " Hz";
 }
 
-INSTANTIATE_TEST_SUITE_P(FemRates, FlatPunch, testing::Values(50.0, 200.0, 1000.0),
+INSTANTIATE_TEST_SUITE_P(FemRates, FlatPunch, testing::Values(50.0, 1000.0, 200.0),
                          [](const testing::TestParamInfo<double>& param) {
                            return std::to_string(static_cast<int>(param.param)) + "Hz";
                          });
