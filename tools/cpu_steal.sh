@@ -8,8 +8,9 @@
 # Default: 600 s, busy 5-20 ms, idle 50-150 ms. Run a test beside it, e.g.
 #   sudo bash tools/cpu_steal.sh 300 & ctest --test-dir build -R test_qos_events
 # and tools/timer_check.sh shows what it does to sleeps (on the 2-core Xeon
-# VM with the defaults: 8.1 ms sleeps took 20.7 ms on average, 252 ms at
-# worst). Needs root (SCHED_FIFO); stops on SIGINT/SIGTERM or after SECONDS.
+# VM with the defaults, two runs: 8.1 ms sleeps took 9.1 and 20.7 ms on
+# average, 16 and 252 ms at worst; it varies with how the bursts fall).
+# Needs root (SCHED_FIFO); stops on SIGINT/SIGTERM or after SECONDS.
 set -euo pipefail
 seconds=${1:-600}
 busy_min=${2:-5} busy_max=${3:-20} idle_min=${4:-50} idle_max=${5:-150}
