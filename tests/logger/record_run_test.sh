@@ -143,13 +143,13 @@ case "$mode" in
     gateway=$!
     # SECONDS of recording count from the first chunk on disk (a starved
     # machine may take seconds to start the gateway and match it).
-    part="$out/killed.mcap.part"
-    empty=$(stat -c %s "$part" 2>/dev/null || echo 0)
+    part_size() { stat -c %s "$out/killed.mcap.part" 2>/dev/null || echo 0; }
+    empty=$(part_size)
     for _ in $(seq 600); do
-      [ "$(stat -c %s "$part" 2>/dev/null || echo 0)" -gt "$empty" ] && break
+      [ "$(part_size)" -gt "$empty" ] && break
       sleep 0.1
     done
-    [ "$(stat -c %s "$part" 2>/dev/null || echo 0)" -gt "$empty" ] || {
+    [ "$(part_size)" -gt "$empty" ] || {
       echo "record_run_test: the recorder wrote nothing within 60 s" >&2; cat "$out/logger.log" >&2; exit 1; }
     sleep "$seconds"
     kill_ns=$(date +%s%N)
