@@ -91,7 +91,10 @@ TEST_P(QosEvents, DeadlineMissesCountTheSilence) {
     longest_gap_ns = std::max(longest_gap_ns, gap);
     founded += static_cast<int>(gap / kDeadlineNs);
   }
-  EXPECT_GT(longest_gap_ns, 450'000'000) << "no 500 ms silence seen";
+  // The writer keeps 500 ms between its two writes; the sample before the
+  // silence may reach the reader late (a starved CI machine delivered one
+  // 58 ms late), which shortens the gap seen here but not the silence.
+  EXPECT_GT(longest_gap_ns, 7 * kDeadlineNs) << "no 500 ms silence seen";
   // Misses reported while the writer ran (those after its last sample are its
   // end, not a silence).
   const int reported = static_cast<int>(std::count_if(

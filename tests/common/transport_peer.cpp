@@ -80,14 +80,23 @@ int run_writer(Participant& participant, char** argv) {
   }
   const auto start = std::chrono::steady_clock::now();
   auto next = start;
+  auto last_write = start;
+  bool silenced = silent_ms <= 0;
   for (int tick = 0;; ++tick) {
     next += milliseconds(period_ms);
     std::this_thread::sleep_until(next);
     const auto elapsed =
         std::chrono::duration_cast<milliseconds>(std::chrono::steady_clock::now() - start).count();
     if (elapsed >= total_ms) break;
-    if (elapsed >= silent_at_ms && elapsed < silent_at_ms + silent_ms) continue;
+    if (!silenced && elapsed >= silent_at_ms) {
+      // The silence is measured from the last write, whenever a late wake-up
+      // let it go out, so the gap between two writes is never shorter.
+      silenced = true;
+      std::this_thread::sleep_until(last_write + milliseconds(silent_ms));
+      next = std::chrono::steady_clock::now();
+    }
     pose.servo_tick(static_cast<std::uint64_t>(tick));
+    last_write = std::chrono::steady_clock::now();
     publisher.write(pose);
   }
   return 0;

@@ -1,9 +1,14 @@
 // fault_probe: listens to a running station and writes every DevicePose and
 // ForceCommand it receives, one line each, for fault_test.sh's analysis:
 //
-//   P <wall ns> <gateway writer> <servo tick> <safety state> <|F| rendered N> <Fx> <Fy> <Fz>
-//   C <wall ns> <haptic writer> <answered pose seq> <reason> <|F| commanded N>
-//   S <wall ns> <FEM writer> <FEM step>                       (with --states)
+//   P <wall ns> <gateway writer> <servo tick> <safety state> <|F| rendered N> <Fx> <Fy> <Fz> <seq>
+//     <source ns>
+//   C <wall ns> <haptic writer> <answered pose seq> <reason> <|F| commanded N> <seq> <source ns>
+//   S <wall ns> <FEM writer> <FEM step> <seq> <source ns>     (with --states)
+//
+// <wall ns> is when the probe received the sample, <seq> and <source ns>
+// the writer's header (its count of writes and when it wrote this one):
+// a probe that lags or drops samples still reads the writer's own rate.
 //
 //   fault_probe --duration-s S --out FILE [--dds V] [--domain N]   (SIGINT ends it early)
 //
@@ -34,6 +39,8 @@ struct Line {
   std::uint64_t count;  // servo tick or answered pose seq
   int state;            // safety state or reason
   double f[4];
+  std::uint64_t seq;
+  std::int64_t source_ns;
 };
 
 }  // namespace
@@ -69,7 +76,9 @@ int main(int argc, char** argv) {
                          p.header().writer_id(),
                          p.servo_tick(),
                          static_cast<int>(p.safety_state()),
-                         {f.norm(), f.x(), f.y(), f.z()}});
+                         {f.norm(), f.x(), f.y(), f.z()},
+                         p.header().seq(),
+                         p.header().source_time_ns()});
       });
   common::Subscriber<msg::ForceCommand> commands(
       participant, qos, common::TopicTraits<msg::ForceCommand>::kName,
@@ -81,7 +90,9 @@ int main(int argc, char** argv) {
                          c.header().writer_id(),
                          c.answered_pose_seq(),
                          static_cast<int>(c.reason()),
-                         {f.norm(), 0, 0, 0}});
+                         {f.norm(), 0, 0, 0},
+                         c.header().seq(),
+                         c.header().source_time_ns()});
       });
   std::unique_ptr<common::Subscriber<msg::DeformationState>> states;
   if (with_states) {
@@ -90,8 +101,14 @@ int main(int argc, char** argv) {
         common::TopicTraits<msg::DeformationState>::kName,
         [&](const msg::DeformationState& s, const common::SampleInfo& info) {
           std::lock_guard lock(mutex);
-          lines.push_back(
-              {'S', info.receive_time_ns, s.header().writer_id(), s.step(), 0, {0, 0, 0, 0}});
+          lines.push_back({'S',
+                           info.receive_time_ns,
+                           s.header().writer_id(),
+                           s.step(),
+                           0,
+                           {0, 0, 0, 0},
+                           s.header().seq(),
+                           s.header().source_time_ns()});
         });
   }
   common::install_stop_handlers();
@@ -108,17 +125,18 @@ int main(int argc, char** argv) {
   }
   for (const Line& l : lines) {
     if (l.kind == 'P') {
-      std::fprintf(out, "P %lld %u %llu %d %.6f %.6f %.6f %.6f\n",
-                   static_cast<long long>(l.wall_ns), l.writer,
-                   static_cast<unsigned long long>(l.count), l.state, l.f[0], l.f[1], l.f[2],
-                   l.f[3]);
+      std::fprintf(out, "P %lld %u %llu %d %.6f %.6f %.6f %.6f", static_cast<long long>(l.wall_ns),
+                   l.writer, static_cast<unsigned long long>(l.count), l.state, l.f[0], l.f[1],
+                   l.f[2], l.f[3]);
     } else if (l.kind == 'S') {
-      std::fprintf(out, "S %lld %u %llu\n", static_cast<long long>(l.wall_ns), l.writer,
+      std::fprintf(out, "S %lld %u %llu", static_cast<long long>(l.wall_ns), l.writer,
                    static_cast<unsigned long long>(l.count));
     } else {
-      std::fprintf(out, "C %lld %u %llu %d %.6f\n", static_cast<long long>(l.wall_ns), l.writer,
+      std::fprintf(out, "C %lld %u %llu %d %.6f", static_cast<long long>(l.wall_ns), l.writer,
                    static_cast<unsigned long long>(l.count), l.state, l.f[0]);
     }
+    std::fprintf(out, " %llu %lld\n", static_cast<unsigned long long>(l.seq),
+                 static_cast<long long>(l.source_ns));
   }
   std::fclose(out);
   std::printf("fault_probe: %zu lines written to %s\n", lines.size(), out_path.c_str());

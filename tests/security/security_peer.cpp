@@ -7,20 +7,18 @@
 // listen: counts the ForceCommands it receives, by writer, and prints
 //   "listen: received N ForceCommand from W writers: <writer>=<n> ...".
 // command: publishes a well-formed ForceCommand every millisecond answering
-//   the newest DevicePose it sees (2 N upward, no stiffness: what a hostile
-//   participant would send), and prints "command: writer <id> wrote N,
-//   matched readers M" — or "command: refused: <why>" when its participant
-//   or writer is not allowed to exist.
-#include <algorithm>
+//   the newest DevicePose it sees (zero until the gateway is enabled, then
+//   2 N upward, no stiffness: what a hostile participant would send), and
+//   prints "command: writer <id> wrote N, matched readers M" — or
+//   "command: refused: <why>" when its participant or writer is not allowed
+//   to exist.
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
-#include <optional>
 #include <string>
 #include <thread>
 
@@ -82,22 +80,18 @@ int main(int argc, char** argv) {
     msg::ForceCommand command;
     command.device_id(1);
     std::uint64_t wrote = 0;
-    // From the first pose it hears (discovery can take a second), over and
-    // over: zero for 0.3 s (the gateway's engage rule wants 50 ticks of a
-    // small force), up to 2 N over 0.5 s, held for 0.4 s. What a hostile
-    // participant that knows the rules would send; repeated, because a
-    // gateway that stalls (a starved machine) drops the force and must
-    // engage again.
-    std::optional<std::chrono::steady_clock::time_point> start;
+    // What a hostile participant that knows the gateway's rules sends: zero
+    // until the gateway says it is enabled (its engage rule wants 50 ticks
+    // of a small force), then 2 N; zero again whenever it drops the force (a
+    // starved machine's silences), to engage again. Following the state the
+    // poses carry, not a clock, keeps it from pushing while the gateway
+    // engages however late its own wake-ups come.
     while (std::chrono::steady_clock::now() < end) {
-      const auto now = std::chrono::steady_clock::now();
-      const double t = start ? std::chrono::duration<double>(now - *start).count() : 0.0;
-      const double phase = std::fmod(t, 1.2);
-      command.force_n().y(std::clamp(4.0 * (phase - 0.3), 0.0, 2.0));
       if (poses.fetch_newest()) {
-        if (!start) start = now;
-        command.answered_pose_seq(poses.newest().header().seq());
-        command.answered_position_m(poses.newest().world_from_stylus().position_m());
+        const msg::DevicePose& pose = poses.newest();
+        command.answered_pose_seq(pose.header().seq());
+        command.answered_position_m(pose.world_from_stylus().position_m());
+        command.force_n().y(pose.safety_state() == msg::DEVICE_FORCE_ENABLED ? 2.0 : 0.0);
       }
       if (command.answered_pose_seq() == 0) command.answered_pose_seq(1);
       if (out->write(command)) ++wrote;

@@ -97,12 +97,22 @@ gateway_round() {  # gateway_round GATEWAY-ARGS... -- COMMANDER-ARGS...
   wait "$gateway" || true
   peak=$(sed -n 's/.*peak force \([0-9.]*\) N.*/\1/p' "$out/gateway.txt" | tail -n 1)
   accepted=$(sed -n 's/.*commands accepted \([0-9]*\).*/\1/p' "$out/gateway.txt" | tail -n 1)
-  echo "  gateway: peak force ${peak:-?} N, commands accepted ${accepted:-?}"
+  engaged=$(sed -n 's/.*engaged \([0-9]*\),.*/\1/p' "$out/gateway.txt" | tail -n 1)
+  echo "  gateway: peak force ${peak:-?} N, commands accepted ${accepted:-?}, engaged ${engaged:-?} times"
 }
 echo "security_test: $vendor: a well-formed hostile ForceCommand at the gateway, security off"
 gateway_round --
-check "without security the gateway renders the hostile force (peak ${peak:-0} N)" \
-  awk "BEGIN { exit !(${peak:-0} > 1.0) }"
+check "without security the gateway takes the intruder's commands for its station's (accepted ${accepted:-0})" \
+  [ "${accepted:-0}" -gt 0 ]
+# The force follows only once the gateway engaged: 50 ticks of commands
+# without a 20 ms gap. A starved machine (the commander's 1 ms sleeps waking
+# tens of ms late) may never give it that; then the force is not judged.
+if [ "${engaged:-0}" -gt 0 ]; then
+  check "without security the gateway renders the hostile force (peak ${peak:-0} N)" \
+    awk "BEGIN { exit !(${peak:-0} > 1.0) }"
+else
+  echo "not judged: the rendered force (the gateway never engaged: the commands came with gaps over its 20 ms silence)"
+fi
 echo "security_test: $vendor: the same at a secured gateway, from the intruder's identity"
 gateway_round --security "$out/station" -- "${secured[@]}" --identity intruder
 check "the secured gateway accepts none of it (accepted ${accepted:-?}, peak ${peak:-?} N)" \

@@ -65,7 +65,7 @@ std::string GatewayMetrics::summary(std::uint64_t late_periods) {
       "ticks %llu, late periods %llu, motion-to-force (last window with commands) n=%llu p50 %.3f "
       "ms p99 %.3f ms, whole run n=%llu p50 %.3f ms p99 %.3f ms max %.3f ms, "
       "peak force %.3f N, renderable %.3f N, commands accepted %llu, rejected nan %llu stale %llu, "
-      "silences %llu, PC removed %.3f mJ",
+      "silences %llu, engaged %llu, PC removed %.3f mJ",
       static_cast<unsigned long long>(s.ticks), static_cast<unsigned long long>(late_periods),
       static_cast<unsigned long long>(latency.count()), ms(latency.percentile(0.5)),
       ms(latency.percentile(0.99)), static_cast<unsigned long long>(run.count()),
@@ -73,7 +73,8 @@ std::string GatewayMetrics::summary(std::uint64_t late_periods) {
       s.renderable_force_n, static_cast<unsigned long long>(s.safety.accepted),
       static_cast<unsigned long long>(s.safety.rejected_non_finite),
       static_cast<unsigned long long>(s.safety.rejected_stale),
-      static_cast<unsigned long long>(s.safety.silence_events), s.passivity_dissipated_j * 1e3);
+      static_cast<unsigned long long>(s.safety.silence_events),
+      static_cast<unsigned long long>(s.safety.engage_events), s.passivity_dissipated_j * 1e3);
   return line;
 }
 

@@ -111,6 +111,10 @@ const pixelChange = (a, b) => {
   return a.length ? d / a.length : 0;
 };
 
+// Waits return as soon as the page shows what they wait for; their bounds
+// are for a page that never does, long enough for a starved machine (a
+// page drawn in software beside a station, on two cores whose host steals
+// them) to get there late.
 async function waitFor(pred, timeoutMs, what) {
   const end = Date.now() + timeoutMs;
   while (Date.now() < end) {
@@ -212,7 +216,7 @@ async function playUntil(kind, speed, from) {
       }),
     { kind, speed },
   );
-  await waitFor((x) => x.replay?.paused, 5000, `the replay paused (${kind})`);
+  await waitFor((x) => x.replay?.paused, 30000, `the replay paused (${kind})`);
   await nextFrames();
 }
 
@@ -233,7 +237,7 @@ async function checkGhost(result) {
   const drawnAgain = await grab(rect);
   const toggle = page.locator("#toggles button", { hasText: "ghost" });
   await toggle.click();
-  await waitFor((x) => !x.ghostVisible, 2000, "the grey device blade hidden by its toggle");
+  await waitFor((x) => !x.ghostVisible, 30000, "the grey device blade hidden by its toggle");
   await nextFrames();
   const hidden = await grab(rect);
   await page.screenshot({ path: join(out, "lost_track_hidden.png") });
@@ -285,7 +289,7 @@ if (mode === "live") {
   // 4x to its first ForceCommand; then back 3 s and at half speed to it
   // again, paused at once: well inside the hand's first second.
   await page.evaluate(() => window.fahrSend({ op: "replay", action: "pause" }));
-  await waitFor((x) => x.replay?.paused, 5000, "the replay paused");
+  await waitFor((x) => x.replay?.paused, 30000, "the replay paused");
   // A page that draws slowly (software GL on two cores) pauses late, so the
   // rest frame is found by seeking the paused replay instead: a seek hands
   // the page the newest samples up to that moment, whatever its speed.
