@@ -178,9 +178,10 @@ trap cleanup EXIT
 trap 'exit 130' INT TERM
 
 # Waits until a log shows a line, or the process died, or time ran out.
-wait_for_line() {
+wait_for_line() {  # wait_for_line LOG PATTERN PID SECONDS (of wall time, however late sleeps wake)
   local log=$1 pattern=$2 pid=$3 timeout_s=$4
-  for _ in $(seq $((timeout_s * 10))); do
+  local until=$((SECONDS + timeout_s))
+  while [ "$SECONDS" -lt "$until" ]; do
     grep -q "$pattern" "$log" 2>/dev/null && return 0
     kill -0 "$pid" 2>/dev/null || { echo "run_local: $(basename "$log" .log) exited during set-up:" >&2; tail -n 20 "$log" >&2; return 1; }
     sleep 0.1
@@ -218,8 +219,9 @@ haptic_pid=$!; pids+=("$haptic_pid")
 # gets it into the log while they run.)
 # The gateway's script starts with its first tick: start it only when both
 # services have built their meshes, spheres and fields.
-wait_for_line "$logs/fem.log" "^fahr_fem_service: " "$fem_pid" 60
-wait_for_line "$logs/haptic.log" "ready" "$haptic_pid" 60
+# 180 s: the haptic service's set-up alone took 48-53 s on a slow 2-core VM.
+wait_for_line "$logs/fem.log" "^fahr_fem_service: " "$fem_pid" 180
+wait_for_line "$logs/haptic.log" "ready" "$haptic_pid" 180
 
 if [ "$mode" = lockstep ]; then
   if [ -n "$replay" ]; then

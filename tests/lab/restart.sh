@@ -41,8 +41,8 @@ lab_pid=$!
 
 # Waits until FILE has PATTERN (grep -E), at most SECONDS.
 wait_for() {
-  local file=$1 pattern=$2 seconds=$3
-  for _ in $(seq $((seconds * 10))); do
+  local file=$1 pattern=$2 until=$((SECONDS + $3)) seconds=$3
+  while [ "$SECONDS" -lt "$until" ]; do
     grep -qE "$pattern" "$file" 2>/dev/null && return 0
     sleep 0.1
   done
@@ -56,7 +56,9 @@ wait_for "$run/status" "^service device_gateway pid [0-9]+ state running" 120
 sleep 2
 kill -KILL "$(fem_pid)"
 wait_for "$work/lab.log" "fem restarted \(pid [0-9]+, restart 1\)" 20
-kill -KILL "$(fem_pid)"
+# The restarted FEM's pid from fahr_lab's own line: it writes the status
+# file after that line, so the file may still name the dead one.
+kill -KILL "$(sed -n 's/.*fem restarted (pid \([0-9]*\), restart 1).*/\1/p' "$work/lab.log" | tail -n 1)"
 wait_for "$work/lab.log" "fem restarted \(pid [0-9]+, restart 2\)" 20
 wait "$lab_pid" || true
 lab_pid=""

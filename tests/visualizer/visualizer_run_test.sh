@@ -102,7 +102,7 @@ case "$mode" in
   foxglove)
     start_visualizer --dds cyclonedds --domain 42
     start_run 20 intubation
-    node "$js/foxglove_check.mjs" "ws://127.0.0.1:$port" 60 \
+    node "$js/foxglove_check.mjs" "ws://127.0.0.1:$port" 240 \
       DevicePose,ForceCommand,ContactSet,DeformationState,SceneDescription,ServiceStatus,GlotticView | tee "$out/foxglove.json"
     stop_visualizer
     ;;
@@ -115,7 +115,7 @@ case "$mode" in
     bash "$repo/deployment/run_local.sh" "$build" --dds cyclonedds --domain 42 --mode lockstep \
       --pace 1 --script intubation --duration-s 7 >"$out/run.log" 2>&1 &
     pids+=($!)
-    node "$js/browser_check.mjs" "$url" "$out" 90 live | tee "$out/browser.json"
+    node "$js/browser_check.mjs" "$url" "$out" 300 live | tee "$out/browser.json"
     stop_visualizer
     ;;
   replay)
@@ -161,7 +161,7 @@ case "$mode" in
   remote)
     start_visualizer --dds cyclonedds --domain 44 --allow-remote-input
     "$build/services/device_gateway/fahr_device_gateway" --dds cyclonedds --domain 44 --backend remote \
-      --duration-s 6 >"$out/gateway.log" 2>&1 &
+      --duration-s 90 >"$out/gateway.log" 2>&1 &
     pids+=($!)
     (cd "$js" && node --input-type=module -e '
       import WebSocket from "ws";
@@ -175,11 +175,16 @@ case "$mode" in
       fox.on("message", ({ subscriptionId, data }) => { if (subscriptionId === sub) last = reader.readMessage(new Uint8Array(data.buffer, data.byteOffset, data.byteLength)); });
       const target = [0.02, -0.01, 0.5];  // z beyond the workspace: clamped
       page.on("open", () => setInterval(() => page.send(JSON.stringify({ op: "pose", p: target, q: [1, 0, 0, 0] })), 20));
-      setTimeout(() => {
+      // Judged once the gateway follows (discovery on a starved machine can
+      // take seconds), or as it stands after 60 s.
+      const followed = (p) => p && Math.abs(p.z) < 0.5 && p.z !== 0;
+      const end = () => {
         const p = last?.world_from_stylus?.position_m;
         console.log(`visualizer_run_test: mouse pose sent ${JSON.stringify(target)}, gateway DevicePose at ${p ? [p.x, p.y, p.z].map((v) => v.toFixed(4)).join(", ") : "none"}`);
-        process.exit(p && Math.abs(p.z) < 0.5 && p.z !== 0 ? 0 : 1);
-      }, 4000);' "ws://127.0.0.1:$port")
+        process.exit(followed(p) ? 0 : 1);
+      };
+      setInterval(() => { if (followed(last?.world_from_stylus?.position_m)) end(); }, 100);
+      setTimeout(end, 60000);' "ws://127.0.0.1:$port")
     stop_visualizer
     grep -E "remote|backend" "$out/gateway.log" | head -n 3 || true
     ;;

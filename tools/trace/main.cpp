@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <exception>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -203,9 +204,14 @@ std::string quoted(const std::string& s) {
 // rendered force from one servo tick to the next (DevicePose.rendered_force_n
 // of consecutive poses), and how old the FEM state behind each ForceCommand
 // was when the haptic service used it: the command's write time minus the
-// end of the FEM tick that wrote its DeformationState.step. The FEM's tick
-// spans give every step's time; the DeformationStates the recorder kept
-// tie FEM steps to its ticks. Ages are on the writers' clocks (one clock
+// DeformationState's own write time where the recorder kept that state,
+// else the end of the FEM tick that wrote it (the recorder may keep one
+// state in N, and a starved one loses most of them). The FEM's tick spans
+// give every step's time; the DeformationStates the recorder kept tie FEM
+// steps to its ticks. The youngest age is taken over the states whose write
+// was recorded only: a tick's end comes after its write, and a state used
+// while a starved FEM thread was still finishing its tick would seem used
+// before it was written. Ages are on the writers' clocks (one clock
 // when the hosts are namespaces of one machine; across machines only within
 // their clock error).
 void print_felt(const std::map<std::uint64_t, Pose>& poses, const std::vector<Command>& commands,
@@ -248,10 +254,12 @@ void print_felt(const std::map<std::uint64_t, Pose>& poses, const std::vector<Co
   std::map<std::uint64_t, std::size_t> tick_position;
   for (std::size_t i = 0; i < fem->ticks.size(); ++i) tick_position[fem->ticks[i].tick] = i;
   std::map<std::int64_t, std::size_t> offsets;
+  std::map<std::uint64_t, std::int64_t> written_ns;  // step -> its state's write
   double period_s = 0;
   for (const auto& st : states) {
     if (st.writer_id != fem_id) continue;
     period_s = st.step_s;
+    written_ns[st.step] = st.source_ns;
     auto after = std::upper_bound(fem->ticks.begin(), fem->ticks.end(), st.source_ns,
                                   [](std::int64_t v, const Tick& t) { return v < t.start_ns; });
     if (after == fem->ticks.begin()) continue;
@@ -273,7 +281,8 @@ void print_felt(const std::map<std::uint64_t, Pose>& poses, const std::vector<Co
   std::sort(ends.begin(), ends.end());
   const double limit_ms = 3.0 * period_s * 1e3;
   std::vector<double> ages_ms, behind;
-  std::size_t old = 0, far_behind = 0, unknown = 0;
+  std::size_t old = 0, far_behind = 0, unknown = 0, with_write = 0;
+  double youngest_written_ms = std::numeric_limits<double>::infinity();
   std::map<std::uint64_t, bool> used;
   for (const auto& c : commands) {
     if (c.fem_step == 0) continue;  // before the first state
@@ -285,8 +294,16 @@ void print_felt(const std::map<std::uint64_t, Pose>& poses, const std::vector<Co
       continue;
     }
     const Tick& t = fem->ticks[at->second];
-    const double age_ms = static_cast<double>(c.source_ns - (t.start_ns + t.duration_ns)) * 1e-6;
+    const auto write = written_ns.find(c.fem_step);
+    const bool recorded = write != written_ns.end();
+    const double age_ms =
+        static_cast<double>(c.source_ns - (recorded ? write->second : t.start_ns + t.duration_ns)) *
+        1e-6;
     ages_ms.push_back(age_ms);
+    if (recorded) {
+      youngest_written_ms = std::min(youngest_written_ms, age_ms);
+      ++with_write;
+    }
     if (age_ms > limit_ms) ++old;
     // States the FEM had written after this one by the time it was used.
     const auto newer = std::upper_bound(ends.begin(), ends.end(), c.source_ns) -
@@ -306,11 +323,15 @@ void print_felt(const std::map<std::uint64_t, Pose>& poses, const std::vector<Co
   const auto a = percentiles(ages_ms);
   const auto b = percentiles(behind);
   const auto n = static_cast<double>(a.n);
+  char youngest[96] = "min - (no used state's write recorded)";
+  if (with_write > 0)
+    std::snprintf(youngest, sizeof(youngest), "min %.3f ms (%zu with the write recorded)",
+                  youngest_written_ms, with_write);
   std::printf(
-      "  FEM state age at use:       n %zu  min %.3f ms  p50 %.3f ms  p99 %.3f ms  max %.3f ms  "
+      "  FEM state age at use:       n %zu  %s  p50 %.3f ms  p99 %.3f ms  max %.3f ms  "
       "> 3 periods (%.1f ms) %zu (%.3f %%)%s\n",
-      a.n, *std::min_element(ages_ms.begin(), ages_ms.end()), a.p50, a.p99, a.max, limit_ms, old,
-      100.0 * static_cast<double>(old) / n, clock_note(age_error).c_str());
+      a.n, youngest, a.p50, a.p99, a.max, limit_ms, old, 100.0 * static_cast<double>(old) / n,
+      clock_note(age_error).c_str());
   std::printf(
       "  newer FEM states written:   p50 %.0f  p99 %.0f  max %.0f  ticks on a state > 3 behind %zu "
       "(%.3f %%)\n",

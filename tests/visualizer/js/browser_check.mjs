@@ -100,7 +100,7 @@ const capture = () =>
       deformSimTime: st.deformSimTime,
       tongueRect: st.tongueRect,
     };
-  }, 90000);
+  }, 300000);
 const nextFrames = () =>
   page.evaluate(
     () => new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(() => resolve()))),
@@ -264,7 +264,7 @@ async function checkGhost(result) {
 }
 
 const result = { mode };
-let s = await waitFor((x) => x.sceneFrames > 0, 90000, "the scene");
+let s = await waitFor((x) => x.sceneFrames > 0, 300000, "the scene");
 await page.evaluate(() => window.fahrSetCamera("side"));
 // The rest frame's tongue luminance, the tongue's bounds then, and its
 // vertex checksum: what the press must change.
@@ -276,7 +276,7 @@ if (mode === "live") {
   // The first frames of the run: the rest state (the blade reaches the
   // tongue about 3 s into the script).
   const rest = await capture();
-  if (!rest) problems.push("no deformation and state frames within 90 s");
+  if (!rest) problems.push("no deformation and state frames within 300 s");
   result.firstSimTime = rest && Number(Math.max(rest.stateSimTime, rest.deformSimTime).toFixed(3));
   s = await stats();
   firstChecksum = s.positionsChecksum;
