@@ -208,7 +208,7 @@ finish_recording() {
   stop "$logger_pid"
   wait "$logger_pid" 2>/dev/null || { echo "run_local: the logger failed:" >&2; tail -n 20 "$logs/logger.log" >&2; return 1; }
   echo "run_local: recording (per writer: sent = recorded + gaps + drops + skipped; (before): gaps before the recorder matched the writer):"
-  grep "^fahr_logger: " "$logs/logger.log" | grep -v "recording to" | sed 's/^fahr_logger: /  /'
+  grep "^fahr_logger: " "$logs/logger.log" | grep -v "recording to\|writers matched" | sed 's/^fahr_logger: /  /'
 }
 stdbuf -oL "$fem" --scene "$scene" "${fem_flags[@]}" "${fem_extra[@]}" --mode "$mode" --duration-s 0 >"$logs/fem.log" 2>&1 &
 fem_pid=$!; pids+=("$fem_pid")
@@ -233,6 +233,15 @@ if [ "$mode" = lockstep ]; then
       --script "$script" --duration-s "$duration_s" >"$logs/gateway.log" 2>&1 &
   fi
   gateway_pid=$!; pids+=("$gateway_pid")
+  if [ -n "$logger_pid" ]; then
+    # The recorder must have every stream's writer before step 0: a lockstep
+    # writer keeps its last 8 steps for a reader that matches late, and a
+    # starved machine's discovery took seconds (a recording that began
+    # 3.9 s into the script). The writers exist before the clock's grant.
+    matched="writers matched: fahr/DevicePose [1-9][0-9]*, fahr/ForceCommand [1-9][0-9]*, fahr/ContactSet [1-9][0-9]*, fahr/DeformationState [1-9]"
+    wait_for_line "$logs/logger.log" "$matched" "$logger_pid" 120 ||
+      echo "run_local: the recorder has not matched every writer; the recording may lack the first steps" >&2
+  fi
   steps=$(awk "BEGIN { printf \"%d\", $duration_s * 1000 }")
   status=0
   "$clock" --participants device_gateway,fem,haptic --steps "$steps" "${common[@]}" "${clock_extra[@]}" \

@@ -129,11 +129,25 @@ int run(int argc, char** argv) {
               compression.c_str(), static_cast<unsigned long long>(chunk_kib));
   std::fflush(stdout);
 
-  // Progress on a terminal, once a second; quiet otherwise.
+  // Progress on a terminal, once a second; quiet otherwise. The writers
+  // matched on the four streams, a line whenever they change: a lockstep
+  // run starts its clock once the recorder has every writer
+  // (deployment/run_local.sh), since a writer's history keeps only its last
+  // few steps for a reader that matches late.
   const bool tty = isatty(STDERR_FILENO) != 0;
   const std::int64_t start = common::monotonic_now_ns();
   std::int64_t next_progress = start + 1'000'000'000;
+  std::string matched_line;
   while (!common::stop_requested()) {
+    std::string line = "fahr_logger: writers matched:";
+    const auto matched = recorder.matched_by_topic();
+    for (std::size_t i = 0; i < matched.size() && i < 4; ++i)
+      line += (i ? ", " : " ") + matched[i].first + " " + std::to_string(matched[i].second);
+    if (line != matched_line) {
+      std::printf("%s\n", line.c_str());
+      std::fflush(stdout);
+      matched_line = line;
+    }
     const std::int64_t now = common::monotonic_now_ns();
     const double elapsed_s = static_cast<double>(now - start) * 1e-9;
     if (duration_s > 0 && elapsed_s >= duration_s) break;

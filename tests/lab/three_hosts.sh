@@ -242,7 +242,7 @@ fem_line=$(grep "steps, stale contact sets" "$r2/fem.log" || true)
 haptic_line=$(grep "ticks on .* FEM states" "$r1/haptic.log" || true)
 pose_line=$(grep "DevicePoses received" "$r1/haptic.log" || true)
 gateway_line=$(grep "^device_gateway: ticks" "$rg/device_gateway.log" || true)
-logger_table=$(grep "^fahr_logger: " "$r3/logger.log" | grep -v "recording to" || true)
+logger_table=$(grep "^fahr_logger: " "$r3/logger.log" | grep -v "recording to\|writers matched" || true)
 # The whole run's latencies from the recording (the namespaces share one
 # kernel clock, so receive minus source time is a one-way latency): motion
 # to force over every answered pose, each topic from its writer's host to

@@ -107,9 +107,11 @@ check "without security the gateway takes the intruder's commands for its statio
 # The force follows only once the gateway engaged: 50 ticks of commands
 # without a 20 ms gap. A starved machine (the commander's 1 ms sleeps waking
 # tens of ms late) may never give it that; then the force is not judged.
+# Once engaged, the output climbs to the commanded 2 N by 0.1 N a tick;
+# above 0.5 N it is a force the intruder chose (the engage rule admits 0.3).
 if [ "${engaged:-0}" -gt 0 ]; then
   check "without security the gateway renders the hostile force (peak ${peak:-0} N)" \
-    awk "BEGIN { exit !(${peak:-0} > 1.0) }"
+    awk "BEGIN { exit !(${peak:-0} > 0.5) }"
 else
   echo "not judged: the rendered force (the gateway never engaged: the commands came with gaps over its 20 ms silence)"
 fi

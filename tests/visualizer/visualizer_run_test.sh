@@ -130,6 +130,10 @@ case "$mode" in
       --script overshoot --scene "$out/stiff_tongue.yaml" --duration-s 7 --pace 1 --record "$out/run.mcap" \
       >"$out/run.log" 2>&1 || {
       echo "visualizer_run_test: the recorded run failed:" >&2; tail -n 30 "$out/run.log" >&2; exit 1; }
+    # A lockstep recording holds every sample of the four streams from step
+    # 0 (run_local.sh starts the clock once the recorder has every writer).
+    awk '$1 ~ /^fahr\/(DevicePose|ForceCommand|ContactSet|DeformationState)$/ && NF == 8 && $3 != $4 { bad = 1; print "visualizer_run_test: the recording lacks samples: " $0 }
+         END { exit bad }' "$out/run.log" >&2 || exit 1
     # 7 s recorded, played from its start at full speed after the rest
     # frame, watched until the device has lost track (about 5.3 s in).
     start_visualizer --replay "$out/run.mcap" --speed 1

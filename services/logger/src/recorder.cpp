@@ -333,6 +333,14 @@ int Recorder::matched_writers() const {
   return n;
 }
 
+std::vector<std::pair<std::string, int>> Recorder::matched_by_topic() const {
+  std::vector<std::pair<std::string, int>> out;
+  out.reserve(subscribers_.size());
+  for (std::size_t i = 0; i < subscribers_.size(); ++i)
+    out.emplace_back(topics_[i].name, subscribers_[i]->matched_writers());
+  return out;
+}
+
 bool Recorder::bytes_as_received() const {
   return !subscribers_.empty() && subscribers_.front()->bytes_as_received();
 }

@@ -309,7 +309,10 @@ if (mode === "live") {
     );
     let seen = (await stats()).stateFrames;
     for (let i = 0; i < 50; i++) {
+      // 400 ms and two drawn frames: a page that draws slowly reads its
+      // socket slowly too.
       await page.waitForTimeout(400);
+      await nextFrames();
       const now = (await stats()).stateFrames;
       if (now === seen) break;
       seen = now;
@@ -324,7 +327,11 @@ if (mode === "live") {
   // nothing the page is sent.)
   let hi = 0.8 * ((await stats()).replay?.duration ?? 0);
   let sim = await seekAndRead(hi);
-  for (let probe = 0; probe < 12 && !(sim >= 0 && sim < 0.5 * REST_END_S); probe++) {
+  // Up to 24 halvings: a recorder starved for a while receives the held-up
+  // samples in one burst, a simulated second within a few milliseconds of
+  // its clock (0.95 s of the script within 23 ms in one run here), and the
+  // bisection must reach inside it.
+  for (let probe = 0; probe < 24 && !(sim >= 0 && sim < 0.5 * REST_END_S); probe++) {
     const mid = (lo + hi) / 2;
     sim = await seekAndRead(mid);
     if (sim < 0) lo = mid;

@@ -72,8 +72,10 @@ class Recorder {
   RecorderStats stats() const;
   std::vector<WriterTally> tallies() const { return accounting_.snapshot(); }
   std::vector<std::string> files() const;
-  // Writers (subscriptions matched) per topic, for a ready check.
+  // Writers (subscriptions matched) over all topics, for a ready check.
   int matched_writers() const;
+  // Writers matched on each topic, by name, in the order of the topics.
+  std::vector<std::pair<std::string, int>> matched_by_topic() const;
   bool bytes_as_received() const;
 
   // One topic the recorder subscribes to.
