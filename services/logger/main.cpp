@@ -10,12 +10,14 @@
 //               [--decimate TOPIC=N]... [--scene FILE]
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <exception>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "fahr/cli/cli.h"
@@ -137,16 +139,17 @@ int run(int argc, char** argv) {
   const bool tty = isatty(STDERR_FILENO) != 0;
   const std::int64_t start = common::monotonic_now_ns();
   std::int64_t next_progress = start + 1'000'000'000;
-  std::string matched_line;
+  std::vector<std::pair<std::string, int>> said;
   while (!common::stop_requested()) {
-    std::string line = "fahr_logger: writers matched:";
-    const auto matched = recorder.matched_by_topic();
-    for (std::size_t i = 0; i < matched.size() && i < 4; ++i)
-      line += (i ? ", " : " ") + matched[i].first + " " + std::to_string(matched[i].second);
-    if (line != matched_line) {
-      std::printf("%s\n", line.c_str());
+    auto matched = recorder.matched_by_topic();
+    matched.resize(std::min<std::size_t>(matched.size(), 4));  // the four streams
+    if (matched != said) {
+      std::printf("fahr_logger: writers matched:");
+      for (std::size_t i = 0; i < matched.size(); ++i)
+        std::printf("%s%s %d", i ? ", " : " ", matched[i].first.c_str(), matched[i].second);
+      std::printf("\n");
       std::fflush(stdout);
-      matched_line = line;
+      said = std::move(matched);
     }
     const std::int64_t now = common::monotonic_now_ns();
     const double elapsed_s = static_cast<double>(now - start) * 1e-9;

@@ -8,8 +8,8 @@ S (DeformationState) lines, each ending in its writer's header: the writer's
 count of writes (seq) and when it wrote the sample (source wall ns). A
 stream's rate in a window is how far its writer's count moved across it,
 read from the samples the probe got on either side of each edge: the
-writer's own rate, which a probe that lags or drops samples (a starved
-machine's probe read a third of the gateway's poses) does not change.
+writer's own rate, which a probe that lags or drops samples does not
+change.
 Samples with the intruder's writer_id (hostile_peer's 0xbad) are not
 counted. WINDOWS_FILE has one window a line, "<label> <start wall ns> <end
 wall ns>"; the label "calm" is the reference. 100 ms at each edge of a
