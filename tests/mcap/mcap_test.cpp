@@ -291,6 +291,63 @@ TEST(Mcap, IndexedReaderSeeksByReadingOnlyTheChunksOfTheSpan) {
   }
 }
 
+// A stream that falls silent (a recorder that received nothing of it for a
+// while): the state at a moment long after still holds its last message,
+// and only the chunks that can hold it are read.
+TEST(Mcap, IndexedReaderFindsEachChannelsNewestMessageHoweverOld) {
+  WriterOptions options;
+  options.compression = "zstd";
+  options.chunk_size = 16 * 1024ULL;
+  options.sync_chunks = false;
+  const std::string path = temp_path("newest.mcap");
+  Written ids;
+  {
+    Writer w(options);
+    w.open(path);
+    const auto schema = w.add_schema({0, "fahr::msg::Test", "omgidl", "module fahr { };"});
+    ids.a = w.add_channel({0, schema, "fahr/A", "cdr", {}});
+    ids.b = w.add_channel({0, schema, "fahr/B", "cdr", {}});
+    // B for the first 200 ms only, A throughout (5 s at 1 kHz).
+    for (std::uint32_t i = 0; i < 5000; ++i) {
+      const auto p = payload(i);
+      const std::uint64_t t = 1'000'000'000ULL + i * 1'000'000ULL;
+      w.write_message(i < 200 && i % 2 == 0 ? ids.b : ids.a, i, t, t, p.data(), p.size());
+    }
+    w.close();
+  }
+  IndexedReader r(path);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_GT(r.chunks().size(), 20U);
+  std::vector<std::pair<std::string, std::uint32_t>> seen;
+  const auto collect = [&](const Channel& c, const MessageView& m) {
+    const auto p = payload(m.sequence);
+    EXPECT_TRUE(std::equal(p.begin(), p.end(), m.data.begin(), m.data.end()));
+    seen.emplace_back(c.topic, m.sequence);
+  };
+  // At 4 s: A's message 2999, B's 198 (its last), oldest first.
+  const auto all = [](const Channel&) { return true; };
+  ASSERT_TRUE(r.read_newest(1'000'000'000ULL + 3000ULL * 1'000'000ULL, all, collect));
+  const std::vector<std::pair<std::string, std::uint32_t>> expected{{"fahr/B", 198},
+                                                                    {"fahr/A", 2999}};
+  EXPECT_EQ(seen, expected);
+  // The chunk before the moment and B's last: not every chunk between.
+  EXPECT_LE(r.chunks_read(), 3U);
+  // Before the first message nothing; 1 ms later B's first alone; a filter
+  // that takes only B.
+  seen.clear();
+  ASSERT_TRUE(r.read_newest(1'000'000'000ULL, all, collect));
+  EXPECT_TRUE(seen.empty());
+  ASSERT_TRUE(r.read_newest(1'000'000'000ULL + 1'000'000ULL, all, collect));
+  ASSERT_EQ(seen.size(), 1U);
+  EXPECT_EQ(seen[0], std::make_pair(std::string("fahr/B"), 0U));
+  seen.clear();
+  ASSERT_TRUE(r.read_newest(
+      1'000'000'000ULL + 4000ULL * 1'000'000ULL,
+      [](const Channel& c) { return c.topic == "fahr/B"; }, collect));
+  ASSERT_EQ(seen.size(), 1U);
+  EXPECT_EQ(seen[0].second, 198U);
+}
+
 TEST(Mcap, IndexedReaderRefusesGarbage) {
   const std::string path = temp_path("garbage.mcap");
   {

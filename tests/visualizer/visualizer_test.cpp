@@ -1,9 +1,9 @@
-// services/visualizer in one process: the live store, the page's frames
-// (strain 0 at rest), and the server against hostile and slow clients (a
-// Boost.Beast client in the test): malformed, oversized, flooding and
-// forbidden messages are refused and counted, the server stays up; a client
-// that stops reading loses its oldest frames while another keeps its rate
-// and the sources never wait.
+// services/visualizer in one process: the live store, a replay seek into a
+// stalled stream, the page's frames (strain 0 at rest), and the server
+// against hostile and slow clients (a Boost.Beast client in the test):
+// malformed, oversized, flooding and forbidden messages are refused and
+// counted, the server stays up; a client that stops reading loses its
+// oldest frames while another keeps its rate and the sources never wait.
 #include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <sys/time.h>
@@ -22,11 +22,14 @@
 #include "fahr/common/cdr_bytes.h"
 #include "fahr/common/clock.h"
 #include "fahr/glottic_view/scene_view.h"
+#include "fahr/mcap/writer.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/visualizer_service/glottic_view_service.h"
 #include "fahr/visualizer_service/live_state.h"
 #include "fahr/visualizer_service/page_model.h"
 #include "fahr/visualizer_service/server.h"
+#include "fahr/visualizer_service/sources.h"
+#include "force_commandPubSubTypes.h"
 #include "glottic_viewPubSubTypes.h"
 #include "sample_factory.h"
 
@@ -96,6 +99,58 @@ TEST(LiveState, ASeeksClearAndRefillAreOneChange) {
   live.clear_streams();
   EXPECT_EQ(live.collect(slots), 1U);
   EXPECT_TRUE(slots[0].bytes.empty());
+}
+
+// A recording in which the recorder received no ForceCommand for 3 s (a
+// lockstep run stalled under a slow FEM step): a seek into the stall shows
+// the last one before it, as the run stood then, not "no command yet".
+TEST(ReplaySource, ASeekIntoAStalledStreamShowsItsLastSample) {
+  const std::string path = ::testing::TempDir() + "fahr_replay_stall.mcap";
+  {
+    mcap::WriterOptions options;
+    options.chunk_size = 8 * 1024ULL;
+    options.sync_chunks = false;
+    mcap::Writer w(options);
+    w.open(path);
+    const auto schema = w.add_schema({0, "fahr::msg::ForceCommand", "omgidl", "module fahr { };"});
+    const auto commands = w.add_channel({0, schema, "fahr/ForceCommand", "cdr", {}});
+    msg::ForceCommand command;
+    test::fill(command, 7, 0);
+    // 1 s of commands at 1 kHz, 3 s of nothing, 1 s more.
+    for (std::uint32_t i = 0; i < 2000; ++i) {
+      const std::uint64_t log = 1'000'000'000ULL * (i < 1000 ? 1 : 4) + i * 1'000'000ULL;
+      command.header().sim_time_ns(static_cast<std::int64_t>(i) * 1'000'000);
+      const auto bytes = test::cdr_bytes(command);
+      w.write_message(commands, i, log, log, bytes.data(), bytes.size());
+    }
+    w.close();
+  }
+  LiveState live;
+  ReplaySource replay(path, live, 1.0);
+  ASSERT_NEAR(replay.duration_s(), 4.999, 1e-6);
+  EXPECT_EQ(replay.control("pause", 0), "");
+  replay.start();
+  // One copy of the store across the seeks: collect() hands over what
+  // changed since, so the state before a seek is not read as its answer.
+  std::vector<Slot> slots;
+  const auto sim_time_at = [&](double seek_s) -> std::int64_t {
+    EXPECT_EQ(replay.control("seek", seek_s), "");
+    for (int i = 0; i < 500; ++i) {
+      std::this_thread::sleep_for(10ms);
+      if (live.collect(slots) == 0) continue;
+      for (const Slot& slot : slots) {
+        if (slot.topic != kForceCommand || slot.bytes.empty()) continue;
+        msg::ForceCommand m;
+        if (common::decode_cdr<msg::ForceCommandPubSubType>(slot.bytes, m))
+          return m.header().sim_time_ns();
+      }
+    }
+    return -1;
+  };
+  EXPECT_EQ(sim_time_at(2.5), 999'000'000);  // 1.5 s into the stall
+  EXPECT_EQ(sim_time_at(4.5), 1'500'000'000);
+  EXPECT_EQ(sim_time_at(0.5), 500'000'000);
+  replay.stop();
 }
 
 TEST(PageModel, TheRestStateHasNoStrainAndAStretchHasSome) {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <utility>
 
 #include "compression.h"
 
@@ -143,6 +144,22 @@ bool IndexedReader::load_chunk(std::size_t index) {
   return true;
 }
 
+bool IndexedReader::scan_loaded_chunk(const std::function<void(const MessageView&)>& fn) const {
+  Decoder in(records_);
+  while (in.remaining() > 0) {
+    const auto op = static_cast<Opcode>(in.u8());
+    const std::uint64_t length = in.u64();
+    const auto body = in.bytes(length);
+    if (!in.ok()) return false;
+    if (op != Opcode::kMessage) continue;
+    bool ok = true;
+    const MessageView m = decode_message(body, ok);
+    if (!ok) return false;
+    fn(m);
+  }
+  return true;
+}
+
 bool IndexedReader::read(std::uint64_t begin, std::uint64_t end, const Handler& fn) {
   if (!ok() || begin >= end) return ok();
   struct Found {
@@ -157,24 +174,70 @@ bool IndexedReader::read(std::uint64_t begin, std::uint64_t end, const Handler& 
     if (!load_chunk(i)) return false;
     // Messages of a chunk are in arrival order, nearly sorted by log time.
     std::vector<Found> found;
-    Decoder in(records_);
-    while (in.remaining() > 0) {
-      const auto op = static_cast<Opcode>(in.u8());
-      const std::uint64_t length = in.u64();
-      const auto body = in.bytes(length);
-      if (!in.ok()) return false;
-      if (op != Opcode::kMessage) continue;
-      bool ok = true;
-      const MessageView m = decode_message(body, ok);
-      if (!ok) return false;
-      if (m.log_time < begin || m.log_time >= end) continue;
+    const bool whole = scan_loaded_chunk([&](const MessageView& m) {
+      if (m.log_time < begin || m.log_time >= end) return;
       auto ch = channels_.find(m.channel_id);
-      if (ch == channels_.end()) continue;
+      if (ch == channels_.end()) return;
       found.push_back({m.log_time, found.size(), &ch->second, m});
-    }
+    });
+    if (!whole) return false;
     std::stable_sort(found.begin(), found.end(),
                      [](const Found& a, const Found& b) { return a.log_time < b.log_time; });
     for (const auto& f : found) fn(*f.channel, f.view);
+  }
+  return true;
+}
+
+bool IndexedReader::read_newest(std::uint64_t end, const ChannelFilter& wanted, const Handler& fn) {
+  if (!ok()) return false;
+  struct Newest {
+    std::uint64_t log_time = 0;
+    std::uint64_t publish_time = 0;
+    std::uint32_t sequence = 0;
+    std::vector<std::uint8_t> data;  // copied: the next chunk read replaces the buffer
+  };
+  std::map<std::uint16_t, Newest> newest;
+  std::map<std::uint16_t, bool> wants;
+  for (const auto& [id, channel] : channels_) wants[id] = wanted(channel);
+  // From the last chunk back. A chunk is read only if it holds a wanted
+  // channel whose newest message found so far is older than the chunk's
+  // end: the index scan costs nothing, the reads stay few.
+  for (std::size_t i = chunks_.size(); i-- > 0;) {
+    const ChunkIndex& c = chunks_[i];
+    if (c.message_start_time >= end) continue;
+    bool useful = false;
+    for (const auto& [id, offset] : c.message_index_offsets) {
+      (void)offset;
+      if (!wants[id]) continue;
+      const auto found = newest.find(id);
+      if (found == newest.end() || found->second.log_time < c.message_end_time) useful = true;
+    }
+    if (!useful) continue;
+    if (!load_chunk(i)) return false;
+    const bool whole = scan_loaded_chunk([&](const MessageView& m) {
+      if (m.log_time >= end || !wants[m.channel_id]) return;
+      auto [it, fresh] = newest.try_emplace(m.channel_id);
+      if (!fresh && it->second.log_time > m.log_time) return;
+      it->second.log_time = m.log_time;
+      it->second.publish_time = m.publish_time;
+      it->second.sequence = m.sequence;
+      it->second.data.assign(m.data.begin(), m.data.end());
+    });
+    if (!whole) return false;
+  }
+  std::vector<std::pair<std::uint16_t, const Newest*>> order;
+  for (const auto& [id, n] : newest) order.emplace_back(id, &n);
+  std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+    return a.second->log_time < b.second->log_time;
+  });
+  for (const auto& [id, n] : order) {
+    MessageView view;
+    view.channel_id = id;
+    view.sequence = n->sequence;
+    view.log_time = n->log_time;
+    view.publish_time = n->publish_time;
+    view.data = n->data;
+    fn(channels_.at(id), view);
   }
   return true;
 }

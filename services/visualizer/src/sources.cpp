@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "device_posePubSubTypes.h"
 #include "fahr/common/cdr_bytes.h"
@@ -127,15 +128,39 @@ std::string ReplaySource::position_json() const {
   return text;
 }
 
+namespace {
+
+// The recorded streams a replay hands the page. The glottic view is
+// recomputed from the recorded geometry (the replay's GlotticViewService),
+// so a recording without it shows it too; the scene is read once.
+bool replayed(std::size_t topic) {
+  return topic != kTopicCount && topic != kSceneDescription && topic != kGlotticView;
+}
+
+}  // namespace
+
 void ReplaySource::fill(std::uint64_t begin, std::uint64_t end) {
   reader_.read(begin, end, [&](const mcap::Channel& c, const mcap::MessageView& m) {
     const std::size_t topic = topic_index(c.topic);
-    // The glottic view is recomputed from the recorded geometry (the
-    // replay's GlotticViewService), so a recording without it shows it too.
-    if (topic == kTopicCount || topic == kSceneDescription || topic == kGlotticView) return;
-    live_.put(topic, m.data, static_cast<std::int64_t>(m.log_time));
+    if (replayed(topic)) live_.put(topic, m.data, static_cast<std::int64_t>(m.log_time));
   });
   chunks_read_ = reader_.chunks_read();
+}
+
+void ReplaySource::refill(std::uint64_t cursor) {
+  // The state as it stood at the cursor: each stream's newest sample
+  // however old (a stream the recorder received nothing of for a while,
+  // a lockstep run stalled under a slow FEM step, still shows its last
+  // sample), then the last half second in order.
+  const std::uint64_t begin = cursor > reader_.start_time() + kSeekHistoryNs
+                                  ? cursor - kSeekHistoryNs
+                                  : reader_.start_time();
+  reader_.read_newest(
+      begin, [](const mcap::Channel& c) { return replayed(topic_index(c.topic)); },
+      [&](const mcap::Channel& c, const mcap::MessageView& m) {
+        live_.put(topic_index(c.topic), m.data, static_cast<std::int64_t>(m.log_time));
+      });
+  fill(begin, cursor + 1);
 }
 
 void ReplaySource::run() {
@@ -144,19 +169,14 @@ void ReplaySource::run() {
     next += std::chrono::nanoseconds(kStepNs);
     std::this_thread::sleep_until(next);
     std::uint64_t begin = 0, end = 0;
-    bool refill = false;
+    std::optional<std::uint64_t> seeked;
     {
       std::lock_guard lock(mutex_);
       if (seek_pending_) {
         seek_pending_ = false;
         cursor_ = seek_to_;
         finished_ = false;
-        refill = true;
-      }
-      if (refill) {
-        begin = cursor_ > reader_.start_time() + kSeekHistoryNs ? cursor_ - kSeekHistoryNs
-                                                                : reader_.start_time();
-        end = cursor_ + 1;
+        seeked = cursor_;
       } else if (!paused_ && !finished_) {
         begin = cursor_ + 1;
         end = std::min(
@@ -166,10 +186,10 @@ void ReplaySource::run() {
         if (cursor_ >= reader_.end_time()) finished_ = true;
       }
     }
-    if (refill) {
+    if (seeked) {
       const LiveState::Batch batch(live_);
       live_.clear_streams();
-      fill(begin, end);
+      refill(*seeked);
     } else if (end > begin) {
       fill(begin, end);
     }

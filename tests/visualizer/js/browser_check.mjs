@@ -358,9 +358,12 @@ if (mode === "live") {
 }
 result.bodies = s.bodies;
 result.tongueRect = rect;
-// Frames at the display rate (live): deformation frames per second over
-// 3 s, after the first burst (a page that starts late reads its socket's
-// backlog).
+// Frames at the display rate (live): deformation frames per second after
+// the first burst (a page that starts late reads its socket's backlog),
+// over at least 3 s and until the FEM has made 20 states (60 s at most): a
+// machine that starves the lockstep run to one or two states a second
+// would otherwise leave a handful of frames to judge, and one frame more or
+// less would decide.
 // The server's own ticks in the same window (its /stats): it sends at most
 // one deformation frame a tick, and a machine that starves it gives fewer.
 const serverTicks = async () => (await (await fetch(new URL("stats", url))).json()).ticks;
@@ -371,8 +374,14 @@ if (mode === "live") {
   const sim0 = s.deformSimTime;
   const ticks0 = await serverTicks();
   const t0 = Date.now();
-  await page.waitForTimeout(3000);
-  s = await stats();
+  const femHz = Number(process.env.FEM_HZ ?? 200);
+  do {
+    await page.waitForTimeout(1000);
+    s = await stats();
+  } while (
+    Date.now() - t0 < 60000 &&
+    (Date.now() - t0 < 3000 || (s.deformSimTime - sim0) * femHz < 20)
+  );
   const ticks1 = await serverTicks();
   const wall = (Date.now() - t0) / 1000;
   result.deformFramesPerSecond = (s.deformFrames - f0) / wall;
@@ -380,8 +389,8 @@ if (mode === "live") {
   // The states the FEM made in that time (its simulated time over its
   // step, FEM_HZ of the scene, 200 for the shipped one): the page can
   // show no more.
-  const femHz = Number(process.env.FEM_HZ ?? 200);
   result.femStatesPerSecond = ((s.deformSimTime - sim0) * femHz) / wall;
+  result.rateWindowS = wall;
 }
 // Let the run go on (the blade presses, the hand pushes past the limit),
 // then look again.
@@ -442,7 +451,8 @@ if (mode !== "replay" && !Number.isFinite(result.femStatesPerSecond)) problems.p
 if (mode !== "replay") {
   const mu = result.serverTicksPerSecond;
   const offered = mu > 0 ? mu * (1 - Math.exp(-result.femStatesPerSecond / mu)) : 0;
-  const floor = Math.max(1, 0.6 * offered);
+  // (At least one frame in the window, whatever was offered.)
+  const floor = Math.max(1 / result.rateWindowS, 0.6 * offered);
   // (Not per tick: frames a starved page reads late from its socket's
   // backlog fall into the window too.)
   const ceiling = 65;

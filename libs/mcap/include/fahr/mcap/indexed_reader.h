@@ -42,12 +42,23 @@ class IndexedReader {
   using Handler = std::function<void(const Channel&, const MessageView&)>;
   bool read(std::uint64_t begin, std::uint64_t end, const Handler& fn);
 
+  // Calls `fn` for the newest message with log_time < end of each channel
+  // that `wanted` accepts, however long before `end` it was written, in
+  // log-time order: the state as it stood at `end`. Reads only chunks that
+  // hold a wanted channel (the chunk indexes say which) and could hold a
+  // newer message of it than one already found. False if a chunk is
+  // damaged.
+  using ChannelFilter = std::function<bool(const Channel&)>;
+  bool read_newest(std::uint64_t end, const ChannelFilter& wanted, const Handler& fn);
+
   // Chunk reads so far (a test checks that a seek reads few).
   std::uint64_t chunks_read() const { return chunks_read_; }
 
  private:
   bool pread_exact(std::uint64_t offset, std::uint64_t size, std::vector<std::uint8_t>& out);
   bool load_chunk(std::size_t index);
+  // Calls `fn` for each message of the loaded chunk; false if it is damaged.
+  bool scan_loaded_chunk(const std::function<void(const MessageView&)>& fn) const;
 
   int fd_ = -1;
   std::uint64_t size_ = 0;

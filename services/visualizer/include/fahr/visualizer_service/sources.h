@@ -64,6 +64,7 @@ class ReplaySource {
  private:
   void run();
   void fill(std::uint64_t begin, std::uint64_t end);
+  void refill(std::uint64_t cursor);
 
   mcap::IndexedReader reader_;
   LiveState& live_;
