@@ -117,11 +117,11 @@ void print_landmarks(const fahr::scenegen::SceneParameters& p,
     if (v.x() < velum_back.x()) velum_back = v;
   }
   std::printf("landmark airway AP behind the soft palate: %.1f mm (at y %.1f)\n",
-              velum_back.x() - pharynx_wall_x(velum_back.y()) - 0.0, velum_back.y());
+              velum_back.x() - posed_pharynx_wall_x(p.airway, velum_back.y()), velum_back.y());
   double narrowest = 1e9;
   double at_y = 0.0;
   for (double y = -18.0; y <= -4.0; y += 0.5) {
-    const double gap = back_of(body, y) - pharynx_wall_x(y);
+    const double gap = back_of(body, y) - posed_pharynx_wall_x(p.airway, y);
     if (gap < narrowest) {
       narrowest = gap;
       at_y = y;
@@ -130,6 +130,14 @@ void print_landmarks(const fahr::scenegen::SceneParameters& p,
   std::printf("landmark airway AP behind the tongue's dorsum: %.1f mm (narrowest, at y %.1f)\n",
               narrowest, at_y);
   std::printf("landmark pharynx lateral walls apart: %.1f mm\n", 2.0 * p.pharynx.half_width_mm);
+  // The scene's glottic_view section, in metres.
+  const GlotticOpening g = glottic_opening(p.airway);
+  std::printf(
+      "glottic_view opening_centre_m [%.7f, %.7f, %.7f] opening_normal [%.6f, %.6f, %.6f]"
+      " opening_major_axis [%.6f, %.6f, %.6f] opening_radius_m %.6f opening_minor_radius_m %.6f\n",
+      g.centre.x() * 1e-3, g.centre.y() * 1e-3, g.centre.z() * 1e-3, g.normal.x(), g.normal.y(),
+      g.normal.z(), g.major_axis.x(), g.major_axis.y(), g.major_axis.z(), g.radius_mm * 1e-3,
+      g.minor_radius_mm * 1e-3);
 }
 
 }  // namespace
@@ -203,7 +211,7 @@ int main(int argc, char** argv) {
   anatomy["larynx_trachea"] = make_larynx_trachea(params.airway, res);
   anatomy["epiglottis"] = make_epiglottis(params.epiglottis, params.airway, res);
   anatomy["soft_palate"] = make_soft_palate(params.soft_palate, params.palate, body_shape, res);
-  anatomy["pharynx"] = make_pharynx(params.pharynx, res);
+  anatomy["pharynx"] = make_pharynx(params.pharynx, params.airway, res);
   std::map<std::string, TriangleMesh> blades;
   blades["miller0"] = make_miller_blade(params.miller0, res);
   blades["miller1"] = make_miller_blade(params.miller1, res);
@@ -245,7 +253,7 @@ int main(int argc, char** argv) {
       {"hyoid", hyoid_box(params.hyoid, params.floor, params.tongue, res)},
       {"epiglottis", epiglottis_box(params.epiglottis, params.airway, res)},
       {"soft_palate", soft_palate_box(params.soft_palate, params.palate, body_shape, res)},
-      {"pharynx", pharynx_box(params.pharynx, res)}};
+      {"pharynx", pharynx_box(params.pharynx, params.airway, res)}};
   for (const auto& [name, box] : boxes) {
     const int folded = folded_box_tets(box);
     std::printf("%s: %d folded or flat tets in its %dx%dx%d parameter lattice\n", name.c_str(),

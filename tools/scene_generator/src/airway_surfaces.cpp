@@ -46,9 +46,39 @@ std::pair<double, double> lumen(const AirwayParameters& p, double depth) {
 
 }  // namespace
 
+Vec3 neck_pose(const AirwayParameters& p, const Vec3& neutral) {
+  if (p.extension_deg == 0.0) return neutral;  // the neutral head, bit for bit
+  const double below = std::clamp((p.pivot_y_mm - neutral.y()) / p.bend_mm, 0.0, 1.0);
+  // Extension turns the head's face up; in its frame the neck turns the
+  // other way (posterior going down): clockwise seen from +z.
+  const double angle = -radians(p.extension_deg) * smoothstep(0.0, 1.0, below);
+  const double dx = neutral.x() - p.pivot_x_mm;
+  const double dy = neutral.y() - p.pivot_y_mm;
+  return Vec3(p.pivot_x_mm + std::cos(angle) * dx - std::sin(angle) * dy,
+              p.pivot_y_mm + std::sin(angle) * dx + std::cos(angle) * dy, neutral.z());
+}
+
+GlotticOpening glottic_opening(const AirwayParameters& p) {
+  const LarynxFrame f = larynx_frame(p);
+  // The larynx lies wholly below the bend: its directions turn by the
+  // whole angle.
+  const double angle = -radians(p.extension_deg);
+  const auto turn = [angle](const Vec3& v) {
+    return Vec3(std::cos(angle) * v.x() - std::sin(angle) * v.y(),
+                std::sin(angle) * v.x() + std::cos(angle) * v.y(), v.z());
+  };
+  GlotticOpening g;
+  g.centre = neck_pose(p, f.inlet + (p.glottis_depth_mm - 0.1) * f.down);
+  g.normal = turn(-f.down).normalized();
+  g.major_axis = turn(f.anterior).normalized();
+  g.radius_mm = p.glottis_half_length_mm - 0.15;
+  g.minor_radius_mm = p.glottis_half_width_mm - 0.1;
+  return g;
+}
+
 Vec3 larynx_axis_point(const AirwayParameters& p, double depth_mm) {
   const LarynxFrame f = larynx_frame(p);
-  return f.inlet + depth_mm * f.down;
+  return neck_pose(p, f.inlet + depth_mm * f.down);
 }
 
 TriangleMesh make_larynx_trachea(const AirwayParameters& p, double resolution_mm) {
@@ -68,8 +98,8 @@ TriangleMesh make_larynx_trachea(const AirwayParameters& p, double resolution_mm
     const double depth = rim + (total - rim) * axial;
     const auto [half_ap, half_lateral] = lumen(p, depth);
     const double wall = p.wall_thickness_mm * radial;
-    return Vec3(f.inlet + depth * f.down + (half_ap + wall) * std::cos(a) * f.anterior +
-                (half_lateral + wall) * std::sin(a) * lateral);
+    return neck_pose(p, f.inlet + depth * f.down + (half_ap + wall) * std::cos(a) * f.anterior +
+                            (half_lateral + wall) * std::sin(a) * lateral);
   };
   const int n_around = cells_for(2.0 * kPi * (p.vestibule_half_ap_mm + p.wall_thickness_mm),
                                  0.5 * resolution_mm, 24);
@@ -83,7 +113,7 @@ ParamBox epiglottis_box(const EpiglottisParameters& e, const AirwayParameters& a
   const double base_y = (f.inlet - a.fold_rise_mm * f.down).y() + e.base_gap_mm;
   const double lean = std::tan(radians(e.lean_back_deg));
   const double curl = radians(e.curl_deg);
-  const auto map = [e, base_y, lean, curl](double u, double v, double w) {
+  const auto map = [e, a, base_y, lean, curl](double u, double v, double w) {
     const double y = base_y + e.length_mm * u;
     const double front = e.front_x_mm - lean * e.length_mm * u;
     // Narrow at the base (the petiole), full curl from a third of the way up.
@@ -92,7 +122,7 @@ ParamBox epiglottis_box(const EpiglottisParameters& e, const AirwayParameters& a
     // The lingual face is the arc; the laryngeal face lies a thickness
     // inside it, towards the curl's centre (posterior).
     const double r = radius - e.thickness_mm * w;
-    return Vec3(front - radius + r * std::cos(phi), y, r * std::sin(phi));
+    return neck_pose(a, Vec3(front - radius + r * std::cos(phi), y, r * std::sin(phi)));
   };
   return {map, cells_for(e.length_mm, 0.5 * resolution_mm),
           cells_for(2.0 * curl * e.radius_mm, 0.4 * resolution_mm), 2};
@@ -160,22 +190,40 @@ double pharynx_wall_x(double y_mm) {
   return kWall(y_mm);
 }
 
-ParamBox pharynx_box(const PharynxParameters& p, double resolution_mm) {
-  const auto map = [p](double u, double v, double w) {
+double posed_pharynx_wall_x(const AirwayParameters& p, double y_mm) {
+  if (p.extension_deg == 0.0) return pharynx_wall_x(y_mm);
+  // The wall's posed mid-line, walked down until it crosses y.
+  constexpr double kStepMm = 0.1;
+  Vec3 above = neck_pose(p, Vec3(pharynx_wall_x(40.0), 40.0, 0.0));
+  for (double y = 40.0 - kStepMm; y > -120.0; y -= kStepMm) {
+    const Vec3 below = neck_pose(p, Vec3(pharynx_wall_x(y), y, 0.0));
+    if (below.y() <= y_mm && above.y() >= y_mm) {
+      const double t = above.y() > below.y() ? (above.y() - y_mm) / (above.y() - below.y()) : 0.0;
+      return above.x() + t * (below.x() - above.x());
+    }
+    above = below;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+ParamBox pharynx_box(const PharynxParameters& p, const AirwayParameters& airway,
+                     double resolution_mm) {
+  const auto map = [p, airway](double u, double v, double w) {
     const double y = p.top_y_mm + (p.bottom_y_mm - p.top_y_mm) * u;
     const double centre = pharynx_wall_x(y) + p.depth_mm;
     const double phi = (2.0 * v - 1.0) * 0.5 * kPi;  // 0 at the back, +-90 deg at the arms' ends
     const double depth = p.depth_mm + p.thickness_mm * w;
     const double half_width = p.half_width_mm + p.thickness_mm * w;
-    return Vec3(centre - depth * std::cos(phi), y, half_width * std::sin(phi));
+    return neck_pose(airway, Vec3(centre - depth * std::cos(phi), y, half_width * std::sin(phi)));
   };
   const double arc = 0.5 * kPi * (p.depth_mm + p.half_width_mm);
   return {map, cells_for(p.top_y_mm - p.bottom_y_mm, resolution_mm), cells_for(arc, resolution_mm),
           2};
 }
 
-TriangleMesh make_pharynx(const PharynxParameters& p, double resolution_mm) {
-  return make_param_box(pharynx_box(p, resolution_mm));
+TriangleMesh make_pharynx(const PharynxParameters& p, const AirwayParameters& airway,
+                          double resolution_mm) {
+  return make_param_box(pharynx_box(p, airway, resolution_mm));
 }
 
 }  // namespace fahr::scenegen

@@ -110,6 +110,15 @@ struct AirwayParameters {
   double trachea_length_mm = 42.0;
   double trachea_lumen_radius_mm = 2.3;  // ~4.6 mm lumen diameter
   double wall_thickness_mm = 1.5;
+  // Head extension (0: the neutral head the rest is given for). In the
+  // head's frame the neck turns the other way about the craniocervical
+  // pivot: larynx, trachea and epiglottis rigidly, the pharyngeal wall from
+  // none at the pivot's height to all of it bend_mm below. The pivot is an
+  // estimate: behind the pharyngeal wall at the level of the hard palate.
+  double extension_deg = 0.0;
+  double pivot_x_mm = -62.0;
+  double pivot_y_mm = 5.0;
+  double bend_mm = 10.0;
 };
 
 // Epiglottis: a curled leaf (U in cross-section, its concave laryngeal face
