@@ -103,6 +103,42 @@ TEST_F(SceneGeneratorTest, CommittedFilesAreTheGeneratorOutput) {
   }
 }
 
+// The numbers after `key` in `text` (up to the line's end): "[a, b, c]" or
+// one value.
+std::vector<double> numbers_after(const std::string& text, const std::string& key) {
+  std::vector<double> out;
+  const auto at = text.find(key);
+  if (at == std::string::npos) return out;
+  const auto end = text.find('\n', at);
+  std::string line = text.substr(at + key.size(), end - at - key.size());
+  for (char& c : line) {
+    if (c == '[' || c == ']' || c == ',' || c == ':') c = ' ';
+  }
+  std::istringstream in(line);
+  // Up to the next key (a word): the generator prints them on one line.
+  for (double v = 0.0; in >> v;) out.push_back(v);
+  return out;
+}
+
+// The shipped scene's glottic_view opening is the generator's glottic slit
+// for the shipped parameters: a larynx moved in the generator without the
+// scene following would score a view of nothing.
+TEST_F(SceneGeneratorTest, TheScenesGlotticOpeningIsTheGeneratedSlit) {
+  const std::string log = slurp(*first_ / "generator.log");
+  const std::string scene = slurp(FAHR_NEONATAL_SCENE);
+  ASSERT_NE(log.find("glottic_view "), std::string::npos) << "the generator printed no opening";
+  for (const std::string key : {"opening_centre_m", "opening_normal", "opening_major_axis",
+                                "opening_radius_m", "opening_minor_radius_m"}) {
+    const auto generated = numbers_after(log, key + " ");
+    const auto shipped = numbers_after(scene, "  " + key + ":");
+    ASSERT_FALSE(generated.empty()) << key;
+    ASSERT_EQ(generated.size(), shipped.size()) << key;
+    for (std::size_t i = 0; i < generated.size(); ++i) {
+      EXPECT_NEAR(generated[i], shipped[i], 1e-6) << key << "[" << i << "]";
+    }
+  }
+}
+
 TEST_F(SceneGeneratorTest, TetsHavePositiveVolumeAndBoundaryIsClosed) {
   MeshedSolid tongue;
   std::string error;
