@@ -65,7 +65,7 @@ GlotticOpening glottic_opening(const AirwayParameters& p) {
   const double angle = -radians(p.extension_deg);
   const auto turn = [angle](const Vec3& v) {
     return Vec3(std::cos(angle) * v.x() - std::sin(angle) * v.y(),
-                std::sin(angle) * v.x() + std::cos(angle) * v.y(), v.z());
+                std::sin(angle) * v.x() + std::cos(angle) * v.y(), v.z() + 0.0);  // no -0
   };
   GlotticOpening g;
   g.centre = neck_pose(p, f.inlet + (p.glottis_depth_mm - 0.1) * f.down);
