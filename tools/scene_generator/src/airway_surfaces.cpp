@@ -44,33 +44,32 @@ std::pair<double, double> lumen(const AirwayParameters& p, double depth) {
   return {ap(depth), lateral(depth)};
 }
 
+// `v` turned with the neck by `share` of the head's extension: extension
+// turns the face up, so in the head's frame the neck turns the other way
+// (posterior going down), clockwise seen from +z.
+Vec3 neck_turn(const AirwayParameters& p, const Vec3& v, double share) {
+  const double angle = -radians(p.extension_deg) * share;
+  return Vec3(std::cos(angle) * v.x() - std::sin(angle) * v.y(),
+              std::sin(angle) * v.x() + std::cos(angle) * v.y(), v.z() + 0.0);  // no -0
+}
+
 }  // namespace
 
 Vec3 neck_pose(const AirwayParameters& p, const Vec3& neutral) {
   if (p.extension_deg == 0.0) return neutral;  // the neutral head, bit for bit
   const double below = std::clamp((p.pivot_y_mm - neutral.y()) / p.bend_mm, 0.0, 1.0);
-  // Extension turns the head's face up; in its frame the neck turns the
-  // other way (posterior going down): clockwise seen from +z.
-  const double angle = -radians(p.extension_deg) * smoothstep(0.0, 1.0, below);
-  const double dx = neutral.x() - p.pivot_x_mm;
-  const double dy = neutral.y() - p.pivot_y_mm;
-  return Vec3(p.pivot_x_mm + std::cos(angle) * dx - std::sin(angle) * dy,
-              p.pivot_y_mm + std::sin(angle) * dx + std::cos(angle) * dy, neutral.z());
+  const Vec3 pivot(p.pivot_x_mm, p.pivot_y_mm, 0.0);
+  return pivot + neck_turn(p, neutral - pivot, smoothstep(0.0, 1.0, below));
 }
 
 GlotticOpening glottic_opening(const AirwayParameters& p) {
   const LarynxFrame f = larynx_frame(p);
   // The larynx lies wholly below the bend: its directions turn by the
   // whole angle.
-  const double angle = -radians(p.extension_deg);
-  const auto turn = [angle](const Vec3& v) {
-    return Vec3(std::cos(angle) * v.x() - std::sin(angle) * v.y(),
-                std::sin(angle) * v.x() + std::cos(angle) * v.y(), v.z() + 0.0);  // no -0
-  };
   GlotticOpening g;
   g.centre = neck_pose(p, f.inlet + (p.glottis_depth_mm - 0.1) * f.down);
-  g.normal = turn(-f.down).normalized();
-  g.major_axis = turn(f.anterior).normalized();
+  g.normal = neck_turn(p, -f.down, 1.0).normalized();
+  g.major_axis = neck_turn(p, f.anterior, 1.0).normalized();
   g.radius_mm = p.glottis_half_length_mm - 0.15;
   g.minor_radius_mm = p.glottis_half_width_mm - 0.1;
   return g;
