@@ -1,13 +1,16 @@
 // fahr_fem_service: the FEM deformation service. Steps the scene's
-// deformable body at the scene's FEM rate, applies the newest ContactSet
-// (Algorithm 1 projection), publishes DeformationState with the contact
-// compliance of the spheres the haptic service is working with, and reports
-// its step time and QoS events. Real time or lockstep, as the scene says.
+// deformable bodies at the scene's FEM rate, applies each body's newest
+// ContactSet (Algorithm 1 projection), publishes a DeformationState per body
+// with the contact compliance of the spheres the haptic service is working
+// with, and reports its step time and QoS events. Real time or lockstep, as
+// the scene says.
 //
 //   fahr_fem_service --scene FILE [--dds V] [--domain N] [--dds-profile F]
 //                    [--duration-s S] [--mode realtime|lockstep] [--cpus LIST]
 #include <chrono>
 #include <cstdio>
+#include <memory>
+#include <vector>
 
 #include "fahr/cli/cli.h"
 #include "fahr/common/service_reporter.h"
@@ -33,15 +36,19 @@ int run(int argc, char** argv) {
   if (const auto exit = app.parse(argc, argv)) return *exit;
   runtime::pin_to_cpus(options.cpus);
 
-  // Set-up: the scene's deformable body, the transport, the status reporter.
+  // Set-up: the scene's deformable bodies, the transport, the status reporter.
   const auto scene = scene::load_scene(options.scene_path);
-  const BodyChoice choice = choose_body(*scene);
-  if (!choice.body) return choice.exit_status;
+  const std::vector<std::size_t> bodies = choose_bodies(*scene);
+  if (bodies.empty()) return 0;
   const bool lockstep = options.lockstep(*scene);
   const double duration_s = options.duration_or_scene_s(*scene);
   common::install_stop_handlers();
-  FemBodySetup setup = set_up_body(*scene, scene->bodies[*choice.body]);
-  ServiceStep fem_step(setup);
+  std::vector<std::unique_ptr<FemBodySetup>> setups;
+  BodySteps steps;
+  for (const std::size_t body : bodies) {
+    setups.push_back(std::make_unique<FemBodySetup>(set_up_body(*scene, scene->bodies[body])));
+    steps.push_back(std::make_unique<ServiceStep>(*setups.back()));
+  }
   common::Participant participant(runtime::transport_for(*scene, options.dds, options.domain,
                                                          options.profile, "fem", options.security));
   common::TickRecorder recorder;
@@ -51,21 +58,21 @@ int run(int argc, char** argv) {
        scene->rates.status_period() > 0ns
            ? std::chrono::duration_cast<std::chrono::milliseconds>(scene->rates.status_period())
            : 250ms},
-      recorder, [&](auto& metrics) { fem_step.metrics(metrics); },
+      recorder, [&](auto& metrics) { append_metrics(steps, metrics); },
       // Refused ContactSets, failed solves, resets: said here, off the step.
-      [&](auto& errors) { fem_step.take_errors(errors); });
+      [&](auto& errors) { take_errors(steps, errors); });
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // launchers wait for the start line
-  print_start_line(participant, setup, *scene, lockstep);
+  print_start_lines(participant, steps, *scene, lockstep);
 
   // The loop.
   reporter.set_state(msg::SERVICE_RUNNING);
-  const int status = lockstep ? run_lockstep(participant, fem_step, *scene, recorder)
-                              : run_realtime(participant, fem_step, *scene, recorder, duration_s);
+  const int status = lockstep ? run_lockstep(participant, steps, *scene, recorder)
+                              : run_realtime(participant, steps, *scene, recorder, duration_s);
 
   // Shutdown.
   reporter.set_state(msg::SERVICE_STOPPING);
   reporter.report();
-  print_end_line(fem_step);
+  print_end_lines(steps);
   return status;
 }
 

@@ -100,8 +100,21 @@ int main(int argc, char** argv) try {
     std::vector<double> query_new_state_us, query_same_state_us, spheres_new_state,
         spheres_same_state;
     std::uint64_t states_seen = sim.haptic().metrics().snapshots.load(std::memory_order_relaxed);
+    // Per deformable body: ticks whose ContactSet held a tool contact (active
+    // or frozen, not a candidate) and the most such contacts in one set.
+    std::vector<std::uint64_t> touched_ticks(sim.body_count(), 0);
+    std::vector<std::size_t> most_touching(sim.body_count(), 0);
     for (std::uint64_t k = 0; k < steps; ++k) {
       sim.step();
+      for (std::size_t b = 0; b < sim.body_count(); ++b) {
+        const auto& contacts = sim.contacts(b).contacts();
+        const auto touching = static_cast<std::size_t>(
+            std::count_if(contacts.begin(), contacts.end(), [](const msg::Contact& c) {
+              return c.kind() != msg::CONTACT_OBSTACLE && c.state() != msg::CONSTRAINT_CANDIDATE;
+            }));
+        if (touching > 0) ++touched_ticks[b];
+        most_touching[b] = std::max(most_touching[b], touching);
+      }
       const auto& report = sim.haptic().response().report();
       pgs_cost.push_back(static_cast<double>(report.pgs_work.row_visits) *
                          static_cast<double>(report.load.rows));
@@ -156,6 +169,26 @@ int main(int argc, char** argv) try {
         "%llu\n",
         static_cast<unsigned long long>(sim.fem().anatomy_returned()),
         static_cast<unsigned long long>(sim.fem().anatomy_beyond_steps()));
+    for (std::size_t b = 0; b < sim.body_count() && sim.body_count() > 1; ++b) {
+      // The body's largest node motion from rest.
+      const auto& rest = sim.fem(b).setup().mesh.rest_positions();
+      const auto x = sim.body(b).positions_m();
+      double moved = 0.0;
+      for (std::size_t n = 0; n < rest.size(); ++n) {
+        const Eigen::Vector3d p(x[3 * n], x[3 * n + 1], x[3 * n + 2]);
+        moved = std::max(moved, (p - rest[n]).norm());
+      }
+      std::printf(
+          "stack_sim: body '%s': ticks with tool contacts %llu, most in one set %zu, largest node "
+          "motion %.2f mm, ContactSets refused: layout %llu, unknown sphere %llu; max inverted "
+          "elements %llu, resets %llu\n",
+          sim.fem(b).setup().scene_body->name.c_str(),
+          static_cast<unsigned long long>(touched_ticks[b]), most_touching[b], 1e3 * moved,
+          static_cast<unsigned long long>(sim.fem(b).layout_check().refused()),
+          static_cast<unsigned long long>(sim.fem(b).unknown_sphere_sets()),
+          static_cast<unsigned long long>(sim.fem(b).inverted_max()),
+          static_cast<unsigned long long>(sim.fem(b).divergence_resets()));
+    }
     const auto& cpu = sim.haptic_tick_cpu();
     const auto& fem_cpu = sim.fem_step_cpu();
     // The tissue-fidelity lines, as scripts grep them: over the whole run.

@@ -248,7 +248,8 @@ TEST(Admission, OneSourceInOrderAndValidAnotherWriterAfterTheSourceFallsSilent) 
           [](const msg::DevicePose& p) {
             return std::isfinite(p.world_from_stylus().position_m().x());
           },
-      .counts = std::make_shared<common::AdmissionCounts>()};
+      .counts = std::make_shared<common::AdmissionCounts>(),
+      .wanted = {}};
   common::Subscriber<msg::DevicePose> sub(b, admission);
   ForgingWriter source(a);
   ForgingWriter intruder(a);

@@ -10,7 +10,12 @@
 # transport), which stack_sim_pinned_hashes checks. Then once more with W
 # along the normals (solver.compliance_columns: normals, 64 spheres, whose
 # columns and normals cross DDS in DeformationState.compliance_normals),
-# on Cyclone DDS against the same in one process.
+# on Cyclone DDS against the same in one process. Last, two deformable
+# bodies: the tongue and a copy of it 1 mm above (both under the blade), which
+# one FEM service steps and the haptic service queries as one tissue, each
+# with its own ContactSets and DeformationStates: Cyclone DDS against the same
+# in one process, both bodies touched and moved, no set refused, and a larger
+# peak force than the tongue's alone (the copy's reaction is felt).
 #
 # One BLAS thread everywhere: CHOLMOD's supernodal factorisation rounds
 # differently with another OpenBLAS thread count (measured: the FEM hash
@@ -40,6 +45,18 @@ run() {
   [ "$(wc -l <"$tmp/$vendor.hashes")" -eq 3 ] || { echo "FAIL: $vendor run: expected 3 hashes"; exit 1; }
 }
 
+# The in-process run of SCENE (its output in $tmp/NAME.txt) must give the
+# hashes of the last Cyclone DDS run.
+same_in_process() {
+  local scene=$1 name=$2 what=$3
+  "$build/sim/stack_sim_run/fahr_stack_sim_run" --seconds 4 --scene "$scene" | tee "$tmp/$name.txt"
+  grep "^lockstep_clock: hash" "$tmp/$name.txt" | sort >"$tmp/$name.hashes"
+  if ! diff "$tmp/cyclonedds.hashes" "$tmp/$name.hashes"; then
+    echo "FAIL: $what the in-process run differs from the DDS run"
+    exit 1
+  fi
+}
+
 run cyclonedds 61
 run fastdds 62
 if ! diff "$tmp/cyclonedds.hashes" "$tmp/fastdds.hashes"; then
@@ -61,15 +78,32 @@ sed -e "s|\.\./\.\./meshes/|$repo/meshes/|" \
 grep -q "^  compliance_columns: normals" "$tmp/normals.yaml" || { echo "FAIL: could not write the normals scene"; exit 1; }
 cp "$tmp/cyclonedds.hashes" "$tmp/blocks.hashes"
 run cyclonedds 63 "$tmp/normals.yaml"
-"$build/sim/stack_sim_run/fahr_stack_sim_run" --seconds 4 --scene "$tmp/normals.yaml" | tee "$tmp/normals_inprocess.txt"
-grep "^lockstep_clock: hash" "$tmp/normals_inprocess.txt" | sort >"$tmp/normals_inprocess.hashes"
-if ! diff "$tmp/cyclonedds.hashes" "$tmp/normals_inprocess.hashes"; then
-  echo "FAIL: with W along the normals the in-process run differs from the DDS run"
-  exit 1
-fi
+same_in_process "$tmp/normals.yaml" normals_inprocess "with W along the normals"
 # The option changed the physics (the FEM's W and the rows): not the same run.
 if diff -q "$tmp/blocks.hashes" "$tmp/cyclonedds.hashes" >/dev/null; then
   echo "FAIL: W along the normals gave the same hashes as the 3x3 blocks"
   exit 1
 fi
-echo "PASS: identical hashes on both vendors and the pinned in-process ones, with W as blocks and along the normals"
+
+# Two deformable bodies: the tongue and a copy 1 mm above it.
+bash "$repo/bench/support/two_tongues_scene.sh" "$repo/deployment/scenes/neonatal_intubation.yaml" \
+  >"$tmp/two_bodies.yaml"
+run cyclonedds 64 "$tmp/two_bodies.yaml"
+same_in_process "$tmp/two_bodies.yaml" two_inprocess "with two deformable bodies"
+for body in tongue tongue_b; do
+  line=$(grep "^stack_sim: body '$body':" "$tmp/two_inprocess.txt") || { echo "FAIL: no line for body $body"; exit 1; }
+  touched=$(sed -n 's/.*ticks with tool contacts \([0-9]*\),.*/\1/p' <<<"$line")
+  moved=$(sed -n 's/.*largest node motion \([0-9.]*\) mm.*/\1/p' <<<"$line")
+  refused=$(sed -n 's/.*refused: layout \([0-9]*\), unknown sphere \([0-9]*\);.*/\1 \2/p' <<<"$line")
+  [ "${touched:-0}" -gt 100 ] || { echo "FAIL: the blade touched $body in ${touched:-0} ticks"; exit 1; }
+  awk -v m="$moved" 'BEGIN { exit !(m > 1.0) }' || { echo "FAIL: $body moved only $moved mm"; exit 1; }
+  [ "$refused" = "0 0" ] || { echo "FAIL: $body refused ContactSets ($refused)"; exit 1; }
+done
+# The haptic service's peak force on the tongue alone (the Fast DDS run's),
+# and in one process with both bodies.
+one=$(sed -n 's/.*fahr_haptic_service: .* peak |F| \([0-9.]*\) N.*/\1/p' "$tmp/fastdds.txt")
+two=$(sed -n 's/^stack_sim: .* peak |F| \([0-9.]*\) N.*/\1/p' "$tmp/two_inprocess.txt")
+echo "peak |F|: tongue alone ${one:-?} N, tongue and its copy ${two:-?} N"
+awk -v a="${one:-0}" -v b="${two:-0}" 'BEGIN { exit !(a > 0 && b > 1.2 * a) }' ||
+  { echo "FAIL: two bodies under the blade gave no larger force (${two:-?} N) than one (${one:-?} N)"; exit 1; }
+echo "PASS: identical hashes on both vendors and the pinned in-process ones, with W as blocks and along the normals, and with two deformable bodies"

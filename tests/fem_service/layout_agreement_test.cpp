@@ -46,7 +46,7 @@ TEST(LayoutAgreement, BothServicesBuildTheSameLayoutAndOtherSettingsDiffer) {
   const auto scene = shipped_scene();
   const haptic_service::HapticSetup haptic = haptic_service::set_up(*scene);
   haptic_service::HapticLoop loop(haptic);
-  FemBodySetup fem = set_up_body(*scene, *haptic.deformable);
+  FemBodySetup fem = set_up_body(*scene, *haptic.bodies.front().body);
 
   // Equal, and published: in the SceneDescription of the deformable body
   // (0 for the rigid ones) and in every ContactSet.
@@ -55,7 +55,8 @@ TEST(LayoutAgreement, BothServicesBuildTheSameLayoutAndOtherSettingsDiffer) {
   EXPECT_EQ(fem.links.size(), haptic.layout.size());
   EXPECT_EQ(loop.layout_fingerprint(), fingerprint);
   for (const msg::SceneDescription& d : haptic_service::describe_scene(haptic)) {
-    EXPECT_EQ(d.layout_fingerprint(), d.body_id() == haptic.deformable->id ? fingerprint : 0u)
+    EXPECT_EQ(d.layout_fingerprint(),
+              d.body_id() == haptic.bodies.front().body->id ? fingerprint : 0u)
         << d.body_name();
   }
   const msg::ContactSet set = haptic_contact_set(haptic, loop);
@@ -72,7 +73,7 @@ TEST(LayoutAgreement, BothServicesBuildTheSameLayoutAndOtherSettingsDiffer) {
   // its service refuses the haptic service's set.
   auto other = std::make_shared<scene::Scene>(*scene);
   scene::Body& tongue =
-      other->bodies[static_cast<std::size_t>(haptic.deformable - scene->bodies.data())];
+      other->bodies[static_cast<std::size_t>(haptic.bodies.front().body - scene->bodies.data())];
   tongue.deformable->aist.sphere_tet_volume_ratio *= 1.5;
   FemBodySetup other_fem = set_up_body(*other, tongue);
   EXPECT_NE(other_fem.layout_fingerprint, fingerprint);

@@ -65,6 +65,7 @@ using common::to_eigen;
 // A DeformationState with the body at rest and no compliance yet.
 msg::DeformationState rest_state(const HapticSetup& setup) {
   msg::DeformationState state;
+  state.body_id(setup.bodies.front().body->id);
   for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
     for (int a = 0; a < 3; ++a) state.positions_m().push_back(static_cast<float>(x[a]));
   }
@@ -79,7 +80,6 @@ msg::DeformationState rest_with_compliance(const HapticSetup& setup,
                                            const msg::ContactSet& contacts, std::uint64_t step,
                                            float w_mpn = 0.02f) {
   msg::DeformationState state = rest_state(setup);
-  state.body_id(setup.deformable->id);
   state.step(step);
   auto& ids = state.compliance_sphere_ids();
   for (const msg::Contact& c : contacts.contacts()) {
@@ -448,6 +448,7 @@ TEST(TissueDigest, RefusesStatesThatDoNotFit) {
   TissueDigest digest(setup);
   TissueSnapshot snapshot = digest.make_snapshot();
   msg::DeformationState state;
+  state.body_id(setup.bodies.front().body->id);
   state.positions_m().assign(3 * setup.mesh.node_count() - 3, 0.0f);
   EXPECT_FALSE(digest.digest(state, snapshot));
   for (const Eigen::Vector3d& x : setup.mesh.rest_positions()) {
@@ -461,6 +462,11 @@ TEST(TissueDigest, RefusesStatesThatDoNotFit) {
   EXPECT_FALSE(digest.digest(state, snapshot));
   state.positions_m()[7] = static_cast<float>(setup.mesh.rest_positions()[2].y());
   ASSERT_TRUE(digest.digest(state, snapshot));
+  // The state of a body the scene does not have (its key another id).
+  state.body_id(state.body_id() + 1);
+  EXPECT_FALSE(digest.plausible(state));
+  EXPECT_FALSE(digest.digest(state, snapshot));
+  state.body_id(setup.bodies.front().body->id);
   // A non-finite W, W normal or free centre: the state is refused whole.
   state.compliance_sphere_ids().assign({3, 4});
   state.compliance_mpn().assign(36, 0.01f);

@@ -135,4 +135,58 @@ std::uint64_t SphereLayout::fingerprint() const {
   return hash;
 }
 
+SphereLayout concatenate(std::span<const SphereLayout* const> layouts,
+                         std::span<const std::size_t> node_offsets) {
+  if (layouts.size() != node_offsets.size() || layouts.empty())
+    throw std::invalid_argument("concatenate: one node offset per layout, at least one layout");
+  std::vector<SphereRecord> spheres;
+  std::vector<std::uint32_t> link_nodes;
+  std::vector<double> link_weights;
+  std::vector<std::uint32_t> linked_tets;
+  std::vector<geometry::Tet> tets;
+  std::vector<SurfaceAnchor> anchors;
+  std::vector<std::uint8_t> has_anchor;
+  std::size_t node_count = 0;
+  int finest_level = 0;
+  double coarse_radius_m = 0.0;
+  bool any_anchor = false;
+  for (const SphereLayout* layout : layouts) any_anchor = any_anchor || layout->anchor_count() > 0;
+  for (std::size_t b = 0; b < layouts.size(); ++b) {
+    const SphereLayout& layout = *layouts[b];
+    const std::size_t node_offset = node_offsets[b];
+    if (node_offset != node_count)
+      throw std::invalid_argument("concatenate: node offsets must follow the bodies' node counts");
+    const auto node = [&](std::uint32_t n) { return static_cast<std::uint32_t>(n + node_offset); };
+    const auto tet_offset = static_cast<std::uint32_t>(tets.size());
+    for (std::size_t i = 0; i < layout.size(); ++i) {
+      SphereRecord record = layout.sphere(i);
+      record.first_link = static_cast<std::uint32_t>(link_nodes.size());
+      record.first_tet = static_cast<std::uint32_t>(linked_tets.size());
+      for (const std::uint32_t n : layout.nodes(i)) link_nodes.push_back(node(n));
+      for (const double w : layout.weights(i)) link_weights.push_back(w);
+      for (const std::uint32_t t : layout.tets_of(i)) linked_tets.push_back(t + tet_offset);
+      spheres.push_back(record);
+      if (any_anchor) {
+        const SurfaceAnchor* anchor = layout.anchor(i);
+        SurfaceAnchor shifted = anchor != nullptr ? *anchor : SurfaceAnchor{};
+        for (auto& n : shifted.nodes) n = node(n);
+        anchors.push_back(shifted);
+        has_anchor.push_back(anchor != nullptr ? 1 : 0);
+      }
+    }
+    for (geometry::Tet t : layout.tets()) {
+      for (auto& n : t) n = static_cast<geometry::Index>(static_cast<std::size_t>(n) + node_offset);
+      tets.push_back(t);
+    }
+    node_count += layout.node_count();
+    finest_level = std::max(finest_level, layout.finest_level());
+    coarse_radius_m = std::max(coarse_radius_m, layout.coarse_radius_m());
+  }
+  SphereLayout joined(std::move(spheres), std::move(link_nodes), std::move(link_weights),
+                      std::move(linked_tets), std::move(tets), node_count, finest_level,
+                      coarse_radius_m);
+  if (any_anchor) joined.set_anchors(std::move(anchors), std::move(has_anchor));
+  return joined;
+}
+
 }  // namespace fahr::sphere_layout

@@ -112,9 +112,10 @@ int run_realtime(const GatewayOptions& o, GatewaySetup& setup, common::Participa
   // One haptic service at a time: another writer's commands are refused
   // while it has sent within 1 s, and a restarted one is followed after that.
   common::Subscriber<msg::ForceCommand> command_sub(
-      participant,
-      common::Admission<msg::ForceCommand>{
-          .takeover = std::chrono::seconds(1), .valid = {}, .counts = metrics.command_admission});
+      participant, common::Admission<msg::ForceCommand>{.takeover = std::chrono::seconds(1),
+                                                        .valid = {},
+                                                        .counts = metrics.command_admission,
+                                                        .wanted = {}});
   std::unique_ptr<common::Subscriber<msg::DevicePose>> remote_sub;
   if (setup.remote != nullptr) {
     remote_sub = std::make_unique<common::Subscriber<msg::DevicePose>>(

@@ -19,44 +19,53 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-// A step's CPU is its thread's and what the background factorisation
-// used since the step before (fem SolverSettings::background_factor_latency_s).
-void record(common::TickRecorder& recorder, ServiceStep& fem_step, std::uint64_t tick,
+// A period's CPU is its thread's and what the bodies' background
+// factorisations used since the period before (fem
+// SolverSettings::background_factor_latency_s).
+void record(common::TickRecorder& recorder, BodySteps& steps, std::uint64_t tick,
             std::int64_t start_ns, std::int64_t cpu_start_ns) {
-  recorder.push({tick, start_ns, common::monotonic_now_ns() - start_ns,
-                 common::thread_cpu_now_ns() - cpu_start_ns + fem_step.take_background_cpu_ns()});
+  std::int64_t cpu_ns = common::thread_cpu_now_ns() - cpu_start_ns;
+  for (auto& step : steps) cpu_ns += step->take_background_cpu_ns();
+  recorder.push({tick, start_ns, common::monotonic_now_ns() - start_ns, cpu_ns});
+}
+
+std::uint32_t body_id(const ServiceStep& step) {
+  return step.setup().scene_body->id;
 }
 
 }  // namespace
 
-BodyChoice choose_body(const scene::Scene& scene) {
+std::vector<std::size_t> choose_bodies(const scene::Scene& scene) {
   const auto plan = scene::derive_plan(scene);
   if (!plan.run_fem) {
     std::printf("fahr_fem_service: scene '%s' has no deformable body; nothing to do\n",
                 scene.name.c_str());
-    return {std::nullopt, 0};
+    return {};
   }
-  if (plan.fem_bodies.size() != 1) {
-    std::fprintf(stderr,
-                 "fahr_fem_service: scene '%s' has %zu deformable bodies; this service steps one\n",
-                 scene.name.c_str(), plan.fem_bodies.size());
-    return {std::nullopt, 2};
-  }
-  return {plan.fem_bodies.front(), 0};
+  return plan.fem_bodies;
 }
 
-int run_realtime(common::Participant& participant, ServiceStep& fem_step, const scene::Scene& scene,
+int run_realtime(common::Participant& participant, BodySteps& steps, const scene::Scene& scene,
                  common::TickRecorder& recorder, double duration_s) {
   common::QosProfile out_qos = common::QosProfile::for_role(common::TopicRole::kStateStream);
   out_qos.deadline =
       3 * scene.rates.fem_period();  // a late step is expected now and then; three are not
-  common::Publisher<msg::DeformationState> out(participant, out_qos);
-  // One haptic service at a time: another writer's sets are refused while
-  // it has sent within 1 s; a restarted one is followed after that.
-  common::Subscriber<msg::ContactSet> in(
-      participant, common::Admission<msg::ContactSet>{.takeover = std::chrono::seconds(1),
-                                                      .valid = {},
-                                                      .counts = fem_step.contact_admission()});
+  // Per body a writer of its states and a reader of its ContactSets. One
+  // haptic service at a time: another writer's sets are refused while it has
+  // sent within 1 s; a restarted one is followed after that.
+  std::vector<std::unique_ptr<common::Publisher<msg::DeformationState>>> out;
+  std::vector<std::unique_ptr<common::Subscriber<msg::ContactSet>>> in;
+  for (auto& step : steps) {
+    const std::uint32_t id = body_id(*step);
+    out.push_back(std::make_unique<common::Publisher<msg::DeformationState>>(participant, out_qos));
+    in.push_back(std::make_unique<common::Subscriber<msg::ContactSet>>(
+        participant, common::Admission<msg::ContactSet>{.takeover = std::chrono::seconds(1),
+                                                        .valid = {},
+                                                        .counts = step->contact_admission(),
+                                                        .wanted = [id](const msg::ContactSet& set) {
+                                                          return set.body_id() == id;
+                                                        }}));
+  }
   const auto period = scene.rates.fem_period();
   const auto start = Clock::now();
   auto next = start;
@@ -73,34 +82,47 @@ int run_realtime(common::Participant& participant, ServiceStep& fem_step, const 
     if (duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(duration_s)) break;
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
-    if (in.fetch_newest())
-      fem_step.take(in.newest(), in.newest_info().seq, common::monotonic_now_ns());
-    fem_step.step(common::monotonic_now_ns());
-    fem_step.state().header().sim_step(fem_step.setup().body->step_index());
-    fem_step.state().header().sim_time_ns(
-        static_cast<std::int64_t>(fem_step.last_report().time_s * 1e9));
-    out.write(fem_step.state());
-    record(recorder, fem_step, tick, t0, c0);
+    for (std::size_t b = 0; b < steps.size(); ++b) {
+      ServiceStep& fem_step = *steps[b];
+      if (in[b]->fetch_newest())
+        fem_step.take(in[b]->newest(), in[b]->newest_info().seq, common::monotonic_now_ns());
+      fem_step.step(common::monotonic_now_ns());
+      fem_step.state().header().sim_step(fem_step.setup().body->step_index());
+      fem_step.state().header().sim_time_ns(
+          static_cast<std::int64_t>(fem_step.last_report().time_s * 1e9));
+      out[b]->write(fem_step.state());
+    }
+    record(recorder, steps, tick, t0, c0);
   }
   if (resyncs > 0) {
     std::printf("fahr_fem_service: %llu times more than 10 steps behind: started again from now\n",
                 static_cast<unsigned long long>(resyncs));
   }
-  std::printf(
-      "fahr_fem_service: refused ContactSets: %s, non-finite %llu, unknown sphere %llu, "
-      "answering a step not reached %llu\n",
-      common::admission_summary(in.admission_counts()).c_str(),
-      static_cast<unsigned long long>(fem_step.non_finite_sets()),
-      static_cast<unsigned long long>(fem_step.unknown_sphere_sets()),
-      static_cast<unsigned long long>(fem_step.ahead_sets()));
+  for (std::size_t b = 0; b < steps.size(); ++b) {
+    const ServiceStep& fem_step = *steps[b];
+    std::printf(
+        "fahr_fem_service: %srefused ContactSets: %s, non-finite %llu, unknown sphere %llu, "
+        "answering a step not reached %llu\n",
+        steps.size() > 1 ? ("body '" + fem_step.setup().scene_body->name + "': ").c_str() : "",
+        common::admission_summary(in[b]->admission_counts()).c_str(),
+        static_cast<unsigned long long>(fem_step.non_finite_sets()),
+        static_cast<unsigned long long>(fem_step.unknown_sphere_sets()),
+        static_cast<unsigned long long>(fem_step.ahead_sets()));
+  }
   return 0;
 }
 
-int run_lockstep(common::Participant& participant, ServiceStep& fem_step, const scene::Scene& scene,
+int run_lockstep(common::Participant& participant, BodySteps& steps, const scene::Scene& scene,
                  common::TickRecorder& recorder) {
-  common::Publisher<msg::DeformationState> out(
-      participant, common::lockstep_output_qos<msg::DeformationState>());
-  common::StepInput<msg::ContactSet> in(participant);
+  std::vector<std::unique_ptr<common::Publisher<msg::DeformationState>>> out;
+  std::vector<std::unique_ptr<common::StepInput<msg::ContactSet>>> in;
+  for (auto& step : steps) {
+    const std::uint32_t id = body_id(*step);
+    out.push_back(std::make_unique<common::Publisher<msg::DeformationState>>(
+        participant, common::lockstep_output_qos<msg::DeformationState>()));
+    in.push_back(std::make_unique<common::StepInput<msg::ContactSet>>(
+        participant, [id](const msg::ContactSet& set) { return set.body_id() == id; }));
+  }
   common::LockstepClient client(participant, "fem");
   client.join();
   const auto base = scene.run.base_period;
@@ -111,24 +133,52 @@ int run_lockstep(common::Participant& participant, ServiceStep& fem_step, const 
        k += fem_steps) {
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
-    if (auto s = common::producer_step_for(k, haptic_steps)) {
-      const msg::ContactSet* set = in.wait(*s, 60s);
-      if (set == nullptr) {
-        std::fprintf(stderr, "fahr_fem_service: ContactSet of haptic step %llu never came\n",
-                     static_cast<unsigned long long>(*s));
-        return 1;
+    const auto s = common::producer_step_for(k, haptic_steps);
+    for (std::size_t b = 0; b < steps.size(); ++b) {
+      ServiceStep& fem_step = *steps[b];
+      if (s) {
+        const msg::ContactSet* set = in[b]->wait(*s, 60s);
+        if (set == nullptr) {
+          std::fprintf(
+              stderr, "fahr_fem_service: ContactSet of body '%s' of haptic step %llu never came\n",
+              fem_step.setup().scene_body->name.c_str(), static_cast<unsigned long long>(*s));
+          return 1;
+        }
+        fem_step.take(*set, set->header().seq());
       }
-      fem_step.take(*set, set->header().seq());
+      fem_step.step();
+      fem_step.state().header().sim_step(k);
+      fem_step.state().header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+      out[b]->write(fem_step.state());
+      hash.add(fem_step.state());
     }
-    fem_step.step();
-    fem_step.state().header().sim_step(k);
-    fem_step.state().header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
-    out.write(fem_step.state());
-    hash.add(fem_step.state());
-    record(recorder, fem_step, k, t0, c0);
+    record(recorder, steps, k, t0, c0);
     client.complete_through(k + fem_steps - 1, hash.value());
   }
   return 0;
+}
+
+void append_metrics(const BodySteps& steps, std::vector<std::pair<std::string, double>>& out) {
+  if (steps.size() == 1) {
+    steps.front()->metrics(out);
+    return;
+  }
+  for (const auto& step : steps) {
+    const std::size_t first = out.size();
+    step->metrics(out);
+    for (std::size_t i = first; i < out.size(); ++i)
+      out[i].first = step->setup().scene_body->name + "/" + out[i].first;
+  }
+}
+
+void take_errors(BodySteps& steps, std::vector<std::string>& errors) {
+  for (auto& step : steps) {
+    const std::size_t first = errors.size();
+    step->take_errors(errors);
+    if (steps.size() == 1) continue;
+    for (std::size_t i = first; i < errors.size(); ++i)
+      errors[i] = "body '" + step->setup().scene_body->name + "': " + errors[i];
+  }
 }
 
 namespace {
@@ -141,37 +191,46 @@ std::string field_sources(const FemBodySetup& setup) {
 
 }  // namespace
 
-void print_start_line(const common::Participant& participant, const FemBodySetup& setup,
-                      const scene::Scene& scene, bool lockstep) {
-  std::printf(
-      "fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres, layout "
-      "0x%016llx), %.0f Hz, %s, %s\n",
-      std::string(common::vendor_name(participant.vendor())).c_str(),
-      setup.scene_body->name.c_str(), setup.mesh.node_count(), setup.mesh.tet_count(),
-      setup.fixed_nodes.size(), setup.links.size(),
-      static_cast<unsigned long long>(setup.layout_fingerprint), scene.rates.fem_hz,
-      lockstep ? "lockstep" : "realtime", field_sources(setup).c_str());
+void print_start_lines(const common::Participant& participant, const BodySteps& steps,
+                       const scene::Scene& scene, bool lockstep) {
+  for (const auto& step : steps) {
+    const FemBodySetup& setup = step->setup();
+    std::printf(
+        "fahr_fem_service: %s, body '%s' (%zu nodes, %zu tets, %zu fixed, %zu spheres, layout "
+        "0x%016llx), %.0f Hz, %s, %s\n",
+        std::string(common::vendor_name(participant.vendor())).c_str(),
+        setup.scene_body->name.c_str(), setup.mesh.node_count(), setup.mesh.tet_count(),
+        setup.fixed_nodes.size(), setup.links.size(),
+        static_cast<unsigned long long>(setup.layout_fingerprint), scene.rates.fem_hz,
+        lockstep ? "lockstep" : "realtime", field_sources(setup).c_str());
+  }
 }
 
-void print_end_line(const ServiceStep& fem_step) {
-  std::printf(
-      "fahr_fem_service: %llu steps, stale contact sets %llu, refused (another sphere layout) "
-      "%llu, max inverted elements %llu, resets after divergence %llu, steps shortened by the "
-      "line search %llu\n",
-      static_cast<unsigned long long>(fem_step.setup().body->step_index()),
-      static_cast<unsigned long long>(fem_step.stale_sets()),
-      static_cast<unsigned long long>(fem_step.layout_check().refused()),
-      static_cast<unsigned long long>(fem_step.inverted_max()),
-      static_cast<unsigned long long>(fem_step.divergence_resets()),
-      static_cast<unsigned long long>(fem_step.shortened_steps()));
-  const ServiceStep::SlowestStep& slow = fem_step.slowest_step();
-  std::printf(
-      "fahr_fem_service: slowest step %.1f ms (step %llu): refactorised %s, W block solved %s, "
-      "tool contacts %zu, projection sweeps %d, anatomy rounds %d, nodes moved out of the "
-      "anatomy %d, inverted tets %d\n",
-      1e-6 * static_cast<double>(slow.wall_ns), static_cast<unsigned long long>(slow.step),
-      slow.refactorised ? "yes" : "no", slow.compliance_solved ? "yes" : "no", slow.tool_contacts,
-      slow.projection_sweeps, slow.anatomy_rounds, slow.anatomy_nodes, slow.inverted_elements);
+void print_end_lines(const BodySteps& steps) {
+  for (const auto& step : steps) {
+    const ServiceStep& fem_step = *step;
+    const std::string body =
+        steps.size() > 1 ? "body '" + fem_step.setup().scene_body->name + "': " : "";
+    std::printf(
+        "fahr_fem_service: %s%llu steps, stale contact sets %llu, refused (another sphere "
+        "layout) %llu, max inverted elements %llu, resets after divergence %llu, steps shortened "
+        "by the line search %llu\n",
+        body.c_str(), static_cast<unsigned long long>(fem_step.setup().body->step_index()),
+        static_cast<unsigned long long>(fem_step.stale_sets()),
+        static_cast<unsigned long long>(fem_step.layout_check().refused()),
+        static_cast<unsigned long long>(fem_step.inverted_max()),
+        static_cast<unsigned long long>(fem_step.divergence_resets()),
+        static_cast<unsigned long long>(fem_step.shortened_steps()));
+    const ServiceStep::SlowestStep& slow = fem_step.slowest_step();
+    std::printf(
+        "fahr_fem_service: %sslowest step %.1f ms (step %llu): refactorised %s, W block solved "
+        "%s, tool contacts %zu, projection sweeps %d, anatomy rounds %d, nodes moved out of the "
+        "anatomy %d, inverted tets %d\n",
+        body.c_str(), 1e-6 * static_cast<double>(slow.wall_ns),
+        static_cast<unsigned long long>(slow.step), slow.refactorised ? "yes" : "no",
+        slow.compliance_solved ? "yes" : "no", slow.tool_contacts, slow.projection_sweeps,
+        slow.anatomy_rounds, slow.anatomy_nodes, slow.inverted_elements);
+  }
 }
 
 }  // namespace fahr::fem_service

@@ -74,9 +74,32 @@ std::string w_summary(const LoopMetrics& m) {
   return line;
 }
 
+void split_contacts(const HapticSetup& setup, const TissueSnapshot& tissue,
+                    const msg::ContactSet& joined, std::span<msg::ContactSet* const> out) {
+  for (std::size_t b = 0; b < out.size(); ++b) {
+    msg::ContactSet& set = *out[b];
+    const TissueBody& body = setup.bodies[b];
+    set.header(joined.header());
+    set.body_id(body.body->id);
+    set.haptic_tick(joined.haptic_tick());
+    set.fem_step(tissue.from_fem ? tissue.body_fem_steps[b] : joined.fem_step());
+    set.layout_fingerprint(body.layout_fingerprint);
+    set.tool_frozen(joined.tool_frozen());
+    set.world_from_tool(joined.world_from_tool());
+    set.contacts().clear();
+  }
+  for (const msg::Contact& c : joined.contacts()) {
+    const std::size_t b = body_of_sphere(setup, c.sphere_id());
+    msg::ContactSet& set = *out[b];
+    if (set.contacts().size() == msg::MAX_CONTACTS) continue;
+    set.contacts().push_back(c);
+    set.contacts().back().sphere_id(c.sphere_id() - setup.bodies[b].first_sphere);
+  }
+}
+
 HapticLoop::HapticLoop(const HapticSetup& setup)
     : setup_(setup),
-      layout_fingerprint_(setup.layout.fingerprint()),
+      layout_fingerprint_(setup.bodies.front().layout_fingerprint),
       nominal_period_s_(1.0 / setup.scene->rates.haptic_hz),
       response_(setup.response),
       penalty_(setup.penalty_settings),
@@ -500,7 +523,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   rendered_n_ = common::to_eigen(command.force_n());
   command.header().sim_step(pose.servo_tick());
   command.header().sim_time_ns(pose.header().sim_time_ns());
-  contacts.body_id(setup_.deformable->id);
+  contacts.body_id(setup_.bodies.front().body->id);
   contacts.haptic_tick(tick_);
   contacts.fem_step(tissue.fem_step);
   contacts.layout_fingerprint(layout_fingerprint_);
@@ -596,7 +619,7 @@ void HapticLoop::lost_tick(const msg::DevicePose& pose, const contact::DeviceSam
   rendered_n_ = force;
   slewing_ = false;
 
-  contacts.body_id(setup_.deformable->id);
+  contacts.body_id(setup_.bodies.front().body->id);
   contacts.haptic_tick(tick_);
   contacts.fem_step(tissue.fem_step);
   contacts.layout_fingerprint(layout_fingerprint_);

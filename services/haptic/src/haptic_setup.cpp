@@ -1,6 +1,7 @@
 // Scene -> AIST, rigid fields and response settings of the haptic service.
 #include "fahr/haptic_service/haptic_setup.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -54,30 +55,70 @@ std::unique_ptr<TriangleCollisionSetup> triangle_setup(const HapticSetup& setup)
   return t;
 }
 
+std::size_t body_of_sphere(const HapticSetup& setup, std::uint32_t sphere) {
+  std::size_t b = 0;
+  while (b + 1 < setup.bodies.size() && sphere >= setup.bodies[b + 1].first_sphere) ++b;
+  return b;
+}
+
 HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fem_keeps_anatomy) {
   const scene::ServicePlan plan = scene::derive_plan(scene);
   if (!plan.tool_body)
     throw std::runtime_error("scene '" + scene.name +
                              "' has no tool: nothing for the haptic service");
-  if (plan.fem_bodies.size() != 1) {
-    throw std::runtime_error("scene '" + scene.name + "' has " +
-                             std::to_string(plan.fem_bodies.size()) +
-                             " deformable bodies; this service handles exactly one");
-  }
+  if (plan.fem_bodies.empty())
+    throw std::runtime_error("scene '" + scene.name +
+                             "' has no deformable body: nothing for the haptic service");
+  if (plan.fem_bodies.size() > kMaxTissueBodies)
+    throw std::runtime_error(
+        "scene '" + scene.name + "' has " + std::to_string(plan.fem_bodies.size()) +
+        " deformable bodies; the haptic service takes at most " + std::to_string(kMaxTissueBodies));
   HapticSetup setup;
   setup.scene = &scene;
-  setup.deformable = &scene.bodies[plan.fem_bodies.front()];
-  setup.mesh = runtime::world_tet_mesh(*setup.deformable);
   // W along the normals covers every row the FEM was sent last: rows by
   // their free-motion depth keep them (RowCompliance::kFreeDepth).
   if (scene.solver.compliance_columns == scene::ComplianceColumns::kNormals) {
     setup.row_compliance = RowCompliance::kFreeDepth;
   }
-  try {
-    setup.layout =
-        sphere_layout::fill_spheres(setup.mesh, runtime::fill_settings_for(*setup.deformable));
-  } catch (const std::exception& e) {
-    throw std::runtime_error("body '" + setup.deformable->name + "': AIST: " + e.what());
+  std::size_t nodes = 0;
+  std::uint32_t spheres = 0;
+  for (const std::size_t index : plan.fem_bodies) {
+    TissueBody body;
+    body.body = &scene.bodies[index];
+    body.mesh = runtime::world_tet_mesh(*body.body);
+    try {
+      body.layout = sphere_layout::fill_spheres(body.mesh, runtime::fill_settings_for(*body.body));
+    } catch (const std::exception& e) {
+      throw std::runtime_error("body '" + body.body->name + "': AIST: " + e.what());
+    }
+    body.layout_fingerprint = body.layout.fingerprint();
+    body.first_node = nodes;
+    body.first_sphere = spheres;
+    nodes += body.mesh.node_count();
+    spheres += static_cast<std::uint32_t>(body.layout.size());
+    setup.bodies.push_back(std::move(body));
+  }
+  if (setup.bodies.size() == 1) {
+    setup.mesh = setup.bodies.front().mesh;
+    setup.layout = setup.bodies.front().layout;
+  } else {
+    std::vector<Eigen::Vector3d> positions;
+    std::vector<geometry::Tet> tets;
+    std::vector<const sphere_layout::SphereLayout*> layouts;
+    std::vector<std::size_t> offsets;
+    for (const TissueBody& body : setup.bodies) {
+      const auto offset = static_cast<geometry::Index>(body.first_node);
+      positions.insert(positions.end(), body.mesh.rest_positions().begin(),
+                       body.mesh.rest_positions().end());
+      for (geometry::Tet t : body.mesh.tets()) {
+        for (auto& n : t) n += offset;
+        tets.push_back(t);
+      }
+      layouts.push_back(&body.layout);
+      offsets.push_back(body.first_node);
+    }
+    setup.mesh = geometry::TetMesh(std::move(positions), std::move(tets));
+    setup.layout = sphere_layout::concatenate(layouts, offsets);
   }
   setup.tool = runtime::load_rigid_field(scene.bodies[*plan.tool_body]);
   setup.tool_grid = std::make_unique<collision::FieldGrid>(*setup.tool->sdf);
@@ -98,9 +139,15 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fe
     return anatomy_of_body[body];
   };
   for (const auto& pair : plan.pairs) {
-    if (pair.kind == scene::PairKind::kHard && pair.first == plan.fem_bodies.front()) {
+    const bool tissue = std::find(plan.fem_bodies.begin(), plan.fem_bodies.end(), pair.first) !=
+                        plan.fem_bodies.end();
+    if (pair.kind == scene::PairKind::kHard && tissue) {
       if (fem_keeps_anatomy) continue;
-      setup.tissue_obstacles.push_back(anatomy_index(pair.second));
+      // Tested against the joined tissue once, whichever bodies it is near.
+      const std::size_t a = anatomy_index(pair.second);
+      if (std::find(setup.tissue_obstacles.begin(), setup.tissue_obstacles.end(), a) ==
+          setup.tissue_obstacles.end())
+        setup.tissue_obstacles.push_back(a);
     } else if (pair.kind == scene::PairKind::kTool &&
                pair.reason == scene::PairReason::kToolObstacle &&
                scene.contact.tool_stops_at_anatomy) {

@@ -18,17 +18,17 @@ msg::BodyRole wire_role(scene::BodyRole role) {
   return msg::BODY_OBSTACLE;
 }
 
-void describe_deformable(const HapticSetup& setup, msg::SceneDescription& d) {
-  for (const auto& p : setup.mesh.rest_positions()) {
+void describe_deformable(const TissueBody& body, msg::SceneDescription& d) {
+  for (const auto& p : body.mesh.rest_positions()) {
     for (int k = 0; k < 3; ++k) d.rest_positions_m().push_back(static_cast<float>(p[k]));
   }
-  for (const auto& t : setup.mesh.tets()) {
+  for (const auto& t : body.mesh.tets()) {
     for (auto n : t) d.tets().push_back(static_cast<std::uint32_t>(n));
   }
-  for (const auto& f : setup.mesh.boundary_faces()) {
+  for (const auto& f : body.mesh.boundary_faces()) {
     for (auto n : f.nodes) d.triangles().push_back(static_cast<std::uint32_t>(n));
   }
-  const auto& layout = setup.layout;
+  const auto& layout = body.layout;
   d.layout_fingerprint(layout.fingerprint());
   for (std::size_t i = 0; i < layout.size(); ++i) {
     const auto& s = layout.sphere(i);
@@ -58,7 +58,9 @@ std::vector<msg::SceneDescription> describe_scene(const HapticSetup& setup) {
     d.mesh_uri(body.mesh_uri.substr(0, 255));
     d.scene_text_utf8().assign(scene.source_text.begin(),
                                scene.source_text.begin() + static_cast<std::ptrdiff_t>(text_bytes));
-    if (&body == setup.deformable) describe_deformable(setup, d);
+    for (const TissueBody& tissue : setup.bodies) {
+      if (tissue.body == &body) describe_deformable(tissue, d);
+    }
     out.push_back(std::move(d));
   }
   return out;

@@ -2,9 +2,11 @@
 #include "fahr/haptic_service/service_loop.h"
 
 #include <Eigen/Core>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,18 +49,30 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
   common::Subscriber<msg::DevicePose> poses(
       participant, common::Admission<msg::DevicePose>{.takeover = std::chrono::seconds(1),
                                                       .valid = plausible_device_pose,
-                                                      .counts = std::move(pose_admission)});
+                                                      .counts = std::move(pose_admission),
+                                                      .wanted = {}});
   common::Publisher<msg::ForceCommand> commands(participant);
   // The ContactSet's write (tens of microseconds: serialisation and send)
   // leaves the tick for a thread of its own, which looks for a new set
   // every 0.5 ms; the FEM takes the newest set at its own rate (5 ms) anyway.
   // The ForceCommand, which the gateway's servo loop waits on, is written
   // on the tick.
-  common::BackgroundPublisher<msg::ContactSet> contact_sets(participant, 500us, [] {
-    msg::ContactSet contacts;
-    contacts.contacts().reserve(msg::MAX_CONTACTS);
-    return contacts;
-  });
+  // One per body (its own writer). With several bodies the tick fills the
+  // joined tissue's set, split into theirs (split_contacts).
+  const HapticSetup& setup = loop.setup();
+  const std::size_t bodies = setup.bodies.size();
+  std::vector<std::unique_ptr<common::BackgroundPublisher<msg::ContactSet>>> contact_sets;
+  for (std::size_t b = 0; b < bodies; ++b) {
+    contact_sets.push_back(
+        std::make_unique<common::BackgroundPublisher<msg::ContactSet>>(participant, 500us, [] {
+          msg::ContactSet contacts;
+          contacts.contacts().reserve(msg::MAX_CONTACTS);
+          return contacts;
+        }));
+  }
+  msg::ContactSet joined;
+  joined.contacts().reserve(msg::MAX_CONTACTS);
+  std::array<msg::ContactSet*, kMaxTissueBodies> per_body{};
   msg::ForceCommand command;
   const auto start = Clock::now();
   const auto duration = std::chrono::duration<double>(duration_s);
@@ -110,7 +124,13 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
     // The FEM is lost once it has sent states and then none for the timeout.
     const std::int64_t last_state_ns = feed.last_state_ns();
     const bool tissue_lost = last_state_ns != 0 && t0 - last_state_ns > kTissueLossTimeoutNs;
-    loop.tick(poses.newest(), feed.newest(), command, contact_sets.back(), tissue_lost);
+    const TissueSnapshot& tissue = feed.newest();
+    msg::ContactSet& contacts = bodies > 1 ? joined : contact_sets.front()->back();
+    loop.tick(poses.newest(), tissue, command, contacts, tissue_lost);
+    if (bodies > 1) {
+      for (std::size_t b = 0; b < bodies; ++b) per_body[b] = &contact_sets[b]->back();
+      split_contacts(setup, tissue, joined, {per_body.data(), bodies});
+    }
     const std::int64_t c1 = common::thread_cpu_now_ns();
     commands.write(command);
     // While the FEM is lost the set repeats the last contacts (HapticLoop::
@@ -119,13 +139,20 @@ void run_realtime(common::Participant& participant, TissueFeed& feed, HapticLoop
     // take them (a reliable stream: repairs to a starved reader cost this
     // process CPU).
     lost_ticks = tissue_lost ? lost_ticks + 1 : 0;
-    if (lost_ticks % kLostSetEveryTicks == 0 || lost_ticks == 1) contact_sets.publish();
+    if (lost_ticks % kLostSetEveryTicks == 0 || lost_ticks == 1) {
+      for (auto& sets : contact_sets) sets->publish();
+    }
     const std::int64_t c2 = common::thread_cpu_now_ns();
     recorder.push({tick++, t0, common::monotonic_now_ns() - t0, c2 - c0});
     report.record(t0, c0, c1, c2, loop.last_phases());
   }
-  report.print(contact_sets.handed(), contact_sets.written(), contact_sets.refused(),
-               feed.metrics());
+  std::uint64_t handed = 0, written = 0, refused = 0;
+  for (const auto& sets : contact_sets) {
+    handed += sets->handed();
+    written += sets->written();
+    refused += sets->refused();
+  }
+  report.print(handed, written, refused, feed.metrics());
   std::printf("fahr_haptic_service: %s\n", w_summary(loop.metrics()).c_str());
   // Received against the gateway's sequence numbers: a tick runs on the
   // newest pose, so fewer ticks than poses is lateness; a gap is a pose the
@@ -159,33 +186,53 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
     return 2;
   }
   common::StepInput<msg::DevicePose> poses(participant);
-  common::StepInput<msg::DeformationState> states(participant);
+  // Per body a reader of its states and a writer of its ContactSets.
+  const std::size_t bodies = setup.bodies.size();
+  std::vector<std::unique_ptr<common::StepInput<msg::DeformationState>>> states;
+  std::vector<std::unique_ptr<common::Publisher<msg::ContactSet>>> contact_sets;
+  for (const TissueBody& body : setup.bodies) {
+    const std::uint32_t id = body.body->id;
+    states.push_back(std::make_unique<common::StepInput<msg::DeformationState>>(
+        participant, [id](const msg::DeformationState& s) { return s.body_id() == id; }));
+    contact_sets.push_back(std::make_unique<common::Publisher<msg::ContactSet>>(
+        participant, common::lockstep_output_qos<msg::ContactSet>()));
+  }
   common::Publisher<msg::ForceCommand> commands(participant,
                                                 common::lockstep_output_qos<msg::ForceCommand>());
-  common::Publisher<msg::ContactSet> contact_sets(participant,
-                                                  common::lockstep_output_qos<msg::ContactSet>());
   common::LockstepClient client(participant, "haptic");
   client.join();
   TissueDigest digest(setup);
   TissueSnapshot tissue = digest.make_snapshot();
   msg::ForceCommand command;
-  msg::ContactSet contacts;
-  contacts.contacts().reserve(msg::MAX_CONTACTS);
-  contacts.body_id(setup.deformable->id);
-  contacts.layout_fingerprint(setup.layout.fingerprint());  // step 0 answers with no tick
+  // The tick's set (the joined tissue's) and, with several bodies, one per body.
+  std::vector<msg::ContactSet> sets(bodies > 1 ? bodies + 1 : 1);
+  std::vector<msg::ContactSet*> per_body;
+  for (auto& set : sets) set.contacts().reserve(msg::MAX_CONTACTS);
+  for (std::size_t b = 0; b < bodies; ++b) {
+    msg::ContactSet& set = sets[bodies > 1 ? b + 1 : 0];
+    per_body.push_back(&set);
+    set.body_id(setup.bodies[b].body->id);
+    set.layout_fingerprint(setup.bodies[b].layout_fingerprint);  // step 0 answers with no tick
+  }
+  msg::ContactSet& contacts = sets.front();
+  std::vector<const msg::DeformationState*> body_states(bodies, nullptr);
   common::OutputHash hash;
   std::optional<std::uint64_t> digested_fem_step;
   for (std::uint64_t k = 0; !common::stop_requested() && client.wait_for_grant(k, 60s); ++k) {
     const std::int64_t t0 = common::monotonic_now_ns();
     const std::int64_t c0 = common::thread_cpu_now_ns();
     if (const auto f = common::producer_step_for(k, fem_steps); f && f != digested_fem_step) {
-      const msg::DeformationState* state = states.wait(*f, 60s);
-      if (state == nullptr) {
-        std::fprintf(stderr, "fahr_haptic_service: DeformationState of FEM step %llu never came\n",
-                     static_cast<unsigned long long>(*f));
-        return 1;
+      for (std::size_t b = 0; b < bodies; ++b) {
+        body_states[b] = states[b]->wait(*f, 60s);
+        if (body_states[b] == nullptr) {
+          std::fprintf(stderr,
+                       "fahr_haptic_service: DeformationState of body '%s' of FEM step %llu "
+                       "never came\n",
+                       setup.bodies[b].body->name.c_str(), static_cast<unsigned long long>(*f));
+          return 1;
+        }
       }
-      if (!digest.digest(*state, tissue)) {
+      if (!digest.digest(body_states, tissue)) {
         std::fprintf(
             stderr,
             "fahr_haptic_service: DeformationState of FEM step %llu does not fit the mesh\n",
@@ -194,6 +241,7 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
       }
       digested_fem_step = f;
     }
+    bool ticked = false;
     if (const auto p = common::producer_step_for(k, 1)) {
       const msg::DevicePose* pose = poses.wait(*p, 60s);
       if (pose == nullptr) {
@@ -202,15 +250,23 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
         return 1;
       }
       loop.tick(*pose, tissue, command, contacts);
+      ticked = true;
     }
     command.header().sim_step(k);
     command.header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
     contacts.header().sim_step(k);
     contacts.header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+    if (bodies > 1 && ticked) split_contacts(setup, tissue, contacts, per_body);
     commands.write(command);
-    contact_sets.write(contacts);
     hash.add(command);
-    hash.add(contacts);
+    for (std::size_t b = 0; b < bodies; ++b) {
+      if (bodies > 1) {
+        per_body[b]->header().sim_step(k);
+        per_body[b]->header().sim_time_ns(static_cast<std::int64_t>(k) * base.count());
+      }
+      contact_sets[b]->write(*per_body[b]);
+      hash.add(*per_body[b]);
+    }
     recorder.push({k, t0, common::monotonic_now_ns() - t0, common::thread_cpu_now_ns() - c0});
     client.complete_through(k, hash.value());
   }
@@ -220,6 +276,14 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
 }
 
 namespace {
+
+// 'tongue' or 'tongue' + 'epiglottis'.
+std::string body_names(const HapticSetup& setup) {
+  std::string names;
+  for (const TissueBody& body : setup.bodies)
+    names += (names.empty() ? "'" : " + '") + body.body->name + "'";
+  return names;
+}
 
 std::string field_sources(const HapticSetup& setup) {
   std::vector<const runtime::RigidField*> fields{setup.tool.get()};
@@ -232,12 +296,12 @@ std::string field_sources(const HapticSetup& setup) {
 void print_ready_line(const common::Participant& participant, const HapticSetup& setup,
                       const std::string& collision, bool lockstep, double setup_s) {
   std::printf(
-      "fahr_haptic_service: ready: %s, body '%s' (%zu nodes, %zu spheres, layout 0x%016llx), "
+      "fahr_haptic_service: ready: %s, body %s (%zu nodes, %zu spheres, layout 0x%016llx), "
       "tool '%s' (%zu surface samples), "
       "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s (%s)\n",
-      std::string(common::vendor_name(participant.vendor())).c_str(),
-      setup.deformable->name.c_str(), setup.mesh.node_count(), setup.layout.size(),
-      static_cast<unsigned long long>(setup.layout.fingerprint()),
+      std::string(common::vendor_name(participant.vendor())).c_str(), body_names(setup).c_str(),
+      setup.mesh.node_count(), setup.layout.size(),
+      static_cast<unsigned long long>(setup.bodies.front().layout_fingerprint),
       setup.tool->scene_body->name.c_str(), setup.tool_samples.points_m().size(),
       setup.tissue_obstacles.size(), setup.tool_obstacles.size(), collision.c_str(),
       setup.scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s,

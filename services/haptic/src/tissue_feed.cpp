@@ -1,6 +1,7 @@
 // The state thread of the real-time haptic service (see tissue_feed.h).
 #include "fahr/haptic_service/tissue_feed.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "fahr/common/clock.h"
@@ -11,16 +12,23 @@ namespace fahr::haptic_service {
 TissueFeed::TissueFeed(common::Participant& participant, const HapticSetup& setup)
     : digest_(setup),
       buffer_([this] { return digest_.make_snapshot(); }),
-      // One FEM at a time: another writer refused while it has sent within
-      // 1 s (the tongue is already lost after 50 ms); a restarted FEM is
-      // followed once the first has been silent that long. A state that
-      // does not fit the mesh is refused before it can become the source.
-      states_(participant,
-              common::Admission<msg::DeformationState>{
-                  .takeover = std::chrono::seconds(1),
-                  .valid = [this](const msg::DeformationState& s) { return digest_.plausible(s); },
-                  .counts = std::make_shared<common::AdmissionCounts>()}),
-      thread_([this] { run(); }) {}
+      newest_(setup.bodies.size(), nullptr) {
+  // One FEM at a time: another writer refused while it has sent within 1 s
+  // (the tongue is already lost after 50 ms); a restarted FEM is followed
+  // once the first has been silent that long. A state that does not fit the
+  // mesh is refused before it can become the source.
+  for (const TissueBody& body : setup.bodies) {
+    const std::uint32_t id = body.body->id;
+    states_.push_back(std::make_unique<common::Subscriber<msg::DeformationState>>(
+        participant,
+        common::Admission<msg::DeformationState>{
+            .takeover = std::chrono::seconds(1),
+            .valid = [this](const msg::DeformationState& s) { return digest_.plausible(s); },
+            .counts = admission_,
+            .wanted = [id](const msg::DeformationState& s) { return s.body_id() == id; }}));
+  }
+  thread_ = std::thread([this] { run(); });
+}
 
 TissueFeed::~TissueFeed() {
   stop_.store(true, std::memory_order_relaxed);
@@ -31,11 +39,20 @@ void TissueFeed::run() {
   using namespace std::chrono_literals;
   std::uint64_t seen = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
-    // 50 ms: short enough to notice the stop, long enough not to spin.
-    seen = states_.wait_for_samples(seen, 50ms);
-    if (!states_.fetch_newest()) continue;
+    // 50 ms: short enough to notice the stop, long enough not to spin. The
+    // FEM writes its bodies' states in order: the last body's marks a period.
+    seen = states_.back()->wait_for_samples(seen, 50ms);
+    bool fresh = false;
+    for (std::size_t b = 0; b < states_.size(); ++b) {
+      if (!states_[b]->fetch_newest()) continue;
+      newest_[b] = &states_[b]->newest();
+      fresh = true;
+    }
+    if (!fresh) continue;
+    // Every body heard from before the first digest.
+    if (std::find(newest_.begin(), newest_.end(), nullptr) != newest_.end()) continue;
     TissueSnapshot& next = buffer_.back();
-    if (!digest_.digest(states_.newest(), next)) {
+    if (!digest_.digest(newest_, next)) {
       metrics_.bad_states.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
@@ -61,7 +78,7 @@ void TissueFeed::append_metrics(std::vector<std::pair<std::string, double>>& out
   };
   out.emplace_back("fem_states", get(metrics_.fem_states));
   out.emplace_back("bad_states", get(metrics_.bad_states));
-  common::append_admission_metrics(states_.admission_counts(), "states", out);
+  common::append_admission_metrics(*admission_, "states", out);
   out.emplace_back("obstacle_contacts", get(metrics_.obstacle_contacts));
   out.emplace_back("obstacle_overflows", get(metrics_.obstacle_overflows));
   out.emplace_back("free_centres",

@@ -2,6 +2,7 @@
 #include "fahr/haptic_service/tissue_snapshot.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -67,11 +68,14 @@ TissueSnapshot TissueDigest::make_snapshot() {
   s.spheres.reset_to_rest(setup_.layout);
   s.tree = collision::SphereTree(setup_.layout);
   s.tree.refit(s.spheres);
-  s.compliance_ids.assign(msg::MAX_COMPLIANCE_SPHERES, 0);
-  s.w_mpn.assign(msg::MAX_COMPLIANCE_ENTRIES, 0.0f);
-  s.free_centres_m.assign(msg::MAX_COMPLIANCE_COORDS, 0.0f);
-  s.compliance_normals.assign(msg::MAX_COMPLIANCE_COORDS, 0.0f);
-  s.free_shift_m.assign(msg::MAX_COMPLIANCE_SPHERES, 0.0f);
+  // Every body's block at its largest.
+  const std::size_t n = setup_.bodies.size();
+  s.body_fem_steps.assign(n, 0);
+  s.compliance_ids.assign(n * msg::MAX_COMPLIANCE_SPHERES, 0);
+  s.w_mpn.assign(n * n * msg::MAX_COMPLIANCE_ENTRIES, 0.0f);
+  s.free_centres_m.assign(n * msg::MAX_COMPLIANCE_COORDS, 0.0f);
+  s.compliance_normals.assign(n * msg::MAX_COMPLIANCE_COORDS, 0.0f);
+  s.free_shift_m.assign(n * msg::MAX_COMPLIANCE_SPHERES, 0.0f);
   s.compliance_index.assign(setup_.layout.size(), contact::kNoCompliance);
   s.obstacle_contacts.assign(kObstacleContactCapacity, fem::Contact{});
   s.obstacle_body_ids.assign(kObstacleContactCapacity, 0);
@@ -85,76 +89,149 @@ TissueSnapshot TissueDigest::make_snapshot() {
   return s;
 }
 
+std::size_t TissueDigest::body_index(std::uint32_t body_id) const {
+  std::size_t b = 0;
+  while (b < setup_.bodies.size() && setup_.bodies[b].body->id != body_id) ++b;
+  return b;
+}
+
 bool TissueDigest::plausible(const msg::DeformationState& state) const {
   // A non-finite compliance or free centre is never used: the whole state
   // is refused (counted as a bad state), as for a non-finite position.
   const auto finite = [](const auto& values) {
     return std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); });
   };
-  return state.positions_m().size() == positions_m_.size() && finite(state.positions_m()) &&
-         finite(state.compliance_mpn()) && finite(state.compliance_normals()) &&
-         finite(state.compliance_free_centres_m());
+  const std::size_t b = body_index(state.body_id());
+  return b < setup_.bodies.size() &&
+         state.positions_m().size() == 3 * setup_.bodies[b].mesh.node_count() &&
+         finite(state.positions_m()) && finite(state.compliance_mpn()) &&
+         finite(state.compliance_normals()) && finite(state.compliance_free_centres_m());
 }
 
-bool TissueDigest::digest(const msg::DeformationState& state, TissueSnapshot& out) {
+bool TissueDigest::digest(std::span<const msg::DeformationState* const> states,
+                          TissueSnapshot& out) {
   const auto start = std::chrono::steady_clock::now();
-  if (!plausible(state)) return false;
-  const auto& x = state.positions_m();
-  for (std::size_t i = 0; i < x.size(); ++i) positions_m_[i] = static_cast<double>(x[i]);
+  if (states.size() != setup_.bodies.size()) return false;
+  for (std::size_t b = 0; b < states.size(); ++b) {
+    const TissueBody& body = setup_.bodies[b];
+    if (states[b] == nullptr || states[b]->body_id() != body.body->id || !plausible(*states[b]))
+      return false;
+    const auto& x = states[b]->positions_m();
+    double* to = positions_m_.data() + 3 * body.first_node;
+    for (std::size_t i = 0; i < x.size(); ++i) to[i] = static_cast<double>(x[i]);
+  }
   if (!out.spheres.update(setup_.layout, positions_m_)) return false;  // a NaN from the FEM
   out.tree.refit(out.spheres);
   if (out.triangles) out.triangles->update(positions_m_);
   out.from_fem = true;
-  out.fem_step = state.step();
-  out.reset_epoch = state.reset_epoch();
-  out.fem_writer = state.header().writer_id();
+  out.fem_step = states.front()->step();
+  out.reset_epoch = 0;
+  for (std::size_t b = 0; b < states.size(); ++b) {
+    out.body_fem_steps[b] = states[b]->step();
+    out.reset_epoch += states[b]->reset_epoch();
+  }
+  out.fem_writer = states.front()->header().writer_id();
   query_obstacles(out);
-  index_compliance(state, out);
+  index_compliance(states, out);
   out.digest_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   return true;
 }
 
-void TissueDigest::index_compliance(const msg::DeformationState& state, TissueSnapshot& out) {
+namespace {
+
+// A body's usable W block: its sphere count k (0: none usable) and whether
+// it is along normals.
+struct Block {
+  std::size_t k = 0;
+  bool along = false;
+};
+
+Block usable_block(const msg::DeformationState& state, std::size_t capacity,
+                   std::size_t layout_size) {
+  const auto& ids = state.compliance_sphere_ids();
+  Block block;
+  block.k = std::min<std::size_t>(ids.size(), capacity);
+  block.along = !state.compliance_normals().empty();
+  if (block.along && state.compliance_normals().size() < 3 * block.k) return {};
+  const std::size_t entries = block.along ? 3 * block.k * block.k : 9 * block.k * block.k;
+  if (block.k == 0 || state.compliance_mpn().size() < entries) return {};
+  // An id beyond the layout would index past the table: the whole block is
+  // refused rather than solved with a row missing.
+  for (std::size_t i = 0; i < block.k; ++i) {
+    if (ids[i] >= layout_size) return {};
+  }
+  return block;
+}
+
+}  // namespace
+
+void TissueDigest::index_compliance(std::span<const msg::DeformationState* const> states,
+                                    TissueSnapshot& out) {
   // The slot is reused: clear what its previous state indexed.
   for (std::size_t i = 0; i < out.compliance_count; ++i) {
     out.compliance_index[out.compliance_ids[i]] = contact::kNoCompliance;
   }
   out.compliance_count = 0;
   out.have_free_centres = false;
-  const auto& ids = state.compliance_sphere_ids();
-  const std::size_t k = std::min<std::size_t>(ids.size(), out.compliance_ids.size());
   out.have_compliance_normals = false;
-  const bool along = !state.compliance_normals().empty();
-  if (along && state.compliance_normals().size() < 3 * k) return;
-  const std::size_t entries = along ? 3 * k * k : 9 * k * k;
-  if (k == 0 || state.compliance_mpn().size() < entries)
-    return;  // no usable W: rows use the fallback
-  for (std::size_t i = 0; i < k; ++i) {
-    // An id beyond the layout would index past the table: the whole W is
-    // refused rather than solved with a row missing.
-    if (ids[i] >= out.compliance_index.size()) return;
+  // Each body's block (no usable W: its rows use the fallback), all along
+  // normals or none: the scene decides for every body.
+  std::array<Block, kMaxTissueBodies> blocks{};
+  std::size_t total = 0;
+  bool along = false;
+  bool free_centres = true;
+  for (std::size_t b = 0; b < states.size(); ++b) {
+    blocks[b] =
+        usable_block(*states[b], msg::MAX_COMPLIANCE_SPHERES, setup_.bodies[b].layout.size());
+    if (blocks[b].k == 0) continue;
+    if (total > 0 && blocks[b].along != along) return;  // mixed kinds: no W at all
+    along = blocks[b].along;
+    total += blocks[b].k;
+    free_centres = free_centres && states[b]->compliance_free_centres_m().size() >= 3 * blocks[b].k;
   }
-  for (std::size_t i = 0; i < k; ++i) {
-    out.compliance_ids[i] = ids[i];
-    out.compliance_index[ids[i]] = static_cast<std::int32_t>(i);
+  if (total == 0) return;
+  const std::size_t columns = along ? total : 3 * total;  // W's row length
+  if (states.size() > 1) std::fill_n(out.w_mpn.begin(), 3 * total * columns, 0.0f);
+  std::size_t first = 0;  // the block's first sphere in the joined W
+  for (std::size_t b = 0; b < states.size(); ++b) {
+    const std::size_t k = blocks[b].k;
+    if (k == 0) continue;
+    const msg::DeformationState& state = *states[b];
+    const std::uint32_t offset = setup_.bodies[b].first_sphere;
+    const auto& ids = state.compliance_sphere_ids();
+    for (std::size_t i = 0; i < k; ++i) {
+      out.compliance_ids[first + i] = ids[i] + offset;
+      out.compliance_index[ids[i] + offset] = static_cast<std::int32_t>(first + i);
+    }
+    // The block's rows, each into its place in the joined rows.
+    const std::size_t block_columns = along ? k : 3 * k;
+    const std::size_t column_offset = along ? first : 3 * first;
+    for (std::size_t r = 0; r < 3 * k; ++r) {
+      std::copy_n(state.compliance_mpn().data() + r * block_columns, block_columns,
+                  out.w_mpn.data() + (3 * first + r) * columns + column_offset);
+    }
+    if (along) {
+      std::copy_n(state.compliance_normals().data(), 3 * k,
+                  out.compliance_normals.data() + 3 * first);
+    }
+    // Without free centres no sphere has moved off its published centre.
+    std::fill_n(out.free_shift_m.begin() + static_cast<std::ptrdiff_t>(first), k, 0.0f);
+    if (free_centres) {
+      std::copy_n(state.compliance_free_centres_m().data(), 3 * k,
+                  out.free_centres_m.data() + 3 * first);
+    }
+    first += k;
   }
-  std::copy_n(state.compliance_mpn().data(), entries, out.w_mpn.data());
-  if (along) {
-    std::copy_n(state.compliance_normals().data(), 3 * k, out.compliance_normals.data());
-    out.have_compliance_normals = true;
-  }
-  out.compliance_count = k;
-  // Without free centres no sphere has moved off its published centre.
-  std::fill_n(out.free_shift_m.begin(), k, 0.0f);
-  if (state.compliance_free_centres_m().size() >= 3 * k) {
-    std::copy_n(state.compliance_free_centres_m().data(), 3 * k, out.free_centres_m.data());
+  out.have_compliance_normals = along;
+  out.compliance_count = total;
+  if (free_centres) {
     out.have_free_centres = true;
     const auto centres = out.spheres.centres_m();
-    for (std::size_t i = 0; i < k; ++i) {
+    for (std::size_t i = 0; i < total; ++i) {
       const float* f = out.free_centres_m.data() + 3 * i;
-      out.free_shift_m[i] =
-          static_cast<float>((centres[ids[i]] - Eigen::Vector3d(f[0], f[1], f[2])).norm());
+      out.free_shift_m[i] = static_cast<float>(
+          (centres[out.compliance_ids[i]] - Eigen::Vector3d(f[0], f[1], f[2])).norm());
     }
   }
 }

@@ -2,6 +2,7 @@
 #include "fahr/stack_sim/stack_sim.h"
 
 #include <stdexcept>
+#include <vector>
 
 #include "fahr/common/clock.h"
 #include "fahr/gateway_service/msg_conversion.h"
@@ -10,13 +11,11 @@
 namespace fahr::stack_sim {
 namespace {
 
-const scene::Body& deformable_body(const scene::Scene& scene) {
+std::vector<std::size_t> deformable_bodies(const scene::Scene& scene) {
   const scene::ServicePlan plan = scene::derive_plan(scene);
-  if (plan.fem_bodies.size() != 1) {
-    throw std::runtime_error("stack_sim: scene '" + scene.name +
-                             "' needs exactly one deformable body");
-  }
-  return scene.bodies[plan.fem_bodies.front()];
+  if (plan.fem_bodies.empty())
+    throw std::runtime_error("stack_sim: scene '" + scene.name + "' has no deformable body");
+  return plan.fem_bodies;
 }
 
 }  // namespace
@@ -26,8 +25,11 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
       base_period_ns_(scene_->run.base_period.count()),
       fem_period_(static_cast<std::uint64_t>(scene_->rates.fem_period() / scene_->run.base_period)),
       haptic_setup_(haptic_service::set_up(*scene_, options.collision,
-                                           !options.experiments.haptic_side_anatomy)),
-      fem_setup_(fem_service::set_up_body(*scene_, deformable_body(*scene_))) {
+                                           !options.experiments.haptic_side_anatomy)) {
+  for (const std::size_t b : deformable_bodies(*scene_)) {
+    fem_setups_.push_back(std::make_unique<fem_service::FemBodySetup>(
+        fem_service::set_up_body(*scene_, scene_->bodies[b])));
+  }
   if (scene_->rates.haptic_period() != scene_->run.base_period) {
     throw std::runtime_error("stack_sim: the haptic rate must be the base rate of scene '" +
                              scene_->name + "'");
@@ -53,19 +55,28 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   haptic_ = std::make_unique<haptic_service::HapticLoop>(haptic_setup_);
   digest_ = std::make_unique<haptic_service::TissueDigest>(haptic_setup_);
   tissue_ = digest_->make_snapshot();
-  fem_setup_.enforce_anatomy = !experiments.haptic_side_anatomy;
-  if (experiments.fem_support_ratio)
-    fem_setup_.anatomy_settings.support_stiffness_ratio = *experiments.fem_support_ratio;
-  if (experiments.fem_anatomy_rounds > 0)
-    fem_setup_.anatomy_settings.max_rounds = experiments.fem_anatomy_rounds;
-  fem_ = std::make_unique<fem_service::ServiceStep>(fem_setup_);
-  contacts_.contacts().reserve(msg::MAX_CONTACTS);
-  next_contacts_.contacts().reserve(msg::MAX_CONTACTS);
-  contacts_.body_id(haptic_setup_.deformable->id);
-  next_contacts_.body_id(haptic_setup_.deformable->id);
-  // As the haptic service's lockstep loop: step 0 answers with no tick.
-  contacts_.layout_fingerprint(haptic_->layout_fingerprint());
-  next_contacts_.layout_fingerprint(haptic_->layout_fingerprint());
+  const std::size_t bodies = fem_setups_.size();
+  for (auto& setup : fem_setups_) {
+    setup->enforce_anatomy = !experiments.haptic_side_anatomy;
+    if (experiments.fem_support_ratio)
+      setup->anatomy_settings.support_stiffness_ratio = *experiments.fem_support_ratio;
+    if (experiments.fem_anatomy_rounds > 0)
+      setup->anatomy_settings.max_rounds = experiments.fem_anatomy_rounds;
+    fems_.push_back(std::make_unique<fem_service::ServiceStep>(*setup));
+    fem_states_.push_back(&fems_.back()->state());
+  }
+  contacts_.resize(bodies);
+  next_contacts_.resize(bodies);
+  split_to_.resize(bodies);
+  joined_.contacts().reserve(msg::MAX_CONTACTS);
+  for (std::size_t b = 0; b < bodies; ++b) {
+    for (auto* set : {&contacts_[b], &next_contacts_[b]}) {
+      set->contacts().reserve(msg::MAX_CONTACTS);
+      set->body_id(haptic_setup_.bodies[b].body->id);
+      // As the haptic service's lockstep loop: step 0 answers with no tick.
+      set->layout_fingerprint(haptic_setup_.bodies[b].layout_fingerprint);
+    }
+  }
   pose_.device_id(options.device_id);
 }
 
@@ -87,38 +98,54 @@ void StackSim::step() {
   next_pose_.header().sim_time_ns(sample.device_time_ns);
 
   // Haptic: the FEM's newest state before k, the gateway's pose of k - 1.
+  const std::size_t bodies = fems_.size();
   if (fem_published_) {
-    digest_->digest(fem_->state(), tissue_);
+    digest_->digest(fem_states_, tissue_);
     fem_published_ = false;
   }
   if (k > 0) {
     const std::int64_t cpu0 = common::thread_cpu_now_ns();
-    haptic_->tick(pose_, tissue_, next_command_, next_contacts_);
+    haptic_->tick(pose_, tissue_, next_command_, bodies > 1 ? joined_ : next_contacts_.front());
+    if (bodies > 1) {
+      for (std::size_t b = 0; b < bodies; ++b) split_to_[b] = &next_contacts_[b];
+      haptic_service::split_contacts(haptic_setup_, tissue_, joined_, split_to_);
+    }
     haptic_tick_cpu_.record(std::chrono::nanoseconds(common::thread_cpu_now_ns() - cpu0));
   }
   next_command_.header().seq(k + 1);
   next_command_.header().sim_step(k);
   next_command_.header().sim_time_ns(now_ns);
-  next_contacts_.header().seq(k + 1);
-  next_contacts_.header().sim_step(k);
-  next_contacts_.header().sim_time_ns(now_ns);
+  // Numbered as the haptic service's participant numbers them: one sequence
+  // for the topic, every body's set each step, in the bodies' order (the FEM
+  // reports the number of the set it applied).
+  for (std::size_t b = 0; b < bodies; ++b) {
+    msg::ContactSet& set = next_contacts_[b];
+    set.header().seq(bodies * k + b + 1);
+    set.header().sim_step(k);
+    set.header().sim_time_ns(now_ns);
+  }
 
-  // FEM, at its period: the haptic service's contacts of k - 1.
+  // FEM, at its period: the haptic service's contacts of k - 1, each body's.
   fem_stepped_ = common::executes_at(k, fem_period_);
   if (fem_stepped_) {
-    if (k > 0) fem_->take(contacts_, contacts_.header().seq());
-    const std::int64_t cpu0 = common::thread_cpu_now_ns();
-    fem_->step();
-    // The step's thread and the background factorisation since the last step.
-    const std::chrono::nanoseconds thread(common::thread_cpu_now_ns() - cpu0);
-    const std::chrono::nanoseconds background(fem_->take_background_cpu_ns());
+    std::chrono::nanoseconds thread{0};
+    std::chrono::nanoseconds background{0};
+    for (std::size_t b = 0; b < bodies; ++b) {
+      fem_service::ServiceStep& fem = *fems_[b];
+      if (k > 0) fem.take(contacts_[b], contacts_[b].header().seq());
+      const std::int64_t cpu0 = common::thread_cpu_now_ns();
+      fem.step();
+      // The step's thread and the background factorisation since the last step.
+      thread += std::chrono::nanoseconds(common::thread_cpu_now_ns() - cpu0);
+      background += std::chrono::nanoseconds(fem.take_background_cpu_ns());
+      fem.state().header().sim_step(k);
+      fem.state().header().sim_time_ns(now_ns);
+      fem_hash_.add(fem.state());
+    }
     fem_step_thread_cpu_.record(thread);
     fem_background_cpu_ += background;
     last_fem_step_cpu_ = thread + background;
     fem_step_cpu_.record(last_fem_step_cpu_);
-    fem_->state().header().sim_step(k);
-    fem_->state().header().sim_time_ns(now_ns);
-    fem_hash_.add(fem_->state());
   }
 
   // Publish: what step k + 1 reads.
@@ -127,7 +154,7 @@ void StackSim::step() {
   std::swap(contacts_, next_contacts_);
   gateway_hash_.add(pose_);
   haptic_hash_.add(command_);
-  haptic_hash_.add(contacts_);
+  for (const msg::ContactSet& set : contacts_) haptic_hash_.add(set);
   fem_published_ = fem_stepped_;
   ++step_;
 }

@@ -13,10 +13,12 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fahr/common/publisher.h"
@@ -143,6 +145,13 @@ class StepInput {
   StepInput(Participant& participant, std::string_view topic_name = TopicTraits<T>::kName)
       : subscriber_(participant, input_qos(), topic_name,
                     [this](const T& sample, const SampleInfo&) { store(sample); }) {}
+  // Only the samples `wanted` keeps: one instance of a keyed topic (a
+  // body's), whose steps would otherwise share the slots with the others'.
+  StepInput(Participant& participant, std::function<bool(const T&)> wanted,
+            std::string_view topic_name = TopicTraits<T>::kName)
+      : wanted_(std::move(wanted)),
+        subscriber_(participant, input_qos(), topic_name,
+                    [this](const T& sample, const SampleInfo&) { store(sample); }) {}
 
   // Blocks until the sample of producer step `step` is here; null on timeout.
   const T* wait(std::uint64_t step, std::chrono::milliseconds timeout) {
@@ -159,6 +168,7 @@ class StepInput {
     return qos;
   }
   void store(const T& sample) {
+    if (wanted_ && !wanted_(sample)) return;
     {
       std::lock_guard lock(mutex_);
       Slot& slot = slots_[next_++ % kDepth];
@@ -182,7 +192,8 @@ class StepInput {
   std::condition_variable changed_;
   std::array<Slot, kDepth> slots_{};
   std::size_t next_ = 0;
-  Subscriber<T> subscriber_;
+  std::function<bool(const T&)> wanted_;
+  Subscriber<T> subscriber_;  // last: delivers into the members above
 };
 
 }  // namespace fahr::common

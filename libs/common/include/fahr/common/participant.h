@@ -34,8 +34,9 @@ class Participant {
   EventLog& events() { return *events_; }
   detail::ParticipantBackend& backend() { return *backend_; }
 
-  // Samples this participant's writer of `topic` has sent: its last
-  // sequence number (Publisher keeps it). The status reporter publishes
+  // Samples this participant's writers of `topic` have sent, which is the
+  // topic's last sequence number: every Publisher of the topic draws its
+  // numbers from it (several write a keyed topic, one per instance). The status reporter publishes
   // each as the metric "sent <topic>", so a recorder can check that
   // recorded + lost = sent for every writer. The reference stays valid for
   // the participant's life, after the publisher is gone.

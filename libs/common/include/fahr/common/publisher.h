@@ -31,8 +31,11 @@ class Publisher {
   // sim_time_ns and sim_step. Returns false if the vendor refused.
   bool write(T& sample) {
     auto& header = sample.header();
-    header.seq(++seq_);
-    sent_->store(seq_, std::memory_order_relaxed);
+    // One sequence per topic and participant, whichever of its publishers
+    // writes (one per body of a keyed topic): a recorder counts a writer's
+    // losses by its gaps.
+    seq_ = sent_->fetch_add(1, std::memory_order_relaxed) + 1;
+    header.seq(seq_);
     header.writer_id(writer_id_);
     const std::int64_t now_ns = wall_now_ns();
     header.source_time_ns(now_ns);

@@ -58,6 +58,11 @@ struct Admission {
   // Where the refusals are counted; shared, so a status reporter can read
   // them after the subscriber is gone.
   std::shared_ptr<AdmissionCounts> counts = std::make_shared<AdmissionCounts>();
+  // Of a keyed topic, the instance this reader follows (a body's ContactSets
+  // or DeformationStates, each from its own writer): a sample it does not
+  // want is passed over before anything else is judged, and not counted.
+  // Empty: every instance.
+  std::function<bool(const T&)> wanted;
 };
 
 template <class T>
@@ -147,12 +152,15 @@ class Subscriber final : private detail::SampleSink {
     info.source_time_ns = source_time_ns;
     info.receive_time_ns = wall_now_ns();
     info.source_key = source_key;
+    if (gated_ && admission_.wanted && !admission_.wanted(typed)) return;
     {
       // Sequence gaps per writer: tracks the most recent writer only, which
       // is exact for the single-writer topics fahr has.
       std::lock_guard lock(gap_mutex_);
       if (gated_ && !admit(typed, info)) return;
-      if (info.writer_id == last_writer_ && info.seq > last_seq_ + 1) {
+      // A reader of one instance sees a share of the writer's numbers: its
+      // gaps are the other instances' samples, not losses.
+      if (!admission_.wanted && info.writer_id == last_writer_ && info.seq > last_seq_ + 1) {
         info.missed_before = info.seq - last_seq_ - 1;
         missed_.fetch_add(info.missed_before, std::memory_order_relaxed);
       }

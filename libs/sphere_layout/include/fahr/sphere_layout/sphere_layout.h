@@ -103,6 +103,16 @@ class SphereLayout {
   double coarse_radius_m_ = 0.0;
 };
 
+// The layouts of several bodies as one, for a service that queries them as
+// one tissue (several deformable bodies, docs/design/two-deformable-bodies.md):
+// the spheres of layouts[b] follow those of the layouts before it, and their
+// node and tet indices are shifted by node_offsets[b] and by the tets before
+// it (node_offsets[b]: the nodes of the bodies before b, in the same order
+// as the union mesh's). One layout gives an equal copy. Throws
+// std::invalid_argument when the sizes disagree.
+SphereLayout concatenate(std::span<const SphereLayout* const> layouts,
+                         std::span<const std::size_t> node_offsets);
+
 // Weights that sum to 1 within this are accepted: they are formed in double
 // precision from a handful of terms, so a larger error is a bug.
 inline constexpr double kWeightSumTolerance = 1e-9;

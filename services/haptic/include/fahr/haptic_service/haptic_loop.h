@@ -9,6 +9,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -106,6 +107,15 @@ inline constexpr std::int64_t kTissueLossTimeoutNs = 50'000'000;
 // zero (150 ms at 1 kHz); each command still changes by at most kResetSlewN.
 inline constexpr double kLossRampTicks = 150.0;
 
+// Several deformable bodies: the tick's ContactSet of the joined tissue
+// (sphere ids of HapticSetup::layout) as one set per body, out[b] for
+// HapticSetup::bodies[b]: its contacts in the tick's order with the body's
+// own sphere ids, its layout's fingerprint and the FEM step of its state;
+// the tool's pose, state and header as the tick's. Allocation-free while
+// each out[b] holds msg::MAX_CONTACTS.
+void split_contacts(const HapticSetup& setup, const TissueSnapshot& tissue,
+                    const msg::ContactSet& joined, std::span<msg::ContactSet* const> out);
+
 class HapticLoop {
  public:
   explicit HapticLoop(const HapticSetup& setup);
@@ -118,6 +128,7 @@ class HapticLoop {
   void tick(const msg::DevicePose& pose, const TissueSnapshot& tissue, msg::ForceCommand& command,
             msg::ContactSet& contacts, bool tissue_lost = false);
 
+  const HapticSetup& setup() const { return setup_; }
   const contact::ContactResponse& response() const { return response_; }
   const LoopMetrics& metrics() const { return metrics_; }
   const TickPhases& last_phases() const { return phases_; }

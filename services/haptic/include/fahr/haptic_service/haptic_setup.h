@@ -1,9 +1,15 @@
 // Builds what the haptic service's loop needs from a scene, once, before
-// the first tick: the deformable body's AIST (the same deterministic filling
-// as fahr_fem_service, so sphere ids agree; every ContactSet carries the
-// layout's fingerprint and the FEM refuses a set of another), the tool's
+// the first tick: each deformable body's AIST (the same deterministic
+// filling as fahr_fem_service, so sphere ids agree; every ContactSet carries
+// the layout's fingerprint and the FEM refuses a set of another), the tool's
 // signed distance field in its own frame, the obstacles' fields in theirs,
 // and the contact response settings.
+//
+// Several deformable bodies are one tissue to the tick: their meshes and
+// layouts joined (nodes and spheres of each body after those of the bodies
+// before it, in the scene's order), queried through one sphere tree, their
+// compliance blocks one block-diagonal W (no body moves another), the
+// ContactSet split back into one per body (docs/design/two-deformable-bodies.md).
 #pragma once
 
 #include <cstdint>
@@ -56,10 +62,27 @@ struct TriangleCollisionSetup {
 // The scene decides (HapticSetup::row_compliance).
 enum class RowCompliance { kDeepest, kFreeDepth };
 
+// Deformable bodies a scene may give the haptic service: each adds its W
+// block to the joined one, which grows with the square of the count.
+inline constexpr std::size_t kMaxTissueBodies = 4;
+
+// One deformable body of the tissue.
+struct TissueBody {
+  const scene::Body* body = nullptr;
+  geometry::TetMesh mesh;                // world frame, m (the FEM service's frame too)
+  sphere_layout::SphereLayout layout;    // the FEM service's, sphere ids its own
+  std::uint64_t layout_fingerprint = 0;  // layout.fingerprint(), in its ContactSets
+  std::size_t first_node = 0;            // its first node in HapticSetup::mesh
+  std::uint32_t first_sphere = 0;        // its first sphere in HapticSetup::layout
+};
+
 struct HapticSetup {
   const scene::Scene* scene = nullptr;
-  const scene::Body* deformable = nullptr;
-  geometry::TetMesh mesh;  // world frame, m (the FEM service's frame too)
+  // The deformable bodies, in the scene's order (at least one).
+  std::vector<TissueBody> bodies;
+  // The tissue the tick queries: the bodies' meshes and layouts joined (with
+  // one body, its own).
+  geometry::TetMesh mesh;
   sphere_layout::SphereLayout layout;
   std::unique_ptr<RigidField> tool;
   // The tool field's grid in the compact form the tick's AIST query reads
@@ -90,6 +113,10 @@ struct HapticSetup {
   // spheres 1 mm beyond it, to remember their centres outside.
   double candidate_margin_m = 1e-3;
 };
+
+// The body (index into HapticSetup::bodies) a sphere of the joined layout
+// belongs to.
+std::size_t body_of_sphere(const HapticSetup& setup, std::uint32_t sphere);
 
 // Throws std::runtime_error naming the body and what is wrong.
 // fem_keeps_anatomy: the FEM keeps the tongue out of the anatomy itself

@@ -1,5 +1,7 @@
-// Real time: a thread of its own digests every new DeformationState into a
-// TissueSnapshot and hands it to the tick through a triple buffer. The tick
+// Real time: a thread of its own digests every new DeformationState (with
+// several deformable bodies, each body's newest: one reader per body, the
+// FEM writing them in the scene's order) into a TissueSnapshot and hands it
+// to the tick through a triple buffer. The tick
 // takes the newest snapshot without waiting; a digest (~1 ms on the neonatal
 // tongue) never delays a force. Lockstep digests inline instead
 // (haptic_service_main.cpp), where reproducibility matters, not latency.
@@ -7,6 +9,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <thread>
 #include <utility>
@@ -53,8 +56,9 @@ class TissueFeed {
   std::int64_t last_state_ns() const { return last_state_ns_.load(std::memory_order_acquire); }
 
   const FeedMetrics& metrics() const { return metrics_; }
-  // DeformationStates refused before the digest (another writer, out of order).
-  const common::AdmissionCounts& admission() const { return states_.admission_counts(); }
+  // DeformationStates refused before the digest (another writer, out of
+  // order), all bodies'.
+  const common::AdmissionCounts& admission() const { return *admission_; }
   // Also resets the per-report maximum (reporter thread).
   void append_metrics(std::vector<std::pair<std::string, double>>& out);
 
@@ -63,11 +67,13 @@ class TissueFeed {
 
   TissueDigest digest_;
   common::TripleBuffer<TissueSnapshot> buffer_;
-  common::Subscriber<msg::DeformationState> states_;
+  std::shared_ptr<common::AdmissionCounts> admission_ = std::make_shared<common::AdmissionCounts>();
+  std::vector<std::unique_ptr<common::Subscriber<msg::DeformationState>>> states_;  // per body
+  std::vector<const msg::DeformationState*> newest_;  // per body, null until its first
   FeedMetrics metrics_;
   std::atomic<std::int64_t> last_state_ns_{0};
   std::atomic<bool> stop_{false};
-  std::thread thread_;  // last: starts once everything above exists
+  std::thread thread_;  // started by the constructor once everything above exists
 };
 
 }  // namespace fahr::haptic_service

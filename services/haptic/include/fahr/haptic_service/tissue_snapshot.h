@@ -1,4 +1,5 @@
-// One DeformationState digested for the haptic tick: sphere centres and
+// The DeformationStates of the tissue's bodies (one per deformable body)
+// digested for the haptic tick: sphere centres and
 // radii, the refitted sphere tree, the compliance W of the candidate spheres
 // with their free-motion centres, and the tissue's contacts with the rigid
 // anatomy. Built off the tick (TissueDigest, on the state thread in real time
@@ -29,8 +30,14 @@ namespace fahr::haptic_service {
 struct TissueSnapshot {
   // false: the rest state the loop starts from, before any DeformationState.
   bool from_fem = false;
+  // The first body's DeformationState::step; each body's, in the setup's
+  // order (one FEM service steps them together: they differ only while a
+  // period's states are still arriving).
   std::uint64_t fem_step = 0;
-  std::uint32_t reset_epoch = 0;  // DeformationState::reset_epoch
+  std::vector<std::uint64_t> body_fem_steps;
+  // DeformationState::reset_epoch summed over the bodies: a reset of any
+  // changes it.
+  std::uint32_t reset_epoch = 0;
   // The FEM participant that wrote the state (SampleHeader::writer_id): a
   // restarted FEM service is a new writer whose tongue starts at rest.
   std::uint32_t fem_writer = 0;
@@ -38,7 +45,9 @@ struct TissueSnapshot {
   collision::SphereTree tree;
 
   // W of compliance_ids (3k x 3k row-major, m/N) and their free-motion
-  // centres (3k, m; empty when the FEM did not send them).
+  // centres (3k, m; empty when the FEM did not send them). Several bodies:
+  // their blocks one after the other, block-diagonal (zero between bodies),
+  // ids in the joined layout.
   std::vector<std::uint32_t> compliance_ids;
   std::vector<float> w_mpn;
   std::vector<float> free_centres_m;
@@ -87,20 +96,29 @@ class TissueDigest {
   // its own triangle trees when the setup asks for the baseline).
   TissueSnapshot make_snapshot();
 
-  // Digests `state` into `out` (whatever it held before). False, with `out`
-  // unusable, when the state does not fit the mesh or holds a non-finite
+  // Digests the bodies' states, states[b] of HapticSetup::bodies[b], into
+  // `out` (whatever it held before). False, with `out` unusable, when one is
+  // missing, of another body, does not fit its mesh or holds a non-finite
   // position: the caller keeps its previous snapshot.
-  bool digest(const msg::DeformationState& state, TissueSnapshot& out);
+  bool digest(std::span<const msg::DeformationState* const> states, TissueSnapshot& out);
+  // The one body's state (a scene with one deformable body).
+  bool digest(const msg::DeformationState& state, TissueSnapshot& out) {
+    const msg::DeformationState* one = &state;
+    return digest({&one, 1}, out);
+  }
 
-  // Whether `state` can be digested: positions for every node of the mesh,
-  // every position, compliance entry, normal and free centre finite. Reads
-  // nothing digest() writes (a reader's Admission calls it on the vendor
-  // thread).
+  // Whether `state` can be digested: of one of the bodies, positions for
+  // every node of its mesh, every position, compliance entry, normal and
+  // free centre finite. Reads nothing digest() writes (a reader's Admission
+  // calls it on the vendor thread).
   bool plausible(const msg::DeformationState& state) const;
 
  private:
   void query_obstacles(TissueSnapshot& out);
-  void index_compliance(const msg::DeformationState& state, TissueSnapshot& out);
+  void index_compliance(std::span<const msg::DeformationState* const> states, TissueSnapshot& out);
+  // The body (index into HapticSetup::bodies) of a state's body_id, or the
+  // body count when none.
+  std::size_t body_index(std::uint32_t body_id) const;
 
   const HapticSetup& setup_;
   std::vector<double> positions_m_;  // float wire positions widened for SphereState

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "contact_set.h"
 #include "deformation_state.h"
@@ -81,16 +82,20 @@ class StackSim {
   double time_s() const { return 1e-9 * static_cast<double>(step_ * base_period_ns_); }
   std::uint64_t fem_period_steps() const { return fem_period_; }
 
-  // The outputs of the last step (the FEM's: of its last step).
+  // The outputs of the last step (the FEM's: of its last step). With
+  // several deformable bodies, body b's ContactSet (the scene's order;
+  // contacts() is the first's).
   const msg::DevicePose& pose() const { return pose_; }
   const msg::ForceCommand& command() const { return command_; }
-  const msg::ContactSet& contacts() const { return contacts_; }
+  const msg::ContactSet& contacts(std::size_t b = 0) const { return contacts_[b]; }
   bool fem_stepped() const { return fem_stepped_; }  // in the last step
 
-  const fem::Body& body() const { return *fem_setup_.body; }
-  fem::Body& body() { return *fem_setup_.body; }  // energy() needs it
-  const geometry::TetMesh& tongue_mesh() const { return fem_setup_.mesh; }
-  const fem_service::ServiceStep& fem() const { return *fem_; }
+  // The deformable bodies: the first (the tongue) by default.
+  std::size_t body_count() const { return fems_.size(); }
+  const fem::Body& body(std::size_t b = 0) const { return *fem_setups_[b]->body; }
+  fem::Body& body(std::size_t b = 0) { return *fem_setups_[b]->body; }  // energy() needs it
+  const geometry::TetMesh& tongue_mesh() const { return fem_setups_.front()->mesh; }
+  const fem_service::ServiceStep& fem(std::size_t b = 0) const { return *fems_[b]; }
   const device::ServoCore& gateway() const { return *gateway_; }
   const device::SimulatedBackend& hand() const { return *hand_; }
   const haptic_service::HapticLoop& haptic() const { return *haptic_; }
@@ -128,16 +133,22 @@ class StackSim {
   std::unique_ptr<haptic_service::TissueDigest> digest_;
   haptic_service::TissueSnapshot tissue_;
 
-  fem_service::FemBodySetup fem_setup_;
-  std::unique_ptr<fem_service::ServiceStep> fem_;
+  // One FEM service stepping every deformable body, in the scene's order.
+  std::vector<std::unique_ptr<fem_service::FemBodySetup>> fem_setups_;
+  std::vector<std::unique_ptr<fem_service::ServiceStep>> fems_;
+  std::vector<const msg::DeformationState*> fem_states_;
 
-  // What each service published in the step before (the read rule).
+  // What each service published in the step before (the read rule); a
+  // ContactSet per body. With several bodies the tick fills joined_, split
+  // into next_contacts_ (haptic_service::split_contacts).
   msg::DevicePose pose_;
   msg::ForceCommand command_;
-  msg::ContactSet contacts_;
+  std::vector<msg::ContactSet> contacts_;
   msg::DevicePose next_pose_;
   msg::ForceCommand next_command_;
-  msg::ContactSet next_contacts_;
+  std::vector<msg::ContactSet> next_contacts_;
+  msg::ContactSet joined_;
+  std::vector<msg::ContactSet*> split_to_;
   device::ForceCommandSample command_sample_;
   bool fem_stepped_ = false;
   bool fem_published_ = false;
