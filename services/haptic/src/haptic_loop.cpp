@@ -108,7 +108,7 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
       tool_contacts_(kToolContactCapacity),
       order_(kToolContactCapacity, 0),
       row_key_(kToolContactCapacity, 0.0),
-      order_scratch_(msg::MAX_COMPLIANCE_SPHERES, 0),
+      order_scratch_(setup.bodies.size() * msg::MAX_COMPLIANCE_SPHERES, 0),
       anatomy_contacts_(kAnatomyContactCapacity),
       anatomy_order_(kAnatomyContactCapacity, 0),
       tissue_row_budget_(std::min<std::size_t>(msg::MAX_COMPLIANCE_SPHERES - kComplianceRequests,
