@@ -1,6 +1,7 @@
 // The FEM service's run over DDS (see fem_loop.h).
 #include "fahr/fem_service/fem_loop.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -55,16 +56,24 @@ int run_realtime(common::Participant& participant, BodySteps& steps, const scene
   // sent within 1 s; a restarted one is followed after that.
   std::vector<std::unique_ptr<common::Publisher<msg::DeformationState>>> out;
   std::vector<std::unique_ptr<common::Subscriber<msg::ContactSet>>> in;
+  std::vector<std::uint32_t> ids;
+  for (const auto& step : steps) ids.push_back(body_id(*step));
   for (auto& step : steps) {
     const std::uint32_t id = body_id(*step);
+    // A set naming no body of the scene (an intruder's) goes to the first
+    // body's reader, to be judged and counted there.
+    const bool first = id == ids.front();
     out.push_back(std::make_unique<common::Publisher<msg::DeformationState>>(participant, out_qos));
     in.push_back(std::make_unique<common::Subscriber<msg::ContactSet>>(
-        participant, common::Admission<msg::ContactSet>{.takeover = std::chrono::seconds(1),
-                                                        .valid = {},
-                                                        .counts = step->contact_admission(),
-                                                        .wanted = [id](const msg::ContactSet& set) {
-                                                          return set.body_id() == id;
-                                                        }}));
+        participant, common::Admission<msg::ContactSet>{
+                         .takeover = std::chrono::seconds(1),
+                         .valid = {},
+                         .counts = step->contact_admission(),
+                         .wanted = [id, first, ids](const msg::ContactSet& set) {
+                           return set.body_id() == id ||
+                                  (first &&
+                                   std::find(ids.begin(), ids.end(), set.body_id()) == ids.end());
+                         }}));
   }
   const auto period = scene.rates.fem_period();
   const auto start = Clock::now();

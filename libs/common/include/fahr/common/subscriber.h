@@ -61,7 +61,9 @@ struct Admission {
   // Of a keyed topic, the instance this reader follows (a body's ContactSets
   // or DeformationStates, each from its own writer): a sample it does not
   // want is passed over before anything else is judged, and not counted.
-  // Empty: every instance.
+  // Empty: every instance. Samples of an instance no reader follows (an
+  // intruder's) should be wanted by one of the readers, which then refuses
+  // and counts them.
   std::function<bool(const T&)> wanted;
 };
 
