@@ -50,8 +50,12 @@ round() {  # round LISTENER-ARGS... -- COMMANDER-ARGS...
   "$peer" command --seconds 4 --dds "$vendor" --domain "$domain" "${command_args[@]}" \
     >"$out/command.txt" 2>&1 || true
   wait "$listener" || true
-  command_line=$(grep -a "^command: " "$out/command.txt" | tail -n 1)
-  listen_line=$(grep -a "^listen: received" "$out/listen.txt" | tail -n 1)
+  # A peer that printed no such line (it died) fails the checks below with
+  # its output shown, rather than ending the script here without a word.
+  command_line=$(grep -a "^command: " "$out/command.txt" | tail -n 1 || true)
+  listen_line=$(grep -a "^listen: received" "$out/listen.txt" | tail -n 1 || true)
+  [ -n "$command_line" ] || { echo "  commander printed no result:"; sed 's/^/    /' "$out/command.txt"; }
+  [ -n "$listen_line" ] || { echo "  listener printed no result:"; sed 's/^/    /' "$out/listen.txt"; }
   received=$(echo "$listen_line" | sed -n 's/^listen: received \([0-9]*\) .*/\1/p')
   echo "  commander: $command_line"
   echo "  listener:  $listen_line"

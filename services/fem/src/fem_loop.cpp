@@ -1,7 +1,6 @@
 // The FEM service's run over DDS (see fem_loop.h).
 #include "fahr/fem_service/fem_loop.h"
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -30,8 +29,10 @@ void record(common::TickRecorder& recorder, BodySteps& steps, std::uint64_t tick
   recorder.push({tick, start_ns, common::monotonic_now_ns() - start_ns, cpu_ns});
 }
 
-std::uint32_t body_id(const ServiceStep& step) {
-  return step.setup().scene_body->id;
+std::vector<std::uint32_t> body_ids(const BodySteps& steps) {
+  std::vector<std::uint32_t> ids;
+  for (const auto& step : steps) ids.push_back(step->setup().scene_body->id);
+  return ids;
 }
 
 }  // namespace
@@ -56,24 +57,18 @@ int run_realtime(common::Participant& participant, BodySteps& steps, const scene
   // sent within 1 s; a restarted one is followed after that.
   std::vector<std::unique_ptr<common::Publisher<msg::DeformationState>>> out;
   std::vector<std::unique_ptr<common::Subscriber<msg::ContactSet>>> in;
-  std::vector<std::uint32_t> ids;
-  for (const auto& step : steps) ids.push_back(body_id(*step));
-  for (auto& step : steps) {
-    const std::uint32_t id = body_id(*step);
-    // A set naming no body of the scene (an intruder's) goes to the first
-    // body's reader, to be judged and counted there.
-    const bool first = id == ids.front();
+  // A set naming no body of the scene (an intruder's) goes to the first
+  // body's reader, to be refused and counted there.
+  const std::vector<std::uint32_t> ids = body_ids(steps);
+  for (std::size_t b = 0; b < steps.size(); ++b) {
     out.push_back(std::make_unique<common::Publisher<msg::DeformationState>>(participant, out_qos));
     in.push_back(std::make_unique<common::Subscriber<msg::ContactSet>>(
-        participant, common::Admission<msg::ContactSet>{
-                         .takeover = std::chrono::seconds(1),
-                         .valid = {},
-                         .counts = step->contact_admission(),
-                         .wanted = [id, first, ids](const msg::ContactSet& set) {
-                           return set.body_id() == id ||
-                                  (first &&
-                                   std::find(ids.begin(), ids.end(), set.body_id()) == ids.end());
-                         }}));
+        participant,
+        common::Admission<msg::ContactSet>{
+            .takeover = std::chrono::seconds(1),
+            .valid = {},
+            .counts = steps[b]->contact_admission(),
+            .wanted = common::body_instance<msg::ContactSet>(ids, b, /*strays=*/true)}));
   }
   const auto period = scene.rates.fem_period();
   const auto start = Clock::now();
@@ -125,12 +120,12 @@ int run_lockstep(common::Participant& participant, BodySteps& steps, const scene
                  common::TickRecorder& recorder) {
   std::vector<std::unique_ptr<common::Publisher<msg::DeformationState>>> out;
   std::vector<std::unique_ptr<common::StepInput<msg::ContactSet>>> in;
-  for (auto& step : steps) {
-    const std::uint32_t id = body_id(*step);
+  const std::vector<std::uint32_t> ids = body_ids(steps);
+  for (std::size_t b = 0; b < steps.size(); ++b) {
     out.push_back(std::make_unique<common::Publisher<msg::DeformationState>>(
         participant, common::lockstep_output_qos<msg::DeformationState>()));
     in.push_back(std::make_unique<common::StepInput<msg::ContactSet>>(
-        participant, [id](const msg::ContactSet& set) { return set.body_id() == id; }));
+        participant, common::body_instance<msg::ContactSet>(ids, b, /*strays=*/false)));
   }
   common::LockstepClient client(participant, "fem");
   client.join();

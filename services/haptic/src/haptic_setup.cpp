@@ -61,6 +61,12 @@ std::size_t body_of_sphere(const HapticSetup& setup, std::uint32_t sphere) {
   return b;
 }
 
+std::vector<std::uint32_t> body_ids(const HapticSetup& setup) {
+  std::vector<std::uint32_t> ids;
+  for (const TissueBody& body : setup.bodies) ids.push_back(body.body->id);
+  return ids;
+}
+
 HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fem_keeps_anatomy) {
   const scene::ServicePlan plan = scene::derive_plan(scene);
   if (!plan.tool_body)

@@ -190,10 +190,10 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
   const std::size_t bodies = setup.bodies.size();
   std::vector<std::unique_ptr<common::StepInput<msg::DeformationState>>> states;
   std::vector<std::unique_ptr<common::Publisher<msg::ContactSet>>> contact_sets;
-  for (const TissueBody& body : setup.bodies) {
-    const std::uint32_t id = body.body->id;
+  const std::vector<std::uint32_t> ids = body_ids(setup);
+  for (std::size_t b = 0; b < bodies; ++b) {
     states.push_back(std::make_unique<common::StepInput<msg::DeformationState>>(
-        participant, [id](const msg::DeformationState& s) { return s.body_id() == id; }));
+        participant, common::body_instance<msg::DeformationState>(ids, b, /*strays=*/false)));
     contact_sets.push_back(std::make_unique<common::Publisher<msg::ContactSet>>(
         participant, common::lockstep_output_qos<msg::ContactSet>()));
   }
@@ -277,12 +277,24 @@ int run_lockstep(common::Participant& participant, const HapticSetup& setup, Hap
 
 namespace {
 
-// 'tongue' or 'tongue' + 'epiglottis'.
+// "'tongue'" or "'tongue' + 'epiglottis'", and "layout 0x..." or
+// "layouts 0x..., 0x..." in the same order.
 std::string body_names(const HapticSetup& setup) {
   std::string names;
   for (const TissueBody& body : setup.bodies)
     names += (names.empty() ? "'" : " + '") + body.body->name + "'";
   return names;
+}
+
+std::string layouts(const HapticSetup& setup) {
+  std::string text = setup.bodies.size() > 1 ? "layouts" : "layout";
+  for (std::size_t b = 0; b < setup.bodies.size(); ++b) {
+    char hex[24];
+    std::snprintf(hex, sizeof hex, "%s0x%016llx", b == 0 ? " " : ", ",
+                  static_cast<unsigned long long>(setup.bodies[b].layout_fingerprint));
+    text += hex;
+  }
+  return text;
 }
 
 std::string field_sources(const HapticSetup& setup) {
@@ -296,12 +308,11 @@ std::string field_sources(const HapticSetup& setup) {
 void print_ready_line(const common::Participant& participant, const HapticSetup& setup,
                       const std::string& collision, bool lockstep, double setup_s) {
   std::printf(
-      "fahr_haptic_service: ready: %s, body %s (%zu nodes, %zu spheres, layout 0x%016llx), "
+      "fahr_haptic_service: ready: %s, body %s (%zu nodes, %zu spheres, %s), "
       "tool '%s' (%zu surface samples), "
       "%zu tissue / %zu tool obstacles, %s collision, %.0f Hz, %s, set-up %.2f s (%s)\n",
       std::string(common::vendor_name(participant.vendor())).c_str(), body_names(setup).c_str(),
-      setup.mesh.node_count(), setup.layout.size(),
-      static_cast<unsigned long long>(setup.bodies.front().layout_fingerprint),
+      setup.mesh.node_count(), setup.layout.size(), layouts(setup).c_str(),
       setup.tool->scene_body->name.c_str(), setup.tool_samples.points_m().size(),
       setup.tissue_obstacles.size(), setup.tool_obstacles.size(), collision.c_str(),
       setup.scene->rates.haptic_hz, lockstep ? "lockstep" : "realtime", setup_s,

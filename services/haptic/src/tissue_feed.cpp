@@ -16,25 +16,17 @@ TissueFeed::TissueFeed(common::Participant& participant, const HapticSetup& setu
   // One FEM at a time: another writer refused while it has sent within 1 s
   // (the tongue is already lost after 50 ms); a restarted FEM is followed
   // once the first has been silent that long. A state that does not fit the
-  // mesh is refused before it can become the source.
-  std::vector<std::uint32_t> ids;
-  for (const TissueBody& body : setup.bodies) ids.push_back(body.body->id);
-  for (const TissueBody& body : setup.bodies) {
-    const std::uint32_t id = body.body->id;
-    // A state naming no body of the scene (an intruder's) goes to the first
-    // body's reader, to be judged and counted there.
-    const bool first = id == ids.front();
+  // mesh is refused before it can become the source, and one naming no body
+  // of the scene goes to the first body's reader, to be refused there.
+  const std::vector<std::uint32_t> ids = body_ids(setup);
+  for (std::size_t b = 0; b < ids.size(); ++b) {
     states_.push_back(std::make_unique<common::Subscriber<msg::DeformationState>>(
         participant,
         common::Admission<msg::DeformationState>{
             .takeover = std::chrono::seconds(1),
             .valid = [this](const msg::DeformationState& s) { return digest_.plausible(s); },
             .counts = admission_,
-            .wanted =
-                [id, first, ids](const msg::DeformationState& s) {
-                  return s.body_id() == id ||
-                         (first && std::find(ids.begin(), ids.end(), s.body_id()) == ids.end());
-                }}));
+            .wanted = common::body_instance<msg::DeformationState>(ids, b, /*strays=*/true)}));
   }
   thread_ = std::thread([this] { run(); });
 }

@@ -6,6 +6,7 @@
 // so a refused sample never displaces the newest good one.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -66,6 +67,23 @@ struct Admission {
   // and counts them.
   std::function<bool(const T&)> wanted;
 };
+
+// The `wanted` filter of one of several readers of a topic keyed by body
+// (ContactSet, DeformationState), one reader per body: reader `index` of
+// `bodies` follows its body's instance. With `strays`, the first reader also
+// takes the samples naming none of `bodies` (an intruder's), so that one
+// reader judges, refuses and counts them rather than none.
+template <class T>
+std::function<bool(const T&)> body_instance(std::vector<std::uint32_t> bodies, std::size_t index,
+                                            bool strays) {
+  const std::uint32_t id = bodies.at(index);
+  const bool take_strays = strays && index == 0;
+  return [id, take_strays, bodies = std::move(bodies)](const T& sample) {
+    const std::uint32_t key = sample.body_id();
+    return key == id ||
+           (take_strays && std::find(bodies.begin(), bodies.end(), key) == bodies.end());
+  };
+}
 
 template <class T>
 class Subscriber final : private detail::SampleSink {

@@ -117,6 +117,8 @@ struct HapticSetup {
 // The body (index into HapticSetup::bodies) a sphere of the joined layout
 // belongs to.
 std::size_t body_of_sphere(const HapticSetup& setup, std::uint32_t sphere);
+// The bodies' ids (their DDS keys), in HapticSetup::bodies' order.
+std::vector<std::uint32_t> body_ids(const HapticSetup& setup);
 
 // Throws std::runtime_error naming the body and what is wrong.
 // fem_keeps_anatomy: the FEM keeps the tongue out of the anatomy itself
