@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
         "triangles\n",
         scene->tongue.node_count(), scene->tongue.tet_count(), scene->boundary.triangle_count(),
         scene->mean_boundary_edge_m * 1e3, scene->blade.triangle_count());
-    if (section == "coverage" || section == "all") coverage_table(*scene);
+    if (section == "coverage" || section == "all") coverage_table(*scene, scene_dir);
     if (section == "trajectory" || section == "all") trajectory_table(*scene, options);
     if (section == "sweep" || section == "all") sweep_table(*scene, options);
     if (section == "record" || section == "replay") {

@@ -53,7 +53,9 @@ struct Options {
 // how far inside the surface the sphere union may sit by construction.
 inline constexpr double kCandidateMarginM = 0.25e-3;
 
-void coverage_table(const Scene& scene);
+// The tongue's layouts, the ArtiSynth tongue's, and the epiglottis's thin
+// leaf (scene_dir/epiglottis, when the scene has it).
+void coverage_table(const Scene& scene, const std::string& scene_dir);
 // What the trajectory, record and replay fill and query with (Options').
 sphere_layout::FillSettings trajectory_fill(const Options& options);
 collision::QuerySettings trajectory_query(const Options& options);

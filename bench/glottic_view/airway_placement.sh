@@ -41,28 +41,7 @@ if [ ${#markdown[@]} -gt 0 ] && [ ! -x "$results" ]; then
 fi
 work=$(mktemp -d /tmp/fahr-airway-placement-XXXXXX)
 trap 'rm -rf "$work"' EXIT
-scene="$repo/deployment/scenes/neonatal_intubation.yaml"
 angles=(30 35 40 45 50 55)
-
-# A scene file for the meshes in DIR with the opening the generator printed
-# (its "glottic_view ..." line) and, with "out", without the epiglottis.
-scene_for() {
-  local dir=$1 epiglottis=$2
-  local opening
-  opening=$(grep '^glottic_view ' "$dir/generator.log")
-  awk -v dir="$dir/" -v opening="$opening" -v drop="$epiglottis" '
-    BEGIN { n = split(opening, f, " ")
-            for (i = 2; i < n; i++) if (f[i] ~ /^opening_/) { key = f[i]; val = f[i + 1]
-              for (j = i + 2; j <= n && f[j] !~ /^opening_/; j++) val = val " " f[j]
-              set[key] = val } }
-    { gsub(/\.\.\/\.\.\/meshes\/neonatal\//, dir) }
-    drop == "out" && /^  - name: epiglottis$/ { skipping = 1; next }
-    skipping && /^  - name: / { skipping = 0 }
-    skipping { next }
-    match($0, /^  (opening_[a-z_]+): /) { key = substr($0, 3, RLENGTH - 4)
-      if (key in set) { print "  " key ": " set[key]; next } }
-    { print }' "$scene"
-}
 
 {
   echo "## The glottis seen past the rigid airway: rays %, eyes 150 mm from the opening"
@@ -81,7 +60,11 @@ scene_for() {
       >"$dir/generator.log" 2>&1 || { echo "airway_placement: the generator refused:" >&2; tail -n 20 "$dir/generator.log" >&2; exit 1; }
     glottis=$(sed -nE 's/^landmark lips to glottis.*glottis at \(([-0-9.]+), ([-0-9.]+)\)$/(\1, \2)/p' "$dir/generator.log")
     for epiglottis in in out; do
-      scene_for "$dir" "$epiglottis" >"$dir/scene_$epiglottis.yaml"
+      if [ "$epiglottis" = in ]; then
+        bash "$repo/bench/support/generated_scene.sh" "$dir" >"$dir/scene_$epiglottis.yaml"
+      else
+        bash "$repo/bench/support/generated_scene.sh" "$dir" --without-epiglottis >"$dir/scene_$epiglottis.yaml"
+      fi
       line="| $extension | $rise | $epiglottis | $glottis |"
       for deg in "${angles[@]}"; do
         r=$("$score" --scene "$dir/scene_$epiglottis.yaml" --anatomy-only --around "$deg,150,0" \

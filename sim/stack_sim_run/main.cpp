@@ -4,7 +4,8 @@
 // fahr_lockstep_clock does for the same run over DDS, and a few figures.
 // Equal hashes show that the in-process run is the distributed one.
 //
-//   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
+//   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot]
+//   [--collision aist|triangle]
 //                      [--stiffening C20/C10] [--volume-floor R] [--w-normals N] [--seconds 4]
 //
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
@@ -35,7 +36,8 @@ int main(int argc, char** argv) try {
   double seconds = 4.0;
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--script", script, "the simulated hand's script")
-      ->check(fahr::cli::IsMember({"intubation", "overshoot"}));
+      ->check(
+          fahr::cli::IsMember({std::begin(device::kScriptNames), std::end(device::kScriptNames)}));
   std::string collision = "aist";
   app.add_option("--collision", collision, "the haptic service's collision method")
       ->check(fahr::cli::IsMember({"aist", "triangle"}));
@@ -59,8 +61,7 @@ int main(int argc, char** argv) try {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     stack_sim::StackOptions options;
-    options.script =
-        script == "overshoot" ? device::Script::kOvershoot : device::Script::kIntubation;
+    device::script_by_name(script, options.script);  // the option checks the name
     options.collision = collision == "triangle" ? haptic_service::CollisionMethod::kTriangle
                                                 : haptic_service::CollisionMethod::kAist;
     auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));

@@ -33,14 +33,25 @@ using fahr::scenegen::TriangleMesh;
 #error "FAHR_SCENE_GENERATOR must name the generator executable"
 #endif
 
-const std::vector<std::string> kSceneFiles = {"tongue.node",     "tongue.ele",
-                                              "tongue.face",     "tongue_fixed_nodes.txt",
-                                              "palate.obj",      "jaw.obj",
-                                              "hyoid.obj",       "lips_face.obj",
-                                              "miller0.obj",     "larynx_trachea.obj",
-                                              "miller1.obj",     "scene_parameters.txt",
-                                              "soft_palate.obj", "epiglottis.obj",
-                                              "pharynx.obj"};
+const std::vector<std::string> kSceneFiles = {"tongue.node",
+                                              "tongue.ele",
+                                              "tongue.face",
+                                              "tongue_fixed_nodes.txt",
+                                              "palate.obj",
+                                              "jaw.obj",
+                                              "hyoid.obj",
+                                              "lips_face.obj",
+                                              "miller0.obj",
+                                              "larynx_trachea.obj",
+                                              "miller1.obj",
+                                              "scene_parameters.txt",
+                                              "soft_palate.obj",
+                                              "epiglottis.obj",
+                                              "pharynx.obj",
+                                              "epiglottis.node",
+                                              "epiglottis.ele",
+                                              "epiglottis.face",
+                                              "epiglottis_fixed_nodes.txt"};
 const std::vector<std::string> kSurfaces = {
     "palate",     "jaw",         "hyoid",   "lips_face", "larynx_trachea",
     "epiglottis", "soft_palate", "pharynx", "miller0",   "miller1"};
@@ -66,6 +77,24 @@ fs::path run_generator(const std::string& tag) {
                               dir.string() + "\" > \"" + (dir / "generator.log").string() + "\"";
   EXPECT_EQ(std::system(command.c_str()), 0) << "generator failed; see " << dir / "generator.log";
   return dir;
+}
+
+// Every tet's nodes exist and its volume is positive; the boundary is closed
+// and outward.
+void expect_valid_tets(const MeshedSolid& mesh) {
+  for (size_t i = 0; i < mesh.tets.size(); ++i) {
+    const auto& t = mesh.tets[i];
+    for (const int v : t) ASSERT_LT(static_cast<size_t>(v), mesh.nodes.size()) << "tet " << i;
+    EXPECT_GT(fahr::scenegen::tet_signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]],
+                                                mesh.nodes[t[2]], mesh.nodes[t[3]]),
+              0.0)
+        << "tet " << i;
+  }
+  const TriangleMesh boundary{mesh.nodes, mesh.boundary};
+  const auto closed = fahr::scenegen::check_closed(boundary);
+  EXPECT_TRUE(closed.closed_and_oriented())
+      << closed.bad_edges << " bad, " << closed.inconsistent_edges << " inconsistent edges";
+  EXPECT_GT(fahr::scenegen::enclosed_volume(boundary), 0.0) << "boundary not outward";
 }
 
 class SceneGeneratorTest : public ::testing::Test {
@@ -146,19 +175,7 @@ TEST_F(SceneGeneratorTest, TetsHavePositiveVolumeAndBoundaryIsClosed) {
   // The tongue (about 5,500 tets) with the floor of the mouth (about 2,600).
   EXPECT_GE(tongue.tets.size(), 5600u);
   EXPECT_LE(tongue.tets.size(), 10000u);
-  for (size_t i = 0; i < tongue.tets.size(); ++i) {
-    const auto& t = tongue.tets[i];
-    for (const int v : t) ASSERT_LT(static_cast<size_t>(v), tongue.nodes.size()) << "tet " << i;
-    EXPECT_GT(fahr::scenegen::tet_signed_volume(tongue.nodes[t[0]], tongue.nodes[t[1]],
-                                                tongue.nodes[t[2]], tongue.nodes[t[3]]),
-              0.0)
-        << "tet " << i;
-  }
-  const TriangleMesh boundary{tongue.nodes, tongue.boundary};
-  const auto closed = fahr::scenegen::check_closed(boundary);
-  EXPECT_TRUE(closed.closed_and_oriented())
-      << closed.bad_edges << " bad, " << closed.inconsistent_edges << " inconsistent edges";
-  EXPECT_GT(fahr::scenegen::enclosed_volume(boundary), 0.0) << "boundary not outward";
+  expect_valid_tets(tongue);
 }
 
 TEST_F(SceneGeneratorTest, SurfacesAreClosedAndOutward) {
@@ -236,6 +253,44 @@ TEST_F(SceneGeneratorTest, TongueBoundaryIsCleanWithSignedField) {
   }
   const fahr::geometry::SurfaceMesh surface(std::move(vertices), std::move(triangles));
   expect_clean_and_signed(surface, "tongue boundary");
+}
+
+// The deformable epiglottis: every tet of positive volume and no sliver, a
+// closed outward boundary that is the rigid epiglottis.obj's surface (the same
+// lattice), held at its base only: the fixed nodes are its lowest, over the
+// larynx's anterior rim, and the tip is free.
+TEST_F(SceneGeneratorTest, EpiglottisTetsAreTheLeafHeldAtItsBase) {
+  MeshedSolid leaf;
+  std::string error;
+  ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "epiglottis").string(), leaf, error)) << error;
+  EXPECT_GE(leaf.tets.size(), 1000u);
+  EXPECT_GE(fahr::scenegen::tet_quality(leaf).min_dihedral_deg, 15.0);
+  expect_valid_tets(leaf);
+  const TriangleMesh boundary{leaf.nodes, leaf.boundary};
+  TriangleMesh rigid;
+  ASSERT_TRUE(fahr::scenegen::read_obj((*first_ / "epiglottis.obj").string(), rigid, error))
+      << error;
+  EXPECT_NEAR(fahr::scenegen::enclosed_volume(boundary), fahr::scenegen::enclosed_volume(rigid),
+              0.02 * fahr::scenegen::enclosed_volume(rigid));
+  double lowest = 1e9;
+  double highest = -1e9;
+  for (const auto& p : leaf.nodes) {
+    lowest = std::min(lowest, p.y());
+    highest = std::max(highest, p.y());
+  }
+  std::ifstream file(*first_ / "epiglottis_fixed_nodes.txt");
+  std::string line;
+  int fixed = 0;
+  while (std::getline(file, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    const std::size_t v = std::stoul(line);
+    ASSERT_LT(v, leaf.nodes.size());
+    EXPECT_LE(leaf.nodes[v].y(), lowest + 0.5) << "fixed node " << v << " is not at the base";
+    ++fixed;
+  }
+  EXPECT_GE(fixed, 10);
+  EXPECT_LT(fixed, static_cast<int>(leaf.nodes.size()) / 4);
+  EXPECT_GE(highest - lowest, 8.0) << "the leaf's length";
 }
 
 // The body is held only where it meets bone: every fixed node lies on the

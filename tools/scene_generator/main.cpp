@@ -261,6 +261,31 @@ int main(int argc, char** argv) {
     ok = ok && folded == 0;
   }
 
+  // The epiglottis as a deformable body: its box's lattice split into tets
+  // (a 1.2 mm leaf is thinner than the tongue's grid cell), fixed at its
+  // base (the u = 0 face: the petiole, held by the thyroepiglottic ligament
+  // over the larynx's anterior rim).
+  const MeshedSolid epiglottis = param_box_tets(boxes.at("epiglottis"));
+  const TetQuality epiglottis_quality = tet_quality(epiglottis);
+  const ParamBox& epiglottis_lattice = boxes.at("epiglottis");
+  std::vector<int> epiglottis_base((epiglottis_lattice.nv + 1) * (epiglottis_lattice.nw + 1));
+  for (size_t i = 0; i < epiglottis_base.size(); ++i) epiglottis_base[i] = static_cast<int>(i);
+  {
+    const TriangleMesh boundary = as_written(TriangleMesh{epiglottis.nodes, epiglottis.boundary});
+    const auto closed = check_closed(boundary);
+    std::printf(
+        "epiglottis tets: %zu nodes, %zu tets, %zu boundary triangles, %zu fixed base nodes;"
+        " min dihedral %.2f deg, max dihedral %.2f deg, tets under 10 deg %d, volume min %.4f"
+        " max %.4f mm^3; boundary bad edges %d, inconsistent %d, pinched %d, folded %d\n",
+        epiglottis.nodes.size(), epiglottis.tets.size(), epiglottis.boundary.size(),
+        epiglottis_base.size(), epiglottis_quality.min_dihedral_deg,
+        epiglottis_quality.max_dihedral_deg, epiglottis_quality.below_10_deg,
+        epiglottis_quality.min_volume_mm3, epiglottis_quality.max_volume_mm3, closed.bad_edges,
+        closed.inconsistent_edges, closed.pinched_vertices, closed.folded_edges);
+    ok = ok && closed.clean() && enclosed_volume(boundary) > 0.0 &&
+         epiglottis_quality.min_volume_mm3 > 0.0;
+  }
+
   // The body is fixed where it meets bone: the floor along the mandible's
   // lingual face (mylohyoid line, and the genial tubercles behind the chin,
   // where genioglossus and geniohyoid arise) and on the hyoid.
@@ -348,6 +373,19 @@ int main(int argc, char** argv) {
                        "the attachment band of the mandible (jaw.obj) or the hyoid (hyoid.obj).\n" +
                            note,
                        error);
+  written = written &&
+            write_tetgen(epiglottis, dir + "epiglottis",
+                         "neonatal epiglottis as a deformable body, TetGen format, 0-based; the\n"
+                         "lattice of epiglottis.obj split into Kuhn tets, positive volume;\n"
+                         ".face: outward boundary triangles.\n" +
+                             note,
+                         error) &&
+            write_index_list(epiglottis_base, dir + "epiglottis_fixed_nodes.txt",
+                             "nodes of the epiglottis fixed at its base (the petiole over the\n"
+                             "larynx's anterior rim): 0-based indices into epiglottis.node, the\n"
+                             "lattice's base face.\n" +
+                                 note,
+                             error);
   const std::map<std::string, std::string> what = {
       {"palate", "hard palate (maxilla block, underside = palatal vault and upper gum)"},
       {"jaw", "mandible: U-shaped bar from gonial angle to gonial angle, gum ridge on top"},

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 #include <stdexcept>
 
@@ -66,15 +67,24 @@ TrajectoryPoint Trajectory::at(std::chrono::duration<double> time) const {
 }
 
 bool script_by_name(std::string_view name, Script& out) {
-  if (name == "intubation") {
-    out = Script::kIntubation;
-    return true;
-  }
-  if (name == "overshoot") {
-    out = Script::kOvershoot;
-    return true;
+  for (std::size_t i = 0; i < std::size(kScriptNames); ++i) {
+    if (name == kScriptNames[i]) {
+      out = static_cast<Script>(i);
+      return true;
+    }
   }
   return false;
+}
+
+Trajectory script_trajectory(Script script, double peak_force_n, double hand_stiffness_npm,
+                             double overshoot_factor) {
+  switch (script) {
+    case Script::kOvershoot:
+      return overshoot_script(peak_force_n, hand_stiffness_npm, overshoot_factor);
+    case Script::kIntubation:
+      break;
+  }
+  return intubation_script();
 }
 
 // Keyframes are the hand's intention, not where the blade ends up: while

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <string_view>
 
+#include "fahr/device/trajectory.h"
+
 namespace fahr::gateway_service {
 
 namespace {
@@ -104,7 +106,8 @@ std::optional<GatewayOptions> parse_options(int argc, char** argv) {
   if (!in_set(o.mode, {"realtime", "lockstep"})) return reject("--mode", o.mode);
   if (!in_set(o.backend, {"simulated", "replay", "remote", "openhaptics"}))
     return reject("--backend", o.backend);
-  if (!in_set(o.script, {"intubation", "overshoot"})) return reject("--script", o.script);
+  if (device::Script script{}; !device::script_by_name(o.script, script))
+    return reject("--script", o.script);
   if (o.backend == "replay" && o.replay_file.empty())
     return reject("--replay-file", "(missing: replay needs a file)");
   if (o.rt_priority > 99) return reject("--rt-priority", std::to_string(o.rt_priority));

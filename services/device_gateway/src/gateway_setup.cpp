@@ -28,9 +28,7 @@ std::optional<GatewaySetup> make_setup(const GatewayOptions& o) {
     device::script_by_name(o.script, script);
     const device::HandImpedance hand;
     auto trajectory =
-        script == device::Script::kIntubation
-            ? device::intubation_script()
-            : device::overshoot_script(s.config.model.peak_force_n, hand.stiffness_npm);
+        device::script_trajectory(script, s.config.model.peak_force_n, hand.stiffness_npm);
     if (s.duration_s == 0.0) s.duration_s = trajectory.duration().count();
     s.backend = std::make_unique<device::SimulatedBackend>(
         std::move(trajectory), hand, s.config.model, s.config.mapping, s.config.period);

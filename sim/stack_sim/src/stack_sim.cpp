@@ -39,10 +39,10 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
   gateway_config_.period = scene_->run.base_period;
   const device::HandImpedance hand;
   device::Trajectory script =
-      options.script == device::Script::kOvershoot
-          ? device::overshoot_script(gateway_config_.model.peak_force_n, hand.stiffness_npm,
-                                     options.overshoot_factor)
-          : device::intubation_script();
+      options.keyframes
+          ? *options.keyframes
+          : device::script_trajectory(options.script, gateway_config_.model.peak_force_n,
+                                      hand.stiffness_npm, options.overshoot_factor);
   hand_ =
       std::make_unique<device::SimulatedBackend>(std::move(script), hand, gateway_config_.model,
                                                  gateway_config_.mapping, gateway_config_.period);

@@ -116,15 +116,20 @@ ParamBox epiglottis_box(const EpiglottisParameters& e, const AirwayParameters& a
     const double y = base_y + e.length_mm * u;
     const double front = e.front_x_mm - lean * e.length_mm * u;
     // Narrow at the base (the petiole), full curl from a third of the way up.
-    const double radius = e.radius_mm * (0.55 + 0.45 * smoothstep(0.0, 0.35, u));
+    // The petiole's radius stays well above the leaf's thickness, so the
+    // lattice's tets (the deformable epiglottis) keep their shape there.
+    const double radius = e.radius_mm * (0.7 + 0.3 * smoothstep(0.0, 0.35, u));
     const double phi = (2.0 * v - 1.0) * curl;
     // The lingual face is the arc; the laryngeal face lies a thickness
     // inside it, towards the curl's centre (posterior).
     const double r = radius - e.thickness_mm * w;
     return neck_pose(a, Vec3(front - radius + r * std::cos(phi), y, r * std::sin(phi)));
   };
+  // Cells near cubes (0.75 x 0.9 x 0.6 mm at the 1.5 mm resolution), which
+  // the deformable epiglottis's tets need more than the surface needs a
+  // finer arc.
   return {map, cells_for(e.length_mm, 0.5 * resolution_mm),
-          cells_for(2.0 * curl * e.radius_mm, 0.4 * resolution_mm), 2};
+          cells_for(2.0 * curl * e.radius_mm, 0.6 * resolution_mm), 2};
 }
 
 TriangleMesh make_epiglottis(const EpiglottisParameters& e, const AirwayParameters& a,

@@ -4,9 +4,12 @@
 #include "fahr/scenegen/param_surfaces.h"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <vector>
 
 #include "fahr/scenegen/mesh_checks.h"
+#include "fahr/scenegen/tet_mesher.h"
 
 namespace fahr::scenegen {
 namespace {
@@ -82,58 +85,107 @@ TriangleMesh make_param_box(const ParamBox& box) {
   return make_param_box(box.map, box.nu, box.nv, box.nw);
 }
 
-int folded_box_tets(const ParamBox& box) {
-  const int nu = box.nu;
-  const int nv = box.nv;
-  const int nw = box.nw;
-  std::vector<Vec3> lattice;
-  lattice.reserve(static_cast<size_t>(nu + 1) * static_cast<size_t>(nv + 1) *
-                  static_cast<size_t>(nw + 1));
-  for (int i = 0; i <= nu; ++i) {
-    for (int j = 0; j <= nv; ++j) {
-      for (int k = 0; k <= nw; ++k) {
-        lattice.push_back(
-            box.map(grid_coordinate(i, nu), grid_coordinate(j, nv), grid_coordinate(k, nw)));
+namespace {
+
+// The box's lattice points, (i, j, k) at (i * (nv + 1) + j) * (nw + 1) + k,
+// and its cells split into six Kuhn tets each: a monotone path from corner
+// (0,0,0) to (1,1,1) per axis permutation, every cell with the same main
+// diagonal, so shared faces split alike (conforming). `visit(tet, sign)` gets
+// lattice indices and sign(permutation): the tet's orientation under the
+// identity map.
+struct KuhnLattice {
+  std::vector<Vec3> points;
+  template <class Visit>
+  static void each_tet(const ParamBox& box, Visit&& visit);
+};
+
+KuhnLattice lattice_of(const ParamBox& box) {
+  KuhnLattice l;
+  l.points.reserve(static_cast<size_t>(box.nu + 1) * static_cast<size_t>(box.nv + 1) *
+                   static_cast<size_t>(box.nw + 1));
+  for (int i = 0; i <= box.nu; ++i) {
+    for (int j = 0; j <= box.nv; ++j) {
+      for (int k = 0; k <= box.nw; ++k) {
+        l.points.push_back(box.map(grid_coordinate(i, box.nu), grid_coordinate(j, box.nv),
+                                   grid_coordinate(k, box.nw)));
       }
     }
   }
-  const auto at = [&](int i, int j, int k) -> const Vec3& {
-    const int index = (i * (nv + 1) + j) * (nw + 1) + k;
-    return lattice[static_cast<size_t>(index)];
-  };
-  // Kuhn split: a monotone path from corner (0,0,0) to (1,1,1) per axis
-  // permutation; the identity map gives each tet the volume sign(permutation) / 6.
+  return l;
+}
+
+template <class Visit>
+void KuhnLattice::each_tet(const ParamBox& box, Visit&& visit) {
   constexpr int kPermutations[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1},
                                        {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
-  constexpr double kPermutationSign[6] = {1.0, 1.0, 1.0, -1.0, -1.0, -1.0};
-  int positive = 0;
-  int negative = 0;
-  int flat = 0;
-  for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) {
-      for (int k = 0; k < nw; ++k) {
+  constexpr int kPermutationSign[6] = {1, 1, 1, -1, -1, -1};
+  const auto index = [&box](const int(&c)[3]) {
+    return (c[0] * (box.nv + 1) + c[1]) * (box.nw + 1) + c[2];
+  };
+  for (int i = 0; i < box.nu; ++i) {
+    for (int j = 0; j < box.nv; ++j) {
+      for (int k = 0; k < box.nw; ++k) {
         for (int p = 0; p < 6; ++p) {
           int corner[3] = {i, j, k};
-          Vec3 tet[4];
-          tet[0] = at(corner[0], corner[1], corner[2]);
+          std::array<int, 4> tet{};
+          tet[0] = index(corner);
           for (int step = 0; step < 3; ++step) {
             ++corner[kPermutations[p][step]];
-            tet[step + 1] = at(corner[0], corner[1], corner[2]);
+            tet[static_cast<size_t>(step) + 1] = index(corner);
           }
-          const double volume =
-              kPermutationSign[p] * (tet[1] - tet[0]).dot((tet[2] - tet[0]).cross(tet[3] - tet[0]));
-          if (volume > 0.0) {
-            ++positive;
-          } else if (volume < 0.0) {
-            ++negative;
-          } else {
-            ++flat;
-          }
+          visit(tet, kPermutationSign[p]);
         }
       }
     }
   }
+}
+
+double image_volume(const KuhnLattice& l, const std::array<int, 4>& t, int sign) {
+  const auto& p = l.points;
+  const Vec3& a = p[static_cast<size_t>(t[0])];
+  return sign *
+         (p[static_cast<size_t>(t[1])] - a)
+             .dot((p[static_cast<size_t>(t[2])] - a).cross(p[static_cast<size_t>(t[3])] - a));
+}
+
+}  // namespace
+
+int folded_box_tets(const ParamBox& box) {
+  const KuhnLattice lattice = lattice_of(box);
+  int positive = 0;
+  int negative = 0;
+  int flat = 0;
+  KuhnLattice::each_tet(box, [&](const std::array<int, 4>& tet, int sign) {
+    const double volume = image_volume(lattice, tet, sign);
+    if (volume > 0.0) {
+      ++positive;
+    } else if (volume < 0.0) {
+      ++negative;
+    } else {
+      ++flat;
+    }
+  });
   return std::min(positive, negative) + flat;
+}
+
+MeshedSolid param_box_tets(const ParamBox& box) {
+  KuhnLattice lattice = lattice_of(box);
+  MeshedSolid mesh;
+  // The image's orientation: the map's handedness, the same in every tet of a
+  // box that does not fold (folded_box_tets).
+  double total = 0.0;
+  KuhnLattice::each_tet(box, [&](const std::array<int, 4>& tet, int sign) {
+    total += image_volume(lattice, tet, sign);
+  });
+  const int handedness = total < 0.0 ? -1 : 1;
+  KuhnLattice::each_tet(box, [&](std::array<int, 4> tet, int sign) {
+    // Positive volume in the image, as TetGen files and the FEM expect.
+    if (sign * handedness < 0) std::swap(tet[2], tet[3]);
+    mesh.tets.push_back(tet);
+  });
+  mesh.nodes = std::move(lattice.points);
+  mesh.boundary = boundary_faces(mesh.tets);
+  return mesh;
 }
 
 TriangleMesh make_param_torus(const TorusMap& map, int n_around, int n_loop) {

@@ -97,23 +97,6 @@ std::vector<std::array<int, 4>> inside_tets(const ImplicitSolid& shape, const Gr
   return tets;
 }
 
-// Boundary faces (outward) in tet order, and the set of boundary nodes.
-std::vector<std::array<int, 3>> boundary_faces(const std::vector<std::array<int, 4>>& tets) {
-  std::map<std::array<int, 3>, int> count;
-  for (const auto& t : tets) {
-    for (int f = 0; f < 4; ++f) ++count[sorted_face(t, f)];
-  }
-  std::vector<std::array<int, 3>> faces;
-  for (const auto& t : tets) {
-    for (int f = 0; f < 4; ++f) {
-      if (count[sorted_face(t, f)] == 1) {
-        faces.push_back({t[kTetFaces[f][0]], t[kTetFaces[f][1]], t[kTetFaces[f][2]]});
-      }
-    }
-  }
-  return faces;
-}
-
 // Tets kept by their centroid can meet along an edge only (four boundary
 // faces around one edge): the boundary is then not a manifold. Removing the
 // tets on such edges settles it in a pass or two.
@@ -242,6 +225,22 @@ bool tet_acceptable(const MeshedSolid& m, const std::array<int, 4>& t, double mi
 }
 
 }  // namespace
+
+std::vector<std::array<int, 3>> boundary_faces(const std::vector<std::array<int, 4>>& tets) {
+  std::map<std::array<int, 3>, int> count;
+  for (const auto& t : tets) {
+    for (int f = 0; f < 4; ++f) ++count[sorted_face(t, f)];
+  }
+  std::vector<std::array<int, 3>> faces;
+  for (const auto& t : tets) {
+    for (int f = 0; f < 4; ++f) {
+      if (count[sorted_face(t, f)] == 1) {
+        faces.push_back({t[kTetFaces[f][0]], t[kTetFaces[f][1]], t[kTetFaces[f][2]]});
+      }
+    }
+  }
+  return faces;
+}
 
 MeshedSolid mesh_implicit_solid(const ImplicitSolid& shape, const TetMesherSettings& settings,
                                 TetMesherReport& report) {

@@ -44,7 +44,15 @@ enum class Script : std::uint8_t {
   kOvershoot,   // press the blade up to 3x the force limit, hold 5 s, release
 };
 
+// The names scenes and command lines use, in Script's order.
+inline constexpr std::string_view kScriptNames[] = {"intubation", "overshoot"};
+
 bool script_by_name(std::string_view name, Script& out);
+
+// A script's keyframes; the overshoot script's depth comes from the device's
+// peak force and the hand's stiffness.
+Trajectory script_trajectory(Script script, double peak_force_n, double hand_stiffness_npm,
+                             double overshoot_factor = 3.0);
 
 // The neonatal intubation: poses from meshes/neonatal/README.md (initial tip
 // (12, 0.5, 0) mm, pressing tip (-33, -0.5, 0) mm pitched 8 degrees).

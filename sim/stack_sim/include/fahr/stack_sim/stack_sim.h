@@ -59,6 +59,8 @@ struct Experiments {
 
 struct StackOptions {
   device::Script script = device::Script::kIntubation;
+  // The hand's keyframes instead of the script's (benches that try a motion).
+  std::optional<device::Trajectory> keyframes;
   // Overshoot script: how far past the device's peak force the hand pulls.
   double overshoot_factor = 3.0;
   haptic_service::CollisionMethod collision = haptic_service::CollisionMethod::kAist;

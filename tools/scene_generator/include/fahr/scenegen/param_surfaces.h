@@ -32,6 +32,14 @@ TriangleMesh make_param_box(const ParamBox& box);
 // cells to overlap, which this does not test).
 int folded_box_tets(const ParamBox& box);
 
+// The box as a tet mesh: its lattice points as nodes (node (i, j, k) is
+// (i * (nv + 1) + j) * (nw + 1) + k, so the u = 0 face is the first
+// (nv + 1) * (nw + 1) nodes), each cell split into the six Kuhn tets that
+// folded_box_tets checks, every tet of positive volume when the box does not
+// fold, and the outward boundary triangles. For thin deformable parts (the
+// epiglottis) that a cube grid cannot hold.
+MeshedSolid param_box_tets(const ParamBox& box);
+
 // Torus-topology surface: both parameters periodic on [0, 1). Good for rings
 // and thick-walled tubes (face around the mouth, larynx and trachea).
 using TorusMap = std::function<Vec3(double around, double loop)>;

@@ -5,6 +5,7 @@
 // refused when it would invert a tet or push it below the quality floor.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -37,6 +38,10 @@ struct TetMesherReport {
   double max_surface_gap_mm = 0.0;  // |implicit value| at boundary nodes after snapping
   int nonmanifold_boundary_edges = 0;
 };
+
+// The faces that belong to one tet only, outward for positively oriented
+// tets, in tet order.
+std::vector<std::array<int, 3>> boundary_faces(const std::vector<std::array<int, 4>>& tets);
 
 MeshedSolid mesh_implicit_solid(const ImplicitSolid& shape, const TetMesherSettings& settings,
                                 TetMesherReport& report);

@@ -1,0 +1,212 @@
+// A scripted laryngoscopy on a scene with its deformable bodies, the whole
+// loop in lockstep in one process (fahr::stack_sim): where the blade is,
+// the force it puts on each deformable body, how far each body has moved,
+// and the glottic view score (POGO) from the scene's eye, every
+// --trace-every seconds; then the peaks. For a laryngoscopy that reaches
+// the epiglottis on a scene where it is soft
+// (bench/support/soft_epiglottis_scene.sh): README.md.
+//
+//   fahr_laryngoscopy_bench --scene FILE [--script NAME | --keyframes FILE] [--seconds S]
+//                     [--trace-every S]
+//
+// --keyframes FILE: the hand's own keyframes instead of a script, one per
+// line "t_s x_mm y_mm z_mm pitch_deg" (the blade tip in the world frame,
+// the pitch about +z), '#' starts a comment: to try a motion before it
+// becomes a script.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <iterator>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fahr/cli/cli.h"
+#include "fahr/common/solver_threads.h"
+#include "fahr/glottic_view/blade_from_contacts.h"
+#include "fahr/glottic_view/scene_view.h"
+#include "fahr/scene/load_scene.h"
+#include "fahr/stack_sim/stack_sim.h"
+
+namespace {
+
+using namespace fahr;
+
+// The blade's force on one body: the tool rows' forces along their normals
+// (the anatomy's rows left out), N, and how many tool rows there are.
+struct BodyLoad {
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  std::size_t rows = 0;
+};
+
+BodyLoad tool_load(const msg::ContactSet& set) {
+  BodyLoad load;
+  for (const auto& c : set.contacts()) {
+    if (c.kind() == msg::CONTACT_OBSTACLE || c.state() == msg::CONSTRAINT_CANDIDATE) continue;
+    load.force_n += c.force_n() * Eigen::Vector3d(c.normal().x(), c.normal().y(), c.normal().z());
+    ++load.rows;
+  }
+  return load;
+}
+
+// Largest node motion from rest, m, and the body's positions as points.
+double largest_motion(const stack_sim::StackSim& sim, std::size_t b,
+                      std::vector<Eigen::Vector3d>& points) {
+  const auto& rest = sim.fem(b).setup().mesh.rest_positions();
+  const auto x = sim.body(b).positions_m();
+  points.resize(rest.size());
+  double moved = 0.0;
+  for (std::size_t n = 0; n < rest.size(); ++n) {
+    points[n] = Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]);
+    moved = std::max(moved, (points[n] - rest[n]).norm());
+  }
+  return moved;
+}
+
+// Keyframes from a file (see the header); throws naming the file and line.
+device::Trajectory read_keyframes(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw std::runtime_error(path + ": cannot open");
+  std::vector<device::Keyframe> keyframes;
+  std::string line;
+  for (int number = 1; std::getline(file, line); ++number) {
+    line = line.substr(0, line.find('#'));
+    std::istringstream in(line);
+    double t = 0.0, x = 0.0, y = 0.0, z = 0.0, pitch = 0.0;
+    if (!(in >> t)) continue;  // blank or comment
+    std::string rest;
+    if (!(in >> x >> y >> z >> pitch) || (in >> rest) || !std::isfinite(t + x + y + z + pitch)) {
+      throw std::runtime_error(path + ":" + std::to_string(number) +
+                               ": want five finite numbers: t_s x_mm y_mm z_mm pitch_deg");
+    }
+    keyframes.push_back({t, 1e-3 * Eigen::Vector3d(x, y, z), pitch});
+  }
+  try {
+    return device::Trajectory(std::move(keyframes));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  fahr::common::run_solver_libraries_on_one_thread(argv);
+  cli::App app{"a scripted laryngoscopy in lockstep: forces per body, motion, glottic view"};
+  std::string scene_path = FAHR_SOURCE_DIR "/deployment/scenes/neonatal_intubation.yaml";
+  std::string script_name = "intubation";
+  double seconds = 0.0;
+  double trace_every_s = 0.5;
+  std::string keyframes_path;
+  app.add_option("--scene", scene_path, "scene file");
+  app.add_option("--script", script_name, "the simulated hand's script")
+      ->check(cli::IsMember({std::begin(device::kScriptNames), std::end(device::kScriptNames)}));
+  app.add_option("--keyframes", keyframes_path, "the hand's keyframes instead of the script");
+  app.add_option("--seconds", seconds, "simulated time, s; 0: the whole script")
+      ->check(cli::Range(0.0, 3600.0));
+  app.add_option("--trace-every", trace_every_s, "a trace row every this many seconds")
+      ->check(cli::Range(0.001, 100.0));
+  if (const auto exit = app.parse(argc, argv)) return *exit;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  try {
+    stack_sim::StackOptions options;
+    device::script_by_name(script_name, options.script);  // the option checks the name
+    if (!keyframes_path.empty()) {
+      options.keyframes = read_keyframes(keyframes_path);
+      script_name = std::filesystem::path(keyframes_path).filename().string();
+    }
+    auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));
+    if (seconds == 0.0) {
+      seconds = options.keyframes
+                    ? options.keyframes->duration().count()
+                    : device::script_trajectory(options.script, 1.0, 1.0).duration().count();
+    }
+    stack_sim::StackSim sim(scene, options);
+    auto view = glottic_view::glottic_view_from_scene(*scene);
+    const std::size_t bodies = sim.body_count();
+    std::vector<std::vector<Eigen::Vector3d>> points(bodies);
+    std::vector<double> peak_force(bodies, 0.0);
+    std::vector<double> peak_motion(bodies, 0.0);
+    std::vector<std::uint64_t> touched_ticks(bodies, 0);
+    double peak_total = 0.0;
+    double pogo_first = -1.0;
+    double pogo_best = 0.0;
+    double pogo_best_t = 0.0;
+    const auto steps = static_cast<std::uint64_t>(std::llround(seconds * 1000.0));
+    const auto trace_steps =
+        std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(trace_every_s * 1e3)));
+    std::printf("laryngoscopy_bench: scene %s, script %s, %.1f s, %zu deformable bodies\n",
+                scene->name.c_str(), script_name.c_str(), seconds, bodies);
+    std::printf("  t s | blade tip mm (x, y, z) | hand - blade mm | |F| N");
+    for (std::size_t b = 0; b < bodies; ++b) {
+      std::printf(" | %s: F N, rows, moved mm", sim.fem(b).setup().scene_body->name.c_str());
+    }
+    std::printf(" | POGO %%\n");
+    for (std::uint64_t k = 1; k <= steps; ++k) {
+      sim.step();
+      double total = 0.0;
+      for (std::size_t b = 0; b < bodies; ++b) {
+        const BodyLoad load = tool_load(sim.contacts(b));
+        peak_force[b] = std::max(peak_force[b], load.force_n.norm());
+        if (load.rows > 0) ++touched_ticks[b];
+      }
+      const auto& f = sim.command().force_n();
+      total = Eigen::Vector3d(f.x(), f.y(), f.z()).norm();
+      peak_total = std::max(peak_total, total);
+      if (k % trace_steps != 0 && k != 1) continue;
+      const auto blade = glottic_view::blade_from_contacts(sim.contacts(0));
+      std::vector<std::span<const Eigen::Vector3d>> spans;
+      std::vector<double> moved(bodies);
+      for (std::size_t b = 0; b < bodies; ++b) {
+        moved[b] = largest_motion(sim, b, points[b]);
+        peak_motion[b] = std::max(peak_motion[b], moved[b]);
+        spans.emplace_back(points[b]);
+      }
+      double pogo = 0.0;
+      Eigen::Vector3d tip = Eigen::Vector3d::Zero();
+      if (blade.world_from_tool) {
+        tip = blade.world_from_tool->translation();
+        const Eigen::Vector3d eye = *blade.world_from_tool * view.eye_in_tool_m;
+        pogo = 100.0 * view.view.score(eye, blade.world_from_tool, spans).visible_share;
+      }
+      if (pogo_first < 0.0) pogo_first = pogo;
+      if (pogo > pogo_best) {
+        pogo_best = pogo;
+        pogo_best_t = sim.time_s();
+      }
+      const auto& gap = sim.command().device_minus_proxy_m();
+      std::printf("%5.2f | %6.1f %6.1f %5.1f | %5.1f %5.1f %5.1f | %5.2f", sim.time_s(),
+                  1e3 * tip.x(), 1e3 * tip.y(), 1e3 * tip.z(), 1e3 * gap.x(), 1e3 * gap.y(),
+                  1e3 * gap.z(), total);
+      for (std::size_t b = 0; b < bodies; ++b) {
+        const BodyLoad load = tool_load(sim.contacts(b));
+        std::printf(" | %5.2f %3zu %5.2f", load.force_n.norm(), load.rows, 1e3 * moved[b]);
+      }
+      std::printf(" | %5.1f\n", pogo);
+    }
+    std::printf("laryngoscopy_bench: peak |F| %.3f N; POGO at the start %.1f %%, best %.1f %% at %.2f s\n",
+                peak_total, pogo_first, pogo_best, pogo_best_t);
+    for (std::size_t b = 0; b < bodies; ++b) {
+      std::printf(
+          "laryngoscopy_bench: body '%s': peak tool force %.3f N, ticks touched %llu, largest node "
+          "motion %.2f mm, max inverted elements %llu, resets %llu\n",
+          sim.fem(b).setup().scene_body->name.c_str(), peak_force[b],
+          static_cast<unsigned long long>(touched_ticks[b]), 1e3 * peak_motion[b],
+          static_cast<unsigned long long>(sim.fem(b).inverted_max()),
+          static_cast<unsigned long long>(sim.fem(b).divergence_resets()));
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fahr_laryngoscopy_bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

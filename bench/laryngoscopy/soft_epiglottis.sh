@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# The epiglottis as a second deformable body, on the shipped airway (head
+# neutral) and on the airway placed for laryngoscopy (head extended 15 deg,
+# the larynx's anterior rim 5 mm lowered, generated into a temporary
+# directory: the shipped files are not touched): per airway, the whole loop
+# in lockstep in one process (fahr_laryngoscopy_bench) with the shipped
+# intubation script and with the Miller keyframes tried on it
+# (miller_neutral.keyframes, miller_extended.keyframes). Each run prints
+# the blade's force on each body, their motion and the glottic view every
+# 0.5 s, then the peaks.
+#
+#   bench/laryngoscopy/soft_epiglottis.sh [BUILD_DIR] [--markdown [FILE]]
+#
+# --markdown: also write the output to FILE (a name ending in .md), by
+# default bench/results/<machine>/soft-epiglottis.md. About 3 min.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+repo=$(cd "$here/../.." && pwd)
+command=("$0" "$@")
+build="$repo/build"
+markdown=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --markdown)
+      if [ $# -gt 1 ] && [[ "$2" == *.md ]]; then markdown=(--markdown "$2"); shift 2
+      else markdown=(--markdown); shift; fi ;;
+    -*) echo "soft_epiglottis: unknown flag $1" >&2; exit 2 ;;
+    *) build=$(cd "$1" && pwd); shift ;;
+  esac
+done
+bench="$build/bench/laryngoscopy/fahr_laryngoscopy_bench"
+generator="$build/tools/scene_generator/fahr_scene_generator"
+for tool in "$bench" "$generator"; do
+  [ -x "$tool" ] || { echo "soft_epiglottis: build $(basename "$tool") first" >&2; exit 1; }
+done
+results="$build/bench/support/fahr_bench_results"
+if [ ${#markdown[@]} -gt 0 ] && [ ! -x "$results" ]; then
+  echo "soft_epiglottis: $results is missing; build it: cmake --build $build --target fahr_bench_results" >&2
+  exit 1
+fi
+export OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE:-Haswell} OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+work=$(mktemp -d /tmp/fahr-soft-epiglottis-XXXXXX)
+trap 'rm -rf "$work"' EXIT
+shipped="$repo/deployment/scenes/neonatal_intubation.yaml"
+soft="$repo/bench/support/soft_epiglottis_scene.sh"
+
+# The extended airway: its meshes, and the shipped scene pointed at them.
+mkdir -p "$work/extended"
+"$generator" --out "$work/extended" --head-extension-deg 15 --larynx-fold-rise-mm -5 \
+  >"$work/extended/generator.log" 2>&1 ||
+  { echo "soft_epiglottis: the generator refused:" >&2; tail -n 20 "$work/extended/generator.log" >&2; exit 1; }
+bash "$repo/bench/support/generated_scene.sh" "$work/extended" >"$work/extended/rigid.yaml"
+bash "$soft" "$shipped" >"$work/neutral.yaml"
+bash "$soft" "$work/extended/rigid.yaml" >"$work/extended.yaml"
+
+{
+  echo "## The epiglottis as a deformable body"
+  echo
+  echo "The shipped scene with its epiglottis made soft (bench/support/soft_epiglottis_scene.sh:"
+  echo "the generator's tet leaf, fixed at its base, E 1 MPa, an estimate), in lockstep in one"
+  echo "process. Neutral: the shipped airway; extended: head extended 15 deg, the larynx's"
+  echo "anterior rim 5 mm lowered. Per row: where the blade tip is (world frame), the hand's"
+  echo "lead over the blade, the force rendered, and per body the blade's force on it (the sum of"
+  echo "its tool rows), its tool rows and its largest node motion; the glottic view from the"
+  echo "scene's eye."
+  for airway in neutral extended; do
+    for motion in intubation "miller_$airway.keyframes"; do
+      echo
+      echo "### $airway airway, $motion"
+      echo
+      echo '```'
+      if [ "$motion" = intubation ]; then
+        "$bench" --scene "$work/$airway.yaml" --script intubation --trace-every 1
+      else
+        "$bench" --scene "$work/$airway.yaml" --keyframes "$here/$motion" --seconds 12 \
+          --trace-every 0.5
+      fi
+      echo '```'
+    done
+  done
+} | if [ ${#markdown[@]} -gt 0 ]; then
+  "$results" soft-epiglottis "${markdown[@]}" -- "${command[@]}"
+else
+  cat
+fi
