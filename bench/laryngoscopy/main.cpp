@@ -21,11 +21,11 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <iterator>
 #include <memory>
 #include <optional>
 #include <span>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -138,6 +138,12 @@ int main(int argc, char** argv) {
     std::vector<double> peak_motion(bodies, 0.0);
     std::vector<std::uint64_t> touched_ticks(bodies, 0);
     double peak_total = 0.0;
+    // Ticks on which the tool was wedged (the solve's tissue reaction past
+    // the limit with bone's rows in it: the tissue got the limit, force
+    // only), held (lost track), and the anatomy's largest push on the tool.
+    std::uint64_t wedged_ticks = 0;
+    std::uint64_t held_ticks = 0;
+    double peak_anatomy = 0.0;
     double pogo_first = -1.0;
     double pogo_best = 0.0;
     double pogo_best_t = 0.0;
@@ -159,6 +165,10 @@ int main(int argc, char** argv) {
         peak_force[b] = std::max(peak_force[b], load.force_n.norm());
         if (load.rows > 0) ++touched_ticks[b];
       }
+      const auto& report = sim.haptic().response().report();
+      if (report.tissue_force_clamped) ++wedged_ticks;
+      if (sim.command().lost_track()) ++held_ticks;
+      peak_anatomy = std::max(peak_anatomy, report.obstacle_reaction_n);
       const auto& f = sim.command().force_n();
       total = Eigen::Vector3d(f.x(), f.y(), f.z()).norm();
       peak_total = std::max(peak_total, total);
@@ -193,8 +203,15 @@ int main(int argc, char** argv) {
       }
       std::printf(" | %5.1f\n", pogo);
     }
-    std::printf("laryngoscopy_bench: peak |F| %.3f N; POGO at the start %.1f %%, best %.1f %% at %.2f s\n",
-                peak_total, pogo_first, pogo_best, pogo_best_t);
+    std::printf(
+        "laryngoscopy_bench: peak |F| %.3f N; POGO at the start %.1f %%, best %.1f %% at %.2f s\n",
+        peak_total, pogo_first, pogo_best, pogo_best_t);
+    std::printf(
+        "laryngoscopy_bench: anatomy's push on the blade at most %.3f N; ticks wedged between "
+        "anatomy and tissue (the tissue given the limit, force only) %llu, held (lost track) "
+        "%llu\n",
+        peak_anatomy, static_cast<unsigned long long>(wedged_ticks),
+        static_cast<unsigned long long>(held_ticks));
     for (std::size_t b = 0; b < bodies; ++b) {
       std::printf(
           "laryngoscopy_bench: body '%s': peak tool force %.3f N, ticks touched %llu, largest node "

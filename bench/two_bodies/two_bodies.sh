@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The cost of a second deformable body: the whole loop in one process
 # (fahr_stack_sim_run, lockstep, the intubation script) on the shipped scene
-# and on the same scene with a copy of the tongue 1 mm above it
+# on the same scene with its epiglottis made a deformable body
+# (bench/support/soft_epiglottis_scene.sh: the intubation's blade does not
+# reach it) and with a copy of the tongue 1 mm above it
 # (bench/support/two_tongues_scene.sh: both under the blade), one after the
 # other in one run. Per scene: the peak force, the FEM period's CPU (every
 # body's step and background factorisation), the haptic tick's CPU, and per
@@ -11,7 +13,7 @@
 #   bench/two_bodies/two_bodies.sh [BUILD_DIR] [--seconds S] [--markdown [FILE]]
 #
 # --markdown: also write the output to FILE (a name ending in .md), by
-# default bench/results/<machine>/two-deformable-bodies.md. About 2.5 min
+# default bench/results/<machine>/two-deformable-bodies.md. About 3 min
 # for the default 4 s on the 2-core station.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
@@ -42,7 +44,9 @@ work=$(mktemp -d /tmp/fahr-two-bodies-XXXXXX)
 trap 'rm -rf "$work"' EXIT
 shipped="$repo/deployment/scenes/neonatal_intubation.yaml"
 bash "$repo/bench/support/two_tongues_scene.sh" "$shipped" >"$work/two.yaml"
+bash "$repo/bench/support/soft_epiglottis_scene.sh" "$shipped" >"$work/leaf.yaml"
 "$run" --seconds "$seconds" --scene "$shipped" >"$work/one.txt"
+"$run" --seconds "$seconds" --scene "$work/leaf.yaml" >"$work/leaf.txt"
 "$run" --seconds "$seconds" --scene "$work/two.yaml" >"$work/two.txt"
 
 field() { sed -nE "s/$2/\1/p" "$1" | head -n 1; }
@@ -54,9 +58,13 @@ field() { sed -nE "s/$2/\1/p" "$1" | head -n 1; }
   echo
   echo "| scene | wall s | peak F N | FEM period CPU ms p50 | p99 | max | haptic tick CPU us p50 | p99 | p99.9 | rows per tick p99 |"
   echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
-  for case in one two; do
+  for case in one leaf two; do
     f="$work/$case.txt"
-    name=$([ "$case" = one ] && echo "tongue (shipped)" || echo "tongue + tongue_b")
+    case "$case" in
+      one) name="tongue (shipped)" ;;
+      leaf) name="tongue + soft epiglottis" ;;
+      two) name="tongue + tongue_b" ;;
+    esac
     echo "| $name | $(field "$f" '^stack_sim: [0-9]+ steps, ([0-9.]+) s wall.*') \
 | $(field "$f" '.*peak \|F\| ([0-9.]+) N.*') \
 | $(field "$f" '^FEM step CPU ms median ([0-9.]+) p99.*') \
@@ -68,16 +76,18 @@ field() { sed -nE "s/$2/\1/p" "$1" | head -n 1; }
 | $(field "$f" '^stack_sim: rows per tick p50 [0-9]+ p99 ([0-9]+) .*') |"
   done
   echo
-  echo "## Per body, the two-body run"
+  echo "## Per body, the two-body runs"
   echo
   echo "| body | ticks with tool contacts | most in one set | largest node motion mm | sets refused (layout, unknown sphere) |"
   echo "| --- | ---: | ---: | ---: | --- |"
   sed -nE "s/^stack_sim: body '([^']+)': ticks with tool contacts ([0-9]+), most in one set ([0-9]+), largest node motion ([0-9.]+) mm, ContactSets refused: layout ([0-9]+), unknown sphere ([0-9]+);.*/| \1 | \2 | \3 | \4 | \5, \6 |/p" \
-    "$work/two.txt"
+    "$work/leaf.txt" "$work/two.txt"
   echo
-  echo "The two-body run's output hashes (as fahr_lockstep_clock prints them over DDS):"
+  echo "The two-body runs' output hashes (as fahr_lockstep_clock prints them over DDS):"
   echo
-  sed -n 's/^lockstep_clock: hash \(.*\)/- \1/p' "$work/two.txt"
+  for case in leaf two; do
+    echo "- $case: $(sed -n 's/^lockstep_clock: hash \(.*\)/\1/p' "$work/$case.txt" | paste -sd ',' | sed 's/,/, /g')"
+  done
 } | if [ ${#markdown[@]} -gt 0 ]; then
   "$results" two-deformable-bodies "${markdown[@]}" -- "${command[@]}"
 else
