@@ -144,6 +144,12 @@ int main(int argc, char** argv) {
     std::uint64_t wedged_ticks = 0;
     std::uint64_t held_ticks = 0;
     double peak_anatomy = 0.0;
+    // Where the anatomy pushed hardest: the row's surface point and normal
+    // (into the anatomy), and when.
+    Eigen::Vector3d anatomy_point = Eigen::Vector3d::Zero();
+    Eigen::Vector3d anatomy_normal = Eigen::Vector3d::Zero();
+    double anatomy_row_n = 0.0;
+    double anatomy_t = 0.0;
     double pogo_first = -1.0;
     double pogo_best = 0.0;
     double pogo_best_t = 0.0;
@@ -169,6 +175,16 @@ int main(int argc, char** argv) {
       if (report.tissue_force_clamped) ++wedged_ticks;
       if (sim.command().lost_track()) ++held_ticks;
       peak_anatomy = std::max(peak_anatomy, report.obstacle_reaction_n);
+      const auto& solver = sim.haptic().response().solver();
+      for (std::size_t i = 0; i < solver.size(); ++i) {
+        if (solver.row(i).kind != contact::RowKind::kObstacle) continue;
+        if (solver.lambda(i) > anatomy_row_n) {
+          anatomy_row_n = solver.lambda(i);
+          anatomy_point = solver.row(i).other_point_m;
+          anatomy_normal = solver.row(i).normal;
+          anatomy_t = sim.time_s();
+        }
+      }
       const auto& f = sim.command().force_n();
       total = Eigen::Vector3d(f.x(), f.y(), f.z()).norm();
       peak_total = std::max(peak_total, total);
@@ -212,6 +228,11 @@ int main(int argc, char** argv) {
         "%llu\n",
         peak_anatomy, static_cast<unsigned long long>(wedged_ticks),
         static_cast<unsigned long long>(held_ticks));
+    std::printf(
+        "laryngoscopy_bench: the anatomy's largest row %.3f N at %.2f s, at (%.1f, %.1f, %.1f) mm, "
+        "pushing the blade along (%.2f, %.2f, %.2f)\n",
+        anatomy_row_n, anatomy_t, 1e3 * anatomy_point.x(), 1e3 * anatomy_point.y(),
+        1e3 * anatomy_point.z(), -anatomy_normal.x(), -anatomy_normal.y(), -anatomy_normal.z());
     for (std::size_t b = 0; b < bodies; ++b) {
       std::printf(
           "laryngoscopy_bench: body '%s': peak tool force %.3f N, ticks touched %llu, largest node "

@@ -106,6 +106,8 @@ class ContactResponse {
   const ForceOutput& output() const { return output_; }
   const TickReport& report() const { return report_; }
   const ResponseSettings& settings() const { return settings_; }
+  // The last tick's rows and their forces (for diagnostics).
+  const ContactSolver& solver() const { return solver_; }
 
  private:
   struct Hold {
