@@ -1,5 +1,5 @@
 // fem_bench: tables for the FEM library. Usage:
-//   fem_bench [cantilever|scale|target|compliance|all] [--quick]
+//   fem_bench [cantilever|leaf|scale|target|compliance|all] [--quick]
 //             [--static-max n] [--dynamic-max n]   (cantilever cross-section cells,
 //             defaults 16 and 16; --quick: 6 and 4, no 80k mesh) [--markdown [FILE]]
 #include <unistd.h>
@@ -14,6 +14,7 @@
 
 namespace fahr::fem::bench {
 void run_cantilever(int max_dynamic_n, int max_static_n, int steps);
+void run_leaf();
 void run_scale(bool quick);
 void run_target();
 void run_compliance(bool quick);
@@ -54,6 +55,7 @@ int main(int argc, char** argv) {
   results.begin("fem-" + what + (quick ? "-quick" : ""));
   std::printf("# fem_bench (%s)\n%s\n", what.c_str(), pin_blas_to_one_thread().c_str());
   if (what == "cantilever" || what == "all") run_cantilever(dynamic_max, static_max, 60);
+  if (what == "leaf" || what == "all") run_leaf();
   if (what == "scale" || what == "all") run_scale(quick);
   if (what == "compliance" || what == "all") run_compliance(quick);
   if (what == "target" || what == "all") run_target();
