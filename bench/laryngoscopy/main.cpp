@@ -41,35 +41,23 @@ namespace {
 
 using namespace fahr;
 
-// The blade's force on one body: the tool rows' forces along their normals
-// (the anatomy's rows left out), N, and how many tool rows there are.
-struct BodyLoad {
-  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
-  std::size_t rows = 0;
-};
-
-BodyLoad tool_load(const msg::ContactSet& set) {
-  BodyLoad load;
-  for (const auto& c : set.contacts()) {
-    if (c.kind() == msg::CONTACT_OBSTACLE || c.state() == msg::CONSTRAINT_CANDIDATE) continue;
-    load.force_n += c.force_n() * Eigen::Vector3d(c.normal().x(), c.normal().y(), c.normal().z());
-    ++load.rows;
-  }
-  return load;
+// The blade's rows on one body: its tool contacts (active or frozen, not the
+// anatomy's, not candidates). Their force is blade_from_contacts's.
+std::size_t tool_rows(const msg::ContactSet& set) {
+  return static_cast<std::size_t>(
+      std::count_if(set.contacts().begin(), set.contacts().end(), [](const msg::Contact& c) {
+        return c.kind() != msg::CONTACT_OBSTACLE && c.state() != msg::CONSTRAINT_CANDIDATE;
+      }));
 }
 
-// Largest node motion from rest, m, and the body's positions as points.
-double largest_motion(const stack_sim::StackSim& sim, std::size_t b,
-                      std::vector<Eigen::Vector3d>& points) {
-  const auto& rest = sim.fem(b).setup().mesh.rest_positions();
+// Body b's node positions as points, for the view.
+void positions_of(const stack_sim::StackSim& sim, std::size_t b,
+                  std::vector<Eigen::Vector3d>& points) {
   const auto x = sim.body(b).positions_m();
-  points.resize(rest.size());
-  double moved = 0.0;
-  for (std::size_t n = 0; n < rest.size(); ++n) {
+  points.resize(x.size() / 3);
+  for (std::size_t n = 0; n < points.size(); ++n) {
     points[n] = Eigen::Vector3d(x[3 * n], x[3 * n + 1], x[3 * n + 2]);
-    moved = std::max(moved, (points[n] - rest[n]).norm());
   }
-  return moved;
 }
 
 // Keyframes from a file (see the header); throws naming the file and line.
@@ -165,11 +153,10 @@ int main(int argc, char** argv) {
     std::printf(" | POGO %%\n");
     for (std::uint64_t k = 1; k <= steps; ++k) {
       sim.step();
-      double total = 0.0;
       for (std::size_t b = 0; b < bodies; ++b) {
-        const BodyLoad load = tool_load(sim.contacts(b));
-        peak_force[b] = std::max(peak_force[b], load.force_n.norm());
-        if (load.rows > 0) ++touched_ticks[b];
+        const double force = glottic_view::blade_from_contacts(sim.contacts(b)).tool_force_n;
+        peak_force[b] = std::max(peak_force[b], force);
+        if (tool_rows(sim.contacts(b)) > 0) ++touched_ticks[b];
       }
       const auto& report = sim.haptic().response().report();
       if (report.tissue_force_clamped) ++wedged_ticks;
@@ -186,14 +173,15 @@ int main(int argc, char** argv) {
         }
       }
       const auto& f = sim.command().force_n();
-      total = Eigen::Vector3d(f.x(), f.y(), f.z()).norm();
+      const double total = Eigen::Vector3d(f.x(), f.y(), f.z()).norm();
       peak_total = std::max(peak_total, total);
       if (k % trace_steps != 0 && k != 1) continue;
       const auto blade = glottic_view::blade_from_contacts(sim.contacts(0));
       std::vector<std::span<const Eigen::Vector3d>> spans;
       std::vector<double> moved(bodies);
       for (std::size_t b = 0; b < bodies; ++b) {
-        moved[b] = largest_motion(sim, b, points[b]);
+        moved[b] = sim.largest_node_motion_m(b);
+        positions_of(sim, b, points[b]);
         peak_motion[b] = std::max(peak_motion[b], moved[b]);
         spans.emplace_back(points[b]);
       }
@@ -214,8 +202,9 @@ int main(int argc, char** argv) {
                   1e3 * tip.x(), 1e3 * tip.y(), 1e3 * tip.z(), 1e3 * gap.x(), 1e3 * gap.y(),
                   1e3 * gap.z(), total);
       for (std::size_t b = 0; b < bodies; ++b) {
-        const BodyLoad load = tool_load(sim.contacts(b));
-        std::printf(" | %5.2f %3zu %5.2f", load.force_n.norm(), load.rows, 1e3 * moved[b]);
+        std::printf(" | %5.2f %3zu %5.2f",
+                    glottic_view::blade_from_contacts(sim.contacts(b)).tool_force_n,
+                    tool_rows(sim.contacts(b)), 1e3 * moved[b]);
       }
       std::printf(" | %5.1f\n", pogo);
     }

@@ -4,8 +4,7 @@
 // fahr_lockstep_clock does for the same run over DDS, and a few figures.
 // Equal hashes show that the in-process run is the distributed one.
 //
-//   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot]
-//   [--collision aist|triangle]
+//   fahr_stack_sim_run [--scene FILE] [--script intubation|overshoot] [--collision aist|triangle]
 //                      [--stiffening C20/C10] [--volume-floor R] [--w-normals N] [--seconds 4]
 //
 // --stiffening: the tongue's compression stiffening, the Yeoh ratio C20/C10
@@ -171,14 +170,7 @@ int main(int argc, char** argv) try {
         static_cast<unsigned long long>(sim.fem().anatomy_returned()),
         static_cast<unsigned long long>(sim.fem().anatomy_beyond_steps()));
     for (std::size_t b = 0; b < sim.body_count() && sim.body_count() > 1; ++b) {
-      // The body's largest node motion from rest.
-      const auto& rest = sim.fem(b).setup().mesh.rest_positions();
-      const auto x = sim.body(b).positions_m();
-      double moved = 0.0;
-      for (std::size_t n = 0; n < rest.size(); ++n) {
-        const Eigen::Vector3d p(x[3 * n], x[3 * n + 1], x[3 * n + 2]);
-        moved = std::max(moved, (p - rest[n]).norm());
-      }
+      const double moved = sim.largest_node_motion_m(b);
       std::printf(
           "stack_sim: body '%s': ticks with tool contacts %llu, most in one set %zu, largest node "
           "motion %.2f mm, ContactSets refused: layout %llu, unknown sphere %llu; max inverted "

@@ -1,6 +1,7 @@
 // The services in one process, in lockstep (see stack_sim.h).
 #include "fahr/stack_sim/stack_sim.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
@@ -78,6 +79,17 @@ StackSim::StackSim(std::shared_ptr<const scene::Scene> scene, const StackOptions
     }
   }
   pose_.device_id(options.device_id);
+}
+
+double StackSim::largest_node_motion_m(std::size_t b) const {
+  const auto& rest = fem_setups_[b]->mesh.rest_positions();
+  const auto x = body(b).positions_m();
+  double moved = 0.0;
+  for (std::size_t n = 0; n < rest.size(); ++n) {
+    const Eigen::Vector3d p(x[3 * n], x[3 * n + 1], x[3 * n + 2]);
+    moved = std::max(moved, (p - rest[n]).norm());
+  }
+  return moved;
 }
 
 void StackSim::step() {

@@ -87,35 +87,28 @@ TriangleMesh make_param_box(const ParamBox& box) {
 
 namespace {
 
-// The box's lattice points, (i, j, k) at (i * (nv + 1) + j) * (nw + 1) + k,
-// and its cells split into six Kuhn tets each: a monotone path from corner
-// (0,0,0) to (1,1,1) per axis permutation, every cell with the same main
-// diagonal, so shared faces split alike (conforming). `visit(tet, sign)` gets
-// lattice indices and sign(permutation): the tet's orientation under the
-// identity map.
-struct KuhnLattice {
+// The box's lattice points, (i, j, k) at (i * (nv + 1) + j) * (nw + 1) + k.
+std::vector<Vec3> lattice_points(const ParamBox& box) {
   std::vector<Vec3> points;
-  template <class Visit>
-  static void each_tet(const ParamBox& box, Visit&& visit);
-};
-
-KuhnLattice lattice_of(const ParamBox& box) {
-  KuhnLattice l;
-  l.points.reserve(static_cast<size_t>(box.nu + 1) * static_cast<size_t>(box.nv + 1) *
-                   static_cast<size_t>(box.nw + 1));
+  points.reserve(static_cast<size_t>(box.nu + 1) * static_cast<size_t>(box.nv + 1) *
+                 static_cast<size_t>(box.nw + 1));
   for (int i = 0; i <= box.nu; ++i) {
     for (int j = 0; j <= box.nv; ++j) {
       for (int k = 0; k <= box.nw; ++k) {
-        l.points.push_back(box.map(grid_coordinate(i, box.nu), grid_coordinate(j, box.nv),
-                                   grid_coordinate(k, box.nw)));
+        points.push_back(box.map(grid_coordinate(i, box.nu), grid_coordinate(j, box.nv),
+                                 grid_coordinate(k, box.nw)));
       }
     }
   }
-  return l;
+  return points;
 }
 
+// Every cell split into six Kuhn tets: a monotone path from corner (0,0,0)
+// to (1,1,1) per axis permutation, every cell with the same main diagonal,
+// so shared faces split alike (conforming). `visit(tet, sign)` gets lattice
+// indices and sign(permutation): the tet's orientation under the identity map.
 template <class Visit>
-void KuhnLattice::each_tet(const ParamBox& box, Visit&& visit) {
+void each_kuhn_tet(const ParamBox& box, Visit&& visit) {
   constexpr int kPermutations[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1},
                                        {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
   constexpr int kPermutationSign[6] = {1, 1, 1, -1, -1, -1};
@@ -140,23 +133,21 @@ void KuhnLattice::each_tet(const ParamBox& box, Visit&& visit) {
   }
 }
 
-double image_volume(const KuhnLattice& l, const std::array<int, 4>& t, int sign) {
-  const auto& p = l.points;
+double signed_volume(const std::vector<Vec3>& p, const std::array<int, 4>& t) {
   const Vec3& a = p[static_cast<size_t>(t[0])];
-  return sign *
-         (p[static_cast<size_t>(t[1])] - a)
-             .dot((p[static_cast<size_t>(t[2])] - a).cross(p[static_cast<size_t>(t[3])] - a));
+  return (p[static_cast<size_t>(t[1])] - a)
+      .dot((p[static_cast<size_t>(t[2])] - a).cross(p[static_cast<size_t>(t[3])] - a));
 }
 
 }  // namespace
 
 int folded_box_tets(const ParamBox& box) {
-  const KuhnLattice lattice = lattice_of(box);
+  const std::vector<Vec3> points = lattice_points(box);
   int positive = 0;
   int negative = 0;
   int flat = 0;
-  KuhnLattice::each_tet(box, [&](const std::array<int, 4>& tet, int sign) {
-    const double volume = image_volume(lattice, tet, sign);
+  each_kuhn_tet(box, [&](const std::array<int, 4>& tet, int sign) {
+    const double volume = sign * signed_volume(points, tet);
     if (volume > 0.0) {
       ++positive;
     } else if (volume < 0.0) {
@@ -169,21 +160,14 @@ int folded_box_tets(const ParamBox& box) {
 }
 
 MeshedSolid param_box_tets(const ParamBox& box) {
-  KuhnLattice lattice = lattice_of(box);
   MeshedSolid mesh;
-  // The image's orientation: the map's handedness, the same in every tet of a
-  // box that does not fold (folded_box_tets).
-  double total = 0.0;
-  KuhnLattice::each_tet(box, [&](const std::array<int, 4>& tet, int sign) {
-    total += image_volume(lattice, tet, sign);
-  });
-  const int handedness = total < 0.0 ? -1 : 1;
-  KuhnLattice::each_tet(box, [&](std::array<int, 4> tet, int sign) {
-    // Positive volume in the image, as TetGen files and the FEM expect.
-    if (sign * handedness < 0) std::swap(tet[2], tet[3]);
+  mesh.nodes = lattice_points(box);
+  // Each tet turned to positive volume, as TetGen files and the FEM expect
+  // (the generator writes no mesh of a box that folds: folded_box_tets > 0).
+  each_kuhn_tet(box, [&](std::array<int, 4> tet, int) {
+    if (signed_volume(mesh.nodes, tet) < 0.0) std::swap(tet[2], tet[3]);
     mesh.tets.push_back(tet);
   });
-  mesh.nodes = std::move(lattice.points);
   mesh.boundary = boundary_faces(mesh.tets);
   return mesh;
 }

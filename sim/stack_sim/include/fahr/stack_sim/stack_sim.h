@@ -95,6 +95,8 @@ class StackSim {
   // The deformable bodies: the first (the tongue) by default.
   std::size_t body_count() const { return fems_.size(); }
   const fem::Body& body(std::size_t b = 0) const { return *fem_setups_[b]->body; }
+  // Body b's largest node displacement from rest now, m.
+  double largest_node_motion_m(std::size_t b = 0) const;
   fem::Body& body(std::size_t b = 0) { return *fem_setups_[b]->body; }  // energy() needs it
   const geometry::TetMesh& tongue_mesh() const { return fem_setups_.front()->mesh; }
   const fem_service::ServiceStep& fem(std::size_t b = 0) const { return *fems_[b]; }
