@@ -5,14 +5,15 @@
 # directory: the shipped files are not touched): per airway, the whole loop
 # in lockstep in one process (fahr_laryngoscopy_bench) with the shipped
 # intubation script and with the Miller keyframes tried on it
-# (miller_neutral.keyframes, miller_extended.keyframes). Each run prints
-# the blade's force on each body, their motion and the glottic view every
-# 0.5 s, then the peaks.
+# (miller_neutral.keyframes, miller_extended.keyframes), and the neutral
+# Miller keyframes once more without the blade's contact with the lips. Each
+# run prints the blade's force on each body, their motion and the glottic
+# view every 0.5 s, then the peaks.
 #
 #   bench/laryngoscopy/soft_epiglottis.sh [BUILD_DIR] [--markdown [FILE]]
 #
 # --markdown: also write the output to FILE (a name ending in .md), by
-# default bench/results/<machine>/soft-epiglottis.md. About 3 min.
+# default bench/results/<machine>/soft-epiglottis.md. About 4 min.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
@@ -52,6 +53,12 @@ mkdir -p "$work/extended"
 bash "$repo/bench/support/generated_scene.sh" "$work/extended" >"$work/extended/rigid.yaml"
 bash "$soft" "$shipped" >"$work/neutral.yaml"
 bash "$soft" "$work/extended/rigid.yaml" >"$work/extended.yaml"
+# The neutral airway without the blade's contact with the lips: is the lip
+# what stops the blade?
+sed 's/^  exclude_pairs: \[\]$/  exclude_pairs: [[miller1, lips_face]]/' "$work/neutral.yaml" \
+  >"$work/neutral_without_lips.yaml"
+grep -q '^  exclude_pairs: \[\[miller1, lips_face\]\]$' "$work/neutral_without_lips.yaml" ||
+  { echo "soft_epiglottis: the shipped scene's exclude_pairs line changed; update this script" >&2; exit 1; }
 
 {
   echo "## The epiglottis as a deformable body"
@@ -78,6 +85,13 @@ bash "$soft" "$work/extended/rigid.yaml" >"$work/extended.yaml"
       echo '```'
     done
   done
+  echo
+  echo "### neutral airway without the blade's contact with the lips, miller_neutral.keyframes"
+  echo
+  echo '```'
+  "$bench" --scene "$work/neutral_without_lips.yaml" --keyframes "$here/miller_neutral.keyframes" \
+    --seconds 12 --trace-every 0.5
+  echo '```'
 } | if [ ${#markdown[@]} -gt 0 ]; then
   "$results" soft-epiglottis "${markdown[@]}" -- "${command[@]}"
 else
