@@ -13,6 +13,14 @@
 // line "t_s x_mm y_mm z_mm pitch_deg" (the blade tip in the world frame,
 // the pitch about +z), '#' starts a comment: to try a motion before it
 // becomes a script.
+//
+//   fahr_laryngoscopy_bench --scene FILE --sight-corridor DEG [DEG...] [--corridor-half-width-mm W]
+//
+// No run: how far each deformable body at rest reaches above a line of
+// sight from the glottic opening's centre, turned DEG from its normal
+// towards the mouth in the mid-sagittal plane, within W of the mid-line
+// (default 5 mm, half a Miller 1's width): what a straight blade along that
+// line must press out of the way for the glottis to be seen past it.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -85,6 +93,77 @@ device::Trajectory read_keyframes(const std::string& path) {
   }
 }
 
+// The sight-corridor table (see the header).
+void print_sight_corridor(const glottic_view::SceneGlotticView& view, const scene::Scene& scene,
+                          const std::vector<double>& degrees, double half_width_m) {
+  const auto& opening = view.view.opening();
+  std::vector<std::string> names;
+  for (const auto& body : scene.bodies) {
+    if (body.role == scene::BodyRole::kDeformable) names.push_back(body.name);
+  }
+  std::printf(
+      "sight corridor: scene %s, glottic opening at (%.1f, %.1f, %.1f) mm, within %.1f mm"
+      " of the mid-line\n",
+      scene.name.c_str(), 1e3 * opening.centre_m.x(), 1e3 * opening.centre_m.y(),
+      1e3 * opening.centre_m.z(), 1e3 * half_width_m);
+  for (const double deg : degrees) {
+    // Turn the normal about z, the way that leans it towards the mouth (+x).
+    const double a = deg * std::acos(-1.0) / 180.0;
+    Eigen::Vector3d sight = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()) * opening.normal;
+    const Eigen::Vector3d other = Eigen::AngleAxisd(-a, Eigen::Vector3d::UnitZ()) * opening.normal;
+    if (other.x() > sight.x()) sight = other;
+    std::printf(
+        "\nline %.0f deg from the opening's normal, direction (%.3f, %.3f); at x = 0 it is"
+        " at y %.1f mm\n",
+        deg, sight.x(), sight.y(),
+        sight.x() > 0.0
+            ? 1e3 * (opening.centre_m.y() - opening.centre_m.x() * sight.y() / sight.x())
+            : std::nan(""));
+    std::printf("  x mm | line y mm");
+    for (const auto& name : names) {
+      std::printf(" | %s: top, bottom y mm, top above the line mm", name.c_str());
+    }
+    std::printf("\n");
+    std::vector<double> most(names.size(), -1e9);
+    std::vector<double> most_x(names.size(), 0.0);
+    for (double x_mm = 1e3 * opening.centre_m.x(); x_mm <= 0.0; x_mm += 5.0) {
+      const double x = 1e-3 * x_mm;
+      if (sight.x() <= 0.0) break;
+      const double line_y =
+          opening.centre_m.y() + (x - opening.centre_m.x()) * sight.y() / sight.x();
+      std::printf("%6.1f | %9.1f", x_mm, 1e3 * line_y);
+      for (std::size_t b = 0; b < names.size(); ++b) {
+        // The body's highest rest node in a 5 mm slab around x, near the mid-line.
+        double top = -1e9;
+        double bottom = 1e9;
+        for (const auto& p : view.deformable_rest_m[b]) {
+          if (std::abs(p.x() - x) <= 2.5e-3 && std::abs(p.z()) <= half_width_m) {
+            top = std::max(top, p.y());
+            bottom = std::min(bottom, p.y());
+          }
+        }
+        if (top < -1e8) {
+          std::printf(" | %6s %6s %6s", "-", "-", "-");
+          continue;
+        }
+        const double above = top - line_y;
+        if (above > most[b]) {
+          most[b] = above;
+          most_x[b] = x_mm;
+        }
+        std::printf(" | %6.1f %6.1f %6.1f", 1e3 * top, 1e3 * bottom, 1e3 * above);
+      }
+      std::printf("\n");
+    }
+    for (std::size_t b = 0; b < names.size(); ++b) {
+      if (most[b] < -1e8) continue;
+      std::printf(
+          "sight corridor %.0f deg: '%s' reaches %.1f mm above the line at most (x %.1f mm)\n", deg,
+          names[b].c_str(), 1e3 * most[b], most_x[b]);
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -95,7 +174,16 @@ int main(int argc, char** argv) {
   double seconds = 0.0;
   double trace_every_s = 0.5;
   std::string keyframes_path;
+  std::vector<double> corridor_deg;
+  double corridor_half_width_mm = 5.0;
   app.add_option("--scene", scene_path, "scene file");
+  app.add_option("--sight-corridor", corridor_deg,
+                 "no run: each body's height above lines of sight this many degrees from the "
+                 "glottic opening's normal")
+      ->check(cli::Range(0.0, 89.0));
+  app.add_option("--corridor-half-width-mm", corridor_half_width_mm,
+                 "the corridor's half width about the mid-line, mm")
+      ->check(cli::Range(0.1, 50.0));
   app.add_option("--script", script_name, "the simulated hand's script")
       ->check(cli::IsMember({std::begin(device::kScriptNames), std::end(device::kScriptNames)}));
   app.add_option("--keyframes", keyframes_path, "the hand's keyframes instead of the script");
@@ -113,6 +201,11 @@ int main(int argc, char** argv) {
       script_name = std::filesystem::path(keyframes_path).filename().string();
     }
     auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));
+    if (!corridor_deg.empty()) {
+      print_sight_corridor(glottic_view::glottic_view_from_scene(*scene), *scene, corridor_deg,
+                           1e-3 * corridor_half_width_mm);
+      return 0;
+    }
     if (seconds == 0.0) {
       seconds = options.keyframes
                     ? options.keyframes->duration().count()

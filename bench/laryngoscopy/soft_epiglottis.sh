@@ -6,9 +6,10 @@
 # in lockstep in one process (fahr_laryngoscopy_bench) with the shipped
 # intubation script and with the Miller keyframes tried on it
 # (miller_neutral.keyframes, miller_extended.keyframes), and the neutral
-# Miller keyframes once more without the blade's contact with the lips. Each
-# run prints the blade's force on each body, their motion and the glottic
-# view every 0.5 s, then the peaks.
+# Miller keyframes once more without the blade's contact with the lips; first,
+# how far the tongue and the epiglottis at rest reach above the lines of
+# sight to the glottis. Each run prints the blade's force on each body, their
+# motion and the glottic view every 0.5 s, then the peaks.
 #
 #   bench/laryngoscopy/soft_epiglottis.sh [BUILD_DIR] [--markdown [FILE]]
 #
@@ -70,6 +71,17 @@ grep -q '^  exclude_pairs: \[\[miller1, lips_face\]\]$' "$work/neutral_without_l
   echo "lead over the blade, the force rendered, and per body the blade's force on it (the sum of"
   echo "its tool rows), its tool rows and its largest node motion; the glottic view from the"
   echo "scene's eye."
+  echo
+  echo "### What a straight blade must press out of the line of sight"
+  echo
+  echo "Each deformable body at rest against lines of sight from the glottic opening, turned from"
+  echo "its normal towards the mouth (fahr_laryngoscopy_bench --sight-corridor), within 5 mm of the"
+  echo "mid-line: the extended airway at the angles whose lines pass the rigid anatomy with the"
+  echo "epiglottis out of the way (airway-placement.md: 40 and 45 deg)."
+  echo
+  echo '```'
+  "$bench" --scene "$work/extended.yaml" --sight-corridor 40 45
+  echo '```'
   for airway in neutral extended; do
     for motion in intubation "miller_$airway.keyframes"; do
       echo

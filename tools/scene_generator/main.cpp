@@ -191,9 +191,10 @@ int main(int argc, char** argv) {
       tongue_box[1].y(), tongue_box[0].z(), tongue_box[1].z());
   std::printf(
       "tongue quality: min dihedral %.2f deg, max dihedral %.2f deg, tets under 10 deg %d,"
-      " volume min %.4f max %.4f mm^3\n",
+      " volume min %.4f max %.4f mm^3; radius ratio min %.3f, under 0.1 %d, under 0.3 %d\n",
       quality.min_dihedral_deg, quality.max_dihedral_deg, quality.below_10_deg,
-      quality.min_volume_mm3, quality.max_volume_mm3);
+      quality.min_volume_mm3, quality.max_volume_mm3, quality.min_radius_ratio,
+      quality.radius_ratio_below_0_1, quality.radius_ratio_below_0_3);
   std::printf(
       "tongue snapping: %d boundary nodes, %d fully, %d partly, %d not moved; max surface"
       " gap %.3f mm; non-manifold boundary edges %d\n",

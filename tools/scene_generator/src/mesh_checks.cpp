@@ -2,6 +2,7 @@
 #include "fahr/scenegen/mesh_checks.h"
 
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -76,6 +77,25 @@ double tet_min_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const V
     smallest = std::min(smallest, dihedral_at_edge(*v[e[0]], *v[e[1]], *v[e[2]], *v[e[3]]));
   }
   return smallest;
+}
+
+double tet_radius_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const Vec3 ab = b - a;
+  const Vec3 ac = c - a;
+  const Vec3 ad = d - a;
+  const double six_volume = std::abs(ab.dot(ac.cross(ad)));
+  const double area_sum = 0.5 * (ab.cross(ac).norm() + ab.cross(ad).norm() + ac.cross(ad).norm() +
+                                 (c - b).cross(d - b).norm());
+  if (six_volume <= 0.0 || area_sum <= 0.0) return 0.0;
+  const double inradius = 0.5 * six_volume / area_sum;  // 3 V / S
+  // Circumcentre o - a solves 2 [ab ac ad]^T x = [|ab|^2 |ac|^2 |ad|^2].
+  Eigen::Matrix3d edges;
+  edges.row(0) = ab;
+  edges.row(1) = ac;
+  edges.row(2) = ad;
+  const Vec3 rhs(0.5 * ab.squaredNorm(), 0.5 * ac.squaredNorm(), 0.5 * ad.squaredNorm());
+  const double circumradius = edges.partialPivLu().solve(rhs).norm();
+  return std::clamp(3.0 * inradius / circumradius, 0.0, 1.0);
 }
 
 double enclosed_volume(const TriangleMesh& mesh) {
@@ -200,6 +220,7 @@ TetQuality tet_quality(const MeshedSolid& mesh) {
   q.max_volume_mm3 = -std::numeric_limits<double>::infinity();
   q.min_dihedral_deg = 180.0;
   q.max_dihedral_deg = 0.0;
+  q.min_radius_ratio = 1.0;
   constexpr double kSliverDeg = 10.0;  // common threshold for "poor" FEM tets
   for (const auto& t : mesh.tets) {
     const Vec3& a = mesh.nodes[t[0]];
@@ -212,6 +233,10 @@ TetQuality tet_quality(const MeshedSolid& mesh) {
     const double dmin = tet_min_dihedral_deg(a, b, c, d);
     q.min_dihedral_deg = std::min(q.min_dihedral_deg, dmin);
     if (dmin < kSliverDeg) ++q.below_10_deg;
+    const double ratio = tet_radius_ratio(a, b, c, d);
+    q.min_radius_ratio = std::min(q.min_radius_ratio, ratio);
+    q.radius_ratio_below_0_1 += ratio < 0.1 ? 1 : 0;
+    q.radius_ratio_below_0_3 += ratio < 0.3 ? 1 : 0;
     // The largest dihedral: evaluate all six via the same helper on permutations.
     constexpr int kEdges[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2},
                                   {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};

@@ -16,6 +16,10 @@ double tet_signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
 // Smallest of the six interior dihedral angles of a tet, in degrees.
 double tet_min_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
+// 3 x inradius / circumradius of a tet: 1 for the regular tet, near 0 for
+// slivers, caps and needles alike (the measure fahr::geometry reports).
+double tet_radius_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
 // Volume enclosed by a closed surface (mm^3); positive when outward oriented.
 double enclosed_volume(const TriangleMesh& mesh);
 
@@ -59,6 +63,9 @@ struct TetQuality {
   double min_dihedral_deg = 0.0;
   double max_dihedral_deg = 0.0;
   int below_10_deg = 0;  // tets whose smallest dihedral is under 10 degrees
+  double min_radius_ratio = 0.0;
+  int radius_ratio_below_0_1 = 0;
+  int radius_ratio_below_0_3 = 0;
 };
 TetQuality tet_quality(const MeshedSolid& mesh);
 
