@@ -15,12 +15,15 @@
 // becomes a script.
 //
 //   fahr_laryngoscopy_bench --scene FILE --sight-corridor DEG [DEG...] [--corridor-half-width-mm W]
+//                     [--corridor-mouth-z-mm Z]
 //
 // No run: how far each deformable body at rest reaches above a line of
 // sight from the glottic opening's centre, turned DEG from its normal
 // towards the mouth in the mid-sagittal plane, within W of the mid-line
 // (default 5 mm, half a Miller 1's width): what a straight blade along that
 // line must press out of the way for the glottis to be seen past it.
+// --corridor-mouth-z-mm Z: the strip's centre runs from the opening to z = Z
+// in the mouth's plane instead (a paraglossal path: Z > 0, the right).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -95,17 +98,18 @@ device::Trajectory read_keyframes(const std::string& path) {
 
 // The sight-corridor table (see the header).
 void print_sight_corridor(const glottic_view::SceneGlotticView& view, const scene::Scene& scene,
-                          const std::vector<double>& degrees, double half_width_m) {
+                          const std::vector<double>& degrees, double half_width_m,
+                          double mouth_z_m) {
   const auto& opening = view.view.opening();
   std::vector<std::string> names;
   for (const auto& body : scene.bodies) {
     if (body.role == scene::BodyRole::kDeformable) names.push_back(body.name);
   }
   std::printf(
-      "sight corridor: scene %s, glottic opening at (%.1f, %.1f, %.1f) mm, within %.1f mm"
-      " of the mid-line\n",
+      "sight corridor: scene %s, glottic opening at (%.1f, %.1f, %.1f) mm; a strip %.1f mm either"
+      " side of a centre line from the opening's z to z %.1f mm at the mouth (x = 0)\n",
       scene.name.c_str(), 1e3 * opening.centre_m.x(), 1e3 * opening.centre_m.y(),
-      1e3 * opening.centre_m.z(), 1e3 * half_width_m);
+      1e3 * opening.centre_m.z(), 1e3 * half_width_m, 1e3 * mouth_z_m);
   for (const double deg : degrees) {
     // Turn the normal about z, the way that leans it towards the mouth (+x).
     const double a = deg * std::acos(-1.0) / 180.0;
@@ -131,13 +135,17 @@ void print_sight_corridor(const glottic_view::SceneGlotticView& view, const scen
       if (sight.x() <= 0.0) break;
       const double line_y =
           opening.centre_m.y() + (x - opening.centre_m.x()) * sight.y() / sight.x();
+      // The corridor's centre across: the opening's z there, mouth_z_m at x = 0.
+      const double centre_z = opening.centre_m.z() + (mouth_z_m - opening.centre_m.z()) *
+                                                         (x - opening.centre_m.x()) /
+                                                         (0.0 - opening.centre_m.x());
       std::printf("%6.1f | %9.1f", x_mm, 1e3 * line_y);
       for (std::size_t b = 0; b < names.size(); ++b) {
         // The body's highest rest node in a 5 mm slab around x, near the mid-line.
         double top = -1e9;
         double bottom = 1e9;
         for (const auto& p : view.deformable_rest_m[b]) {
-          if (std::abs(p.x() - x) <= 2.5e-3 && std::abs(p.z()) <= half_width_m) {
+          if (std::abs(p.x() - x) <= 2.5e-3 && std::abs(p.z() - centre_z) <= half_width_m) {
             top = std::max(top, p.y());
             bottom = std::min(bottom, p.y());
           }
@@ -176,6 +184,7 @@ int main(int argc, char** argv) {
   std::string keyframes_path;
   std::vector<double> corridor_deg;
   double corridor_half_width_mm = 5.0;
+  double corridor_mouth_z_mm = 0.0;
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--sight-corridor", corridor_deg,
                  "no run: each body's height above lines of sight this many degrees from the "
@@ -184,6 +193,10 @@ int main(int argc, char** argv) {
   app.add_option("--corridor-half-width-mm", corridor_half_width_mm,
                  "the corridor's half width about the mid-line, mm")
       ->check(cli::Range(0.1, 50.0));
+  app.add_option("--corridor-mouth-z-mm", corridor_mouth_z_mm,
+                 "where the corridor crosses the mouth's plane (x = 0) across, mm (+z: the "
+                 "patient's right; the paraglossal path), straight from the opening")
+      ->check(cli::Range(-50.0, 50.0));
   app.add_option("--script", script_name, "the simulated hand's script")
       ->check(cli::IsMember({std::begin(device::kScriptNames), std::end(device::kScriptNames)}));
   app.add_option("--keyframes", keyframes_path, "the hand's keyframes instead of the script");
@@ -203,7 +216,7 @@ int main(int argc, char** argv) {
     auto scene = std::make_shared<scene::Scene>(*scene::load_scene(scene_path));
     if (!corridor_deg.empty()) {
       print_sight_corridor(glottic_view::glottic_view_from_scene(*scene), *scene, corridor_deg,
-                           1e-3 * corridor_half_width_mm);
+                           1e-3 * corridor_half_width_mm, 1e-3 * corridor_mouth_z_mm);
       return 0;
     }
     if (seconds == 0.0) {

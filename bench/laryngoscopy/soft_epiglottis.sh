@@ -82,6 +82,13 @@ grep -q '^  exclude_pairs: \[\[miller1, lips_face\]\]$' "$work/neutral_without_l
   echo '```'
   "$bench" --scene "$work/extended.yaml" --sight-corridor 40 45
   echo '```'
+  echo
+  echo "The same at 40 deg on a paraglossal path: the strip's centre from the glottis to 10 mm"
+  echo "right of the mid-line in the mouth's plane (\`--corridor-mouth-z-mm 10\`)."
+  echo
+  echo '```'
+  "$bench" --scene "$work/extended.yaml" --sight-corridor 40 --corridor-mouth-z-mm 10
+  echo '```'
   for airway in neutral extended; do
     for motion in intubation "miller_$airway.keyframes"; do
       echo
