@@ -172,6 +172,43 @@ void print_sight_corridor(const glottic_view::SceneGlotticView& view, const scen
   }
 }
 
+// What hides the glottis at the end of the run: the view from the eye at
+// the blade's last pose with everything, then with the rigid anatomy and
+// one occluder at a time (the blade, or one soft body; the others are left
+// out by moving them a metre away), then the rigid anatomy alone.
+void print_what_hides(const stack_sim::StackSim& sim, glottic_view::SceneGlotticView& view) {
+  const auto blade = glottic_view::blade_from_contacts(sim.contacts(0));
+  if (!blade.world_from_tool) return;
+  const Eigen::Vector3d eye = *blade.world_from_tool * view.eye_in_tool_m;
+  const std::size_t bodies = sim.body_count();
+  std::vector<std::vector<Eigen::Vector3d>> points(bodies);
+  std::vector<std::vector<Eigen::Vector3d>> away(bodies);
+  for (std::size_t b = 0; b < bodies; ++b) {
+    positions_of(sim, b, points[b]);
+    away[b] = points[b];
+    for (auto& p : away[b]) p.x() += 1.0;
+  }
+  // only_body: that body alone (bodies: all of them; bodies + 1: none).
+  const auto score = [&](bool tool, std::size_t only_body) {
+    std::vector<std::span<const Eigen::Vector3d>> spans;
+    for (std::size_t b = 0; b < bodies; ++b) {
+      const bool in = only_body == bodies || only_body == b;
+      spans.emplace_back(in ? points[b] : away[b]);
+    }
+    return 100.0 *
+           view.view.score(eye, tool ? blade.world_from_tool : std::nullopt, spans).visible_share;
+  };
+  std::printf(
+      "laryngoscopy_bench: at the end, eye (%.1f, %.1f, %.1f) mm: POGO %.1f %%; with the "
+      "rigid anatomy and only the blade %.1f %%",
+      1e3 * eye.x(), 1e3 * eye.y(), 1e3 * eye.z(), score(true, bodies), score(true, bodies + 1));
+  for (std::size_t b = 0; b < bodies; ++b) {
+    std::printf(", only '%s' %.1f %%", sim.fem(b).setup().scene_body->name.c_str(),
+                score(false, b));
+  }
+  std::printf(", nothing but the rigid anatomy %.1f %%\n", score(false, bodies + 1));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -317,6 +354,7 @@ int main(int argc, char** argv) {
     std::printf(
         "laryngoscopy_bench: peak |F| %.3f N; POGO at the start %.1f %%, best %.1f %% at %.2f s\n",
         peak_total, pogo_first, pogo_best, pogo_best_t);
+    print_what_hides(sim, view);
     std::printf(
         "laryngoscopy_bench: anatomy's push on the blade at most %.3f N; ticks wedged between "
         "anatomy and tissue (the tissue given the limit, force only) %llu, held (lost track) "

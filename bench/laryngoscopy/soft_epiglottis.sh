@@ -5,8 +5,10 @@
 # directory: the shipped files are not touched): per airway, the whole loop
 # in lockstep in one process (fahr_laryngoscopy_bench) with the shipped
 # intubation script and with the Miller keyframes tried on it
-# (miller_neutral.keyframes, miller_extended.keyframes), and the neutral
-# Miller keyframes once more without the blade's contact with the lips; first,
+# (miller_neutral.keyframes, miller_extended.keyframes), the extended airway
+# once more with the mouth opened wider and the hyoid let go
+# (miller_open.keyframes), and the neutral Miller keyframes once more
+# without the blade's contact with the lips; first,
 # how far the tongue and the epiglottis at rest reach above the lines of
 # sight to the glottis. Each run prints the blade's force on each body, their
 # motion and the glottic view every 0.5 s, then the peaks.
@@ -14,7 +16,7 @@
 #   bench/laryngoscopy/soft_epiglottis.sh [BUILD_DIR] [--markdown [FILE]]
 #
 # --markdown: also write the output to FILE (a name ending in .md), by
-# default bench/results/<machine>/soft-epiglottis.md. About 4 min.
+# default bench/results/<machine>/soft-epiglottis.md. About 5 min.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
@@ -46,14 +48,26 @@ trap 'rm -rf "$work"' EXIT
 shipped="$repo/deployment/scenes/neonatal_intubation.yaml"
 soft="$repo/bench/support/soft_epiglottis_scene.sh"
 
-# The extended airway: its meshes, and the shipped scene pointed at them.
-mkdir -p "$work/extended"
-"$generator" --out "$work/extended" --head-extension-deg 15 --larynx-fold-rise-mm -5 \
-  >"$work/extended/generator.log" 2>&1 ||
-  { echo "soft_epiglottis: the generator refused:" >&2; tail -n 20 "$work/extended/generator.log" >&2; exit 1; }
-bash "$repo/bench/support/generated_scene.sh" "$work/extended" >"$work/extended/rigid.yaml"
+# A generated airway: its meshes in DIR, and the shipped scene pointed at
+# them (DIR/rigid.yaml).
+generate() {
+  local dir=$1
+  shift
+  mkdir -p "$dir"
+  "$generator" --out "$dir" "$@" >"$dir/generator.log" 2>&1 ||
+    { echo "soft_epiglottis: the generator refused:" >&2; tail -n 20 "$dir/generator.log" >&2; exit 1; }
+  bash "$repo/bench/support/generated_scene.sh" "$dir" >"$dir/rigid.yaml"
+}
+# The extended airway; and the same with the mouth opened wider (the lower
+# gum ridge 3.5 mm lower, the lips' opening 20 mm tall), its hyoid let go.
+generate "$work/extended" --head-extension-deg 15 --larynx-fold-rise-mm -5
+generate "$work/open" --head-extension-deg 15 --larynx-fold-rise-mm -5 --jaw-ridge-y-mm -9 \
+  --mouth-half-height-mm 10
 bash "$soft" "$shipped" >"$work/neutral.yaml"
 bash "$soft" "$work/extended/rigid.yaml" >"$work/extended.yaml"
+bash "$soft" "$work/open/rigid.yaml" >"$work/open/soft.yaml"
+bash "$repo/bench/support/suspended_hyoid_scene.sh" "$work/open/soft.yaml" \
+  "$work/open/fixed_without_hyoid.txt" >"$work/open.yaml"
 # The neutral airway without the blade's contact with the lips: is the lip
 # what stops the blade?
 sed 's/^  exclude_pairs: \[\]$/  exclude_pairs: [[miller1, lips_face]]/' "$work/neutral.yaml" \
@@ -104,6 +118,13 @@ grep -q '^  exclude_pairs: \[\[miller1, lips_face\]\]$' "$work/neutral_without_l
       echo '```'
     done
   done
+  echo
+  echo "### extended airway, mouth opened wider, hyoid let go, miller_open.keyframes"
+  echo
+  echo '```'
+  "$bench" --scene "$work/open.yaml" --keyframes "$here/miller_open.keyframes" --seconds 13 \
+    --trace-every 0.5
+  echo '```'
   echo
   echo "### neutral airway without the blade's contact with the lips, miller_neutral.keyframes"
   echo
