@@ -8,6 +8,7 @@
 #include <stdlib.h>  // mkdtemp (POSIX)
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -20,6 +21,7 @@
 #include "fahr/geometry/signed_distance_field.h"
 #include "fahr/geometry/surface_loader.h"
 #include "fahr/geometry/surface_mesh.h"
+#include "fahr/geometry/tet_quality.h"
 #include "fahr/scenegen/mesh_checks.h"
 #include "fahr/scenegen/mesh_readers.h"
 
@@ -28,6 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 using fahr::scenegen::MeshedSolid;
 using fahr::scenegen::TriangleMesh;
+using fahr::scenegen::Vec3;
 
 #ifndef FAHR_SCENE_GENERATOR
 #error "FAHR_SCENE_GENERATOR must name the generator executable"
@@ -176,6 +179,30 @@ TEST_F(SceneGeneratorTest, TetsHavePositiveVolumeAndBoundaryIsClosed) {
   EXPECT_GE(tongue.tets.size(), 5600u);
   EXPECT_LE(tongue.tets.size(), 10000u);
   expect_valid_tets(tongue);
+}
+
+// The generator's radius ratio (which its quality line prints) is the
+// geometry library's, tet by tet, on the generated tongue; the regular tet
+// scores 1 and a flat one 0.
+TEST_F(SceneGeneratorTest, RadiusRatioIsTheGeometryLibrarys) {
+  using fahr::scenegen::tet_radius_ratio;
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0.5, std::sqrt(3.0) / 2.0, 0);
+  const Vec3 apex(0.5, std::sqrt(3.0) / 6.0, std::sqrt(2.0 / 3.0));
+  EXPECT_NEAR(tet_radius_ratio(a, b, c, apex), 1.0, 1e-12);
+  EXPECT_EQ(tet_radius_ratio(a, b, c, Vec3(0.3, 0.2, 0.0)), 0.0);
+  MeshedSolid tongue;
+  std::string error;
+  ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "tongue").string(), tongue, error)) << error;
+  double smallest = 1.0;
+  for (const auto& t : tongue.tets) {
+    const auto& n = tongue.nodes;
+    const double ours = tet_radius_ratio(n[t[0]], n[t[1]], n[t[2]], n[t[3]]);
+    const double theirs =
+        fahr::geometry::tet_shape(n[t[0]], n[t[1]], n[t[2]], n[t[3]]).radius_ratio;
+    ASSERT_NEAR(ours, theirs, 1e-9);
+    smallest = std::min(smallest, ours);
+  }
+  EXPECT_NEAR(fahr::scenegen::tet_quality(tongue).min_radius_ratio, smallest, 0.0);
 }
 
 TEST_F(SceneGeneratorTest, SurfacesAreClosedAndOutward) {
