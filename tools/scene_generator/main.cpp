@@ -269,7 +269,8 @@ int main(int argc, char** argv) {
   const MeshedSolid epiglottis = param_box_tets(boxes.at("epiglottis"));
   const TetQuality epiglottis_quality = tet_quality(epiglottis);
   const ParamBox& epiglottis_lattice = boxes.at("epiglottis");
-  std::vector<int> epiglottis_base((epiglottis_lattice.nv + 1) * (epiglottis_lattice.nw + 1));
+  std::vector<int> epiglottis_base(static_cast<std::size_t>(epiglottis_lattice.nv + 1) *
+                                   static_cast<std::size_t>(epiglottis_lattice.nw + 1));
   for (size_t i = 0; i < epiglottis_base.size(); ++i) epiglottis_base[i] = static_cast<int>(i);
   {
     const TriangleMesh boundary = as_written(TriangleMesh{epiglottis.nodes, epiglottis.boundary});
