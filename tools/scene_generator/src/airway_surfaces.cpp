@@ -53,6 +53,11 @@ Vec3 neck_turn(const AirwayParameters& p, const Vec3& v, double share) {
               std::sin(angle) * v.x() + std::cos(angle) * v.y(), v.z() + 0.0);  // no -0
 }
 
+// How far the inlet lies above its default height, mm.
+double larynx_rise_mm(const AirwayParameters& p) {
+  return p.inlet_y_mm - AirwayParameters{}.inlet_y_mm;
+}
+
 }  // namespace
 
 Vec3 neck_pose(const AirwayParameters& p, const Vec3& neutral) {
@@ -184,23 +189,28 @@ TriangleMesh make_soft_palate(const SoftPalateParameters& s, const PalateParamet
   return make_param_box(soft_palate_box(s, palate, tongue, resolution_mm));
 }
 
-double pharynx_wall_x(double y_mm) {
+double pharynx_wall_x(double y_mm, double larynx_rise_mm) {
   // Estimates fitted to the airway's published diameters behind the soft
   // palate and the tongue (meshes/neonatal/README.md): the wall slopes back
   // going down, and behind the larynx it leaves room for the hypopharynx.
   static const PiecewiseLinear kWall = {{-62.0, -72.0}, {-32.0, -69.0}, {-24.0, -66.0},
                                         {-20.0, -62.5}, {-14.0, -59.5}, {-8.0, -57.5},
                                         {2.0, -51.0},   {14.0, -48.0}};
-  return kWall(y_mm);
+  // A raised larynx takes the hypopharynx up with it: below y -20 the wall
+  // is the default wall larynx_rise_mm lower, above y -8 it is unchanged,
+  // blended linearly between.
+  const double share = std::clamp((-8.0 - y_mm) / 12.0, 0.0, 1.0);
+  return kWall(y_mm - share * larynx_rise_mm);
 }
 
 double posed_pharynx_wall_x(const AirwayParameters& p, double y_mm) {
-  if (p.extension_deg == 0.0) return pharynx_wall_x(y_mm);
+  const double rise = larynx_rise_mm(p);
+  if (p.extension_deg == 0.0) return pharynx_wall_x(y_mm, rise);
   // The wall's posed mid-line, walked down until it crosses y.
   constexpr double kStepMm = 0.1;
-  Vec3 above = neck_pose(p, Vec3(pharynx_wall_x(40.0), 40.0, 0.0));
+  Vec3 above = neck_pose(p, Vec3(pharynx_wall_x(40.0, rise), 40.0, 0.0));
   for (double y = 40.0 - kStepMm; y > -120.0; y -= kStepMm) {
-    const Vec3 below = neck_pose(p, Vec3(pharynx_wall_x(y), y, 0.0));
+    const Vec3 below = neck_pose(p, Vec3(pharynx_wall_x(y, rise), y, 0.0));
     if (below.y() <= y_mm && above.y() >= y_mm) {
       const double t = above.y() > below.y() ? (above.y() - y_mm) / (above.y() - below.y()) : 0.0;
       return above.x() + t * (below.x() - above.x());
@@ -214,7 +224,7 @@ ParamBox pharynx_box(const PharynxParameters& p, const AirwayParameters& airway,
                      double resolution_mm) {
   const auto map = [p, airway](double u, double v, double w) {
     const double y = p.top_y_mm + (p.bottom_y_mm - p.top_y_mm) * u;
-    const double centre = pharynx_wall_x(y) + p.depth_mm;
+    const double centre = pharynx_wall_x(y, larynx_rise_mm(airway)) + p.depth_mm;
     const double phi = (2.0 * v - 1.0) * 0.5 * kPi;  // 0 at the back, +-90 deg at the arms' ends
     const double depth = p.depth_mm + p.thickness_mm * w;
     const double half_width = p.half_width_mm + p.thickness_mm * w;

@@ -44,8 +44,10 @@ TriangleMesh make_soft_palate(const SoftPalateParameters& s, const PalateParamet
                               const ImplicitSolid& tongue, double resolution_mm);
 
 // x of the posterior pharyngeal wall's anterior face at the mid-line, at
-// height y: for the neutral head, and placed for the head's extension.
-double pharynx_wall_x(double y_mm);
+// height y: for the neutral head, and placed for the head's extension. The
+// wall behind the larynx rises with it (larynx_rise_mm: the inlet above its
+// default height), the wall behind the soft palate stays.
+double pharynx_wall_x(double y_mm, double larynx_rise_mm);
 double posed_pharynx_wall_x(const AirwayParameters& p, double y_mm);
 ParamBox pharynx_box(const PharynxParameters& p, const AirwayParameters& airway,
                      double resolution_mm);
