@@ -7,7 +7,8 @@
 # intubation script and with the Miller keyframes tried on it
 # (miller_neutral.keyframes, miller_extended.keyframes), the extended airway
 # once more with the mouth opened wider and the hyoid let go
-# (miller_open.keyframes), and the neutral Miller keyframes once more
+# (miller_open.keyframes) and then with the larynx raised 6 mm as well
+# (miller_raised.keyframes), and the neutral Miller keyframes once more
 # without the blade's contact with the lips; first,
 # how far the tongue and the epiglottis at rest reach above the lines of
 # sight to the glottis. Each run prints the blade's force on each body, their
@@ -63,11 +64,22 @@ generate() {
 generate "$work/extended" --head-extension-deg 15 --larynx-fold-rise-mm -5
 generate "$work/open" --head-extension-deg 15 --larynx-fold-rise-mm -5 --jaw-ridge-y-mm -9 \
   --mouth-half-height-mm 10
+# ... and with the larynx raised 6 mm as well.
+generate "$work/raised" --head-extension-deg 15 --larynx-fold-rise-mm -5 --jaw-ridge-y-mm -9 \
+  --mouth-half-height-mm 10 --larynx-inlet-y-mm -18
 bash "$soft" "$shipped" >"$work/neutral.yaml"
 bash "$soft" "$work/extended/rigid.yaml" >"$work/extended.yaml"
 bash "$soft" "$work/open/rigid.yaml" >"$work/open/soft.yaml"
 bash "$repo/bench/support/suspended_hyoid_scene.sh" "$work/open/soft.yaml" \
   "$work/open/fixed_without_hyoid.txt" >"$work/open.yaml"
+bash "$soft" "$work/raised/rigid.yaml" >"$work/raised/soft.yaml"
+# The scene's eye (300 mm along the blade, 100 mm above it) looks down over
+# the upper lip on these airways; this run puts it 30 mm above the blade.
+bash "$repo/bench/support/suspended_hyoid_scene.sh" "$work/raised/soft.yaml" \
+  "$work/raised/fixed_without_hyoid.txt" |
+  sed 's/^  eye_in_tool_m: \[0.30, 0.10, 0.0\]$/  eye_in_tool_m: [0.30, 0.03, 0.0]/' >"$work/raised.yaml"
+grep -q '^  eye_in_tool_m: \[0.30, 0.03, 0.0\]$' "$work/raised.yaml" ||
+  { echo "soft_epiglottis: the scene's eye_in_tool_m line changed; update this script" >&2; exit 1; }
 # The neutral airway without the blade's contact with the lips: is the lip
 # what stops the blade?
 sed 's/^  exclude_pairs: \[\]$/  exclude_pairs: [[miller1, lips_face]]/' "$work/neutral.yaml" \
@@ -123,6 +135,13 @@ grep -q '^  exclude_pairs: \[\[miller1, lips_face\]\]$' "$work/neutral_without_l
   echo
   echo '```'
   "$bench" --scene "$work/open.yaml" --keyframes "$here/miller_open.keyframes" --seconds 13 \
+    --trace-every 0.5
+  echo '```'
+  echo
+  echo "### the same with the larynx raised 6 mm, the eye 30 mm above the blade, miller_raised.keyframes"
+  echo
+  echo '```'
+  "$bench" --scene "$work/raised.yaml" --keyframes "$here/miller_raised.keyframes" --seconds 13 \
     --trace-every 0.5
   echo '```'
   echo
