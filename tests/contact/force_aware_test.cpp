@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <stdexcept>
 #include <vector>
 
 #include "fahr/contact/contact_response.h"
@@ -224,6 +226,68 @@ TEST(ForceAware, ATickNeverThrowsAHeldToolFartherThanAFastHandMoves) {
   ASSERT_TRUE(out.lost_track);
   EXPECT_LE(out.proxy_position_m.norm(), 1e-3 + 1e-9);
   EXPECT_TRUE(out.proxy_position_m.allFinite());
+}
+
+// A plate squeezed between two bodies of tissue, one under it and one over
+// it, 1 mm into each, both stiff (W 1e-5 m/N): the solve pushes each body
+// with about 100 N while their resultants cancel, so the hand feels nothing
+// and the tissue's net reaction stays under the limit. Measured on the
+// ContactSet the FEM receives: as one tissue the squeeze passes unbounded;
+// told they are two bodies, each body's push is within the device's limit.
+TEST(ForceAware, ATwoBodySqueezeGivesNoBodyMoreThanTheLimit) {
+  constexpr double kLimit = 3.0;
+  const auto squeeze = [&](bool two_bodies) {
+    std::vector<std::uint32_t> ids{0, 1};
+    std::vector<float> w(36, 0.0f);
+    for (std::size_t d = 0; d < 6; ++d) w[d * 6 + d] = 1e-5f;
+    std::vector<ContactRow> rows(2);
+    rows[0].kind = rows[1].kind = RowKind::kTissue;
+    rows[0].id = 0;  // under the plate, pushed down
+    rows[0].normal = Eigen::Vector3d(0, -1, 0);
+    rows[0].other_point_m = Eigen::Vector3d(0, 0, 0);
+    rows[0].tool_point_m = Eigen::Vector3d(0, -0.001, 0);
+    rows[0].compliance_index = 0;
+    rows[1].id = 1;  // over it, pushed up
+    rows[1].normal = Eigen::Vector3d(0, 1, 0);
+    rows[1].other_point_m = Eigen::Vector3d(0, 0.002, 0);
+    rows[1].tool_point_m = Eigen::Vector3d(0, 0.003, 0);
+    rows[1].compliance_index = 1;
+    ResponseSettings settings;
+    ContactResponse response(settings);
+    if (two_bodies) {
+      const std::vector<std::uint32_t> first{0, 1};
+      response.set_tissue_bodies(first);
+    }
+    response.reset(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity());
+    TickInput in;
+    in.device.renderable_force_n = kLimit;
+    in.rows = rows;
+    in.compliance = TissueCompliance{7, ids, w, {}};
+    const ForceOutput& out = response.tick(in);
+    std::array<double, 2> push{0.0, 0.0};
+    for (const fem::Contact& c : response.contacts()) {
+      if (c.kind != fem::ContactKind::kObstacle && c.sphere_id < 2) push[c.sphere_id] += c.force_n;
+    }
+    EXPECT_LT(out.force_n.norm(), 0.1);  // the hand feels the resultant: none
+    return push;
+  };
+  const auto one = squeeze(false);
+  EXPECT_GT(one[0], 10.0 * kLimit);  // the regime that fails without bodies
+  EXPECT_GT(one[1], 10.0 * kLimit);
+  const auto two = squeeze(true);
+  EXPECT_LE(two[0] + two[1], kLimit * (1.0 + 1e-9));
+  EXPECT_GT(two[0], 0.4 * kLimit);  // scaled, not dropped
+  EXPECT_GT(two[1], 0.4 * kLimit);
+}
+
+TEST(ForceAware, TissueBodiesAreCheckedWhenSet) {
+  ContactResponse response{ResponseSettings{}};
+  const std::vector<std::uint32_t> not_from_zero{1, 5};
+  EXPECT_THROW(response.set_tissue_bodies(not_from_zero), std::invalid_argument);
+  const std::vector<std::uint32_t> descending{0, 5, 3};
+  EXPECT_THROW(response.set_tissue_bodies(descending), std::invalid_argument);
+  const std::vector<std::uint32_t> too_many(ContactResponse::kMaxTissueBodies + 1, 0);
+  EXPECT_THROW(response.set_tissue_bodies(too_many), std::invalid_argument);
 }
 
 }  // namespace

@@ -2,8 +2,12 @@
 // ForceCommand fields and the ContactSet for the FEM.
 #include "fahr/contact/contact_response.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 #include "fahr/contact/force_limit.h"
 
@@ -397,14 +401,15 @@ double ContactResponse::scale_tissue_forces(const DeviceSample& device) {
   const double solved_reaction = solver_.resultant(RowKind::kTissue).norm();
   tissue_force_scale_ = 1.0;
   if (settings_.mode == ResponseMode::kNaive) return solved_reaction;
+  const double load = tissue_load(solved_reaction);
   const bool holds_proxy = (held == HeldProxy::kStay && state_ == TrackingState::kLostTrack) ||
                            (held == HeldProxy::kHoldLoad && pinned());
   if (holds_proxy) {
     // Held where it froze: the tissue forces are scaled to the limit; the
     // spheres stay frozen (kStay) or carry that load alone (kHoldLoad,
     // force only: write_contacts).
-    if (solved_reaction > device.renderable_force_n) {
-      tissue_force_scale_ = device.renderable_force_n / solved_reaction;
+    if (load > device.renderable_force_n) {
+      tissue_force_scale_ = device.renderable_force_n / load;
       report_.tissue_force_scaled_held = true;
     }
     // kHoldLoad: held, the tissue carries the load alone; catching up, it
@@ -412,11 +417,41 @@ double ContactResponse::scale_tissue_forces(const DeviceSample& device) {
     report_.tissue_held_by_load =
         held == HeldProxy::kHoldLoad &&
         (state_ == TrackingState::kLostTrack || report_.tissue_force_scaled_held);
-  } else if (solved_reaction > kWedgeBand * device.renderable_force_n) {
-    tissue_force_scale_ = device.renderable_force_n / solved_reaction;
+  } else if (load > kWedgeBand * device.renderable_force_n) {
+    tissue_force_scale_ = device.renderable_force_n / load;
     report_.tissue_force_clamped = true;
   }
   return solved_reaction;
+}
+
+double ContactResponse::tissue_load(double resultant_norm) const {
+  if (body_count_ < 2) return resultant_norm;
+  double load = 0.0;
+  for (std::size_t b = 0; b < body_count_; ++b) {
+    const std::uint32_t end =
+        b + 1 < body_count_ ? body_first_ids_[b + 1] : std::numeric_limits<std::uint32_t>::max();
+    load += solver_.resultant(RowKind::kTissue, body_first_ids_[b], end).norm();
+  }
+  return load;
+}
+
+void ContactResponse::set_tissue_bodies(std::span<const std::uint32_t> first_ids) {
+  if (first_ids.size() > kMaxTissueBodies) {
+    throw std::invalid_argument("ContactResponse::set_tissue_bodies: more than " +
+                                std::to_string(kMaxTissueBodies) + " bodies");
+  }
+  if (!first_ids.empty() && first_ids.front() != 0) {
+    throw std::invalid_argument(
+        "ContactResponse::set_tissue_bodies: the first body's first id "
+        "must be 0");
+  }
+  for (std::size_t b = 1; b < first_ids.size(); ++b) {
+    if (first_ids[b] <= first_ids[b - 1]) {
+      throw std::invalid_argument("ContactResponse::set_tissue_bodies: first ids must ascend");
+    }
+  }
+  std::copy(first_ids.begin(), first_ids.end(), body_first_ids_.begin());
+  body_count_ = std::max<std::size_t>(first_ids.size(), 1);
 }
 
 const ForceOutput& ContactResponse::tick(const TickInput& input) {

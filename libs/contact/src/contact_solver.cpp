@@ -264,6 +264,16 @@ Eigen::Vector3d ContactSolver::resultant(RowKind kind) const {
   return sum;
 }
 
+Eigen::Vector3d ContactSolver::resultant(RowKind kind, std::uint32_t first_id,
+                                         std::uint32_t end_id) const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < k_; ++i) {
+    const ContactRow& r = rows_[i];
+    if (r.kind == kind && r.id >= first_id && r.id < end_id) sum += r.normal * lambda_[i];
+  }
+  return sum;
+}
+
 Eigen::Vector3d ContactSolver::predicted_motion(std::size_t i,
                                                 const TissueCompliance& compliance) const {
   Eigen::Vector3d motion = Eigen::Vector3d::Zero();

@@ -120,6 +120,11 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
     sphere_contact_.assign(kToolContactCapacity, 0);
     slot_sphere_.assign(kToolContactCapacity, 0);
   }
+  // Each body's load is bounded by what the device renders, not only their
+  // sum (a blade between the tongue and the epiglottis).
+  std::vector<std::uint32_t> first_spheres;
+  for (const TissueBody& body : setup.bodies) first_spheres.push_back(body.first_sphere);
+  response_.set_tissue_bodies(first_spheres);
   tool_body_.id = setup.tool->scene_body->id;
   tool_body_.sdf = setup.tool->sdf.get();
   tool_body_.grid = setup.tool_grid.get();

@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -95,6 +97,16 @@ class ContactResponse {
   // Puts the proxy at the device pose, tracking, no contacts.
   void reset(const Eigen::Vector3d& position_m, const Eigen::Quaterniond& orientation);
 
+  // The tissue as several bodies: body b's rows are those whose id lies in
+  // [first_ids[b], first_ids[b + 1]) (the last body's run to the end). The
+  // tissue's load is then the sum of each body's resultant, so a tool
+  // squeezed between two bodies cannot hand each more than the device can
+  // render while their resultants cancel. Ascending, first_ids[0] == 0, at
+  // most kMaxTissueBodies (std::invalid_argument otherwise); fewer than two:
+  // one body, the whole tissue's resultant.
+  static constexpr std::size_t kMaxTissueBodies = 8;
+  void set_tissue_bodies(std::span<const std::uint32_t> first_ids);
+
   const ForceOutput& tick(const TickInput& input);
 
   const ToolProxy& proxy() const { return proxy_; }
@@ -131,6 +143,9 @@ class ContactResponse {
   Eigen::Vector3d keep_out_of_bone(const Eigen::Vector3d& step);
   void fill_output(const DeviceSample& device, const EffectiveCoupling& coupling);
   double scale_tissue_forces(const DeviceSample& device);
+  // The load the tissue's rows put on the tissue, N: the resultant's norm,
+  // or with several bodies the sum of theirs.
+  double tissue_load(double resultant_norm) const;
   // The proxy does not follow the device this tick (held, or its catch-up bounded).
   bool pinned() const { return state_ == TrackingState::kLostTrack || report_.catch_up_limited; }
   Eigen::Vector3d catch_up_step(const Eigen::Vector3d& toward, double max_step, double dt_s) const;
@@ -151,6 +166,8 @@ class ContactResponse {
   // the hand's pull along it falls below the band.
   Eigen::Vector3d held_push_direction_ = Eigen::Vector3d::Zero();
   double tissue_force_scale_ = 1.0;  // applied to the ContactSet's tissue forces this tick
+  std::array<std::uint32_t, kMaxTissueBodies> body_first_ids_{};
+  std::size_t body_count_ = 1;
   std::vector<Hold> holds_;
   std::size_t hold_count_ = 0;
   std::vector<fem::Contact> contacts_;

@@ -83,6 +83,8 @@ class ContactSolver {
   double penetration(std::size_t i) const { return depth_[i]; }  // d_i at p0, m
   // sum_i n_i lambda_i over rows of `kind`, N (the force the tool exerts on them).
   Eigen::Vector3d resultant(RowKind kind) const;
+  // The same over the rows of `kind` whose id lies in [first_id, end_id).
+  Eigen::Vector3d resultant(RowKind kind, std::uint32_t first_id, std::uint32_t end_id) const;
   // W_row(i),row(j) n_j summed with lambda_j over tissue rows: the predicted
   // motion of row i's sphere centre under the solved forces, m.
   Eigen::Vector3d predicted_motion(std::size_t i, const TissueCompliance& compliance) const;
