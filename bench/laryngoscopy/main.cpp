@@ -7,7 +7,7 @@
 // (bench/support/soft_epiglottis_scene.sh): README.md.
 //
 //   fahr_laryngoscopy_bench --scene FILE [--script NAME | --keyframes FILE] [--seconds S]
-//                     [--trace-every S]
+//                     [--trace-every S] [--eye-in-tool-mm X Y Z]
 //
 // --keyframes FILE: the hand's own keyframes instead of a script, one per
 // line "t_s x_mm y_mm z_mm pitch_deg" (the blade tip in the world frame,
@@ -222,6 +222,7 @@ int main(int argc, char** argv) {
   std::vector<double> corridor_deg;
   double corridor_half_width_mm = 5.0;
   double corridor_mouth_z_mm = 0.0;
+  std::vector<double> eye_in_tool_mm;
   app.add_option("--scene", scene_path, "scene file");
   app.add_option("--sight-corridor", corridor_deg,
                  "no run: each body's height above lines of sight this many degrees from the "
@@ -230,6 +231,8 @@ int main(int argc, char** argv) {
   app.add_option("--corridor-half-width-mm", corridor_half_width_mm,
                  "the corridor's half width about the mid-line, mm")
       ->check(cli::Range(0.1, 50.0));
+  app.add_option("--eye-in-tool-mm", eye_in_tool_mm,
+                 "X Y Z: the laryngoscopist's eye in the tool frame instead of the scene's, mm");
   app.add_option("--corridor-mouth-z-mm", corridor_mouth_z_mm,
                  "where the corridor crosses the mouth's plane (x = 0) across, mm (+z: the "
                  "patient's right; the paraglossal path), straight from the opening")
@@ -263,6 +266,15 @@ int main(int argc, char** argv) {
     }
     stack_sim::StackSim sim(scene, options);
     auto view = glottic_view::glottic_view_from_scene(*scene);
+    if (!eye_in_tool_mm.empty()) {
+      if (eye_in_tool_mm.size() != 3 ||
+          !std::all_of(eye_in_tool_mm.begin(), eye_in_tool_mm.end(),
+                       [](double v) { return std::isfinite(v) && std::abs(v) <= 10000.0; })) {
+        throw std::runtime_error("--eye-in-tool-mm: want three finite numbers within 10 m");
+      }
+      view.eye_in_tool_m =
+          1e-3 * Eigen::Vector3d(eye_in_tool_mm[0], eye_in_tool_mm[1], eye_in_tool_mm[2]);
+    }
     const std::size_t bodies = sim.body_count();
     std::vector<std::vector<Eigen::Vector3d>> points(bodies);
     std::vector<double> peak_force(bodies, 0.0);
