@@ -28,7 +28,9 @@
 // displacement difference from the exact run (mm), closed loop and shadow;
 // the largest relative difference of the shadow's W from the exact W; W's
 // relative Frobenius error against a fresh factorisation of A linearised at
-// the shadow's current state, for the leading 1, 8, 32 and 64 spheres; the
+// the state the step solves from (W's error: the step's own system solved
+// exactly) and at the state after it (what one step changes), for the
+// leading 1, 8, 32 and 64 spheres; the
 // largest and RMS difference of the force sent to the device (N); the most
 // inverted tets.
 #include <algorithm>
@@ -61,6 +63,7 @@ using fahr::fem::SolverSettings;
 struct Config {
   std::string name;
   bool keep_scene_solver = false;  // "shipped": whatever the scene maps to
+  std::size_t w_refresh = 0;       // "-wfresh": every column on each new factor (0: the FEM's)
   SolverSettings solver;
 };
 
@@ -69,11 +72,18 @@ struct Config {
 // the rest factor, never refreshed), pcg-itN (CG, refreshed when a solve
 // took more than N iterations); a CG name may end in -warp (warped factor)
 // and then -tolX (relative tolerance X instead of 1e-6), e.g.
-// pcg-it12-tol1e-4.
+// pcg-it12-tol1e-4. Any name may end in -wfresh: W's kept columns all solved
+// again on each new factorisation instead of a budget a step.
 bool make_cg_config(const std::string& name, SolverSettings& s);
 
-bool make_config(const std::string& name, Config& config) {
-  config.name = name;
+bool make_config(const std::string& full_name, Config& config) {
+  config.name = full_name;
+  std::string name = full_name;
+  // "-wfresh": W's kept columns all solved again on each new factorisation.
+  if (name.size() > 7 && name.substr(name.size() - 7) == "-wfresh") {
+    config.w_refresh = 1024;
+    name = name.substr(0, name.size() - 7);
+  }
   SolverSettings& s = config.solver;
   s.refactor_period = 0;
   s.refactor_rotation_rad = 0.0;
@@ -158,6 +168,20 @@ struct Shadow {
   // Per audited step and leading sphere count (kAuditSpheres): relative
   // Frobenius error of the leading block.
   std::array<std::vector<double>, 5> audit_error;
+  // The same against A linearised at the state the step began from (every
+  // tangent afresh, the supports the step held): the system the step
+  // solves, so W's own error; audit_error adds how far one step moves A.
+  std::unique_ptr<fahr::fem::CholmodSolver> start_audit;
+  fahr::fem::SystemAssembly start_assembly;
+  fahr::fem::ComplianceBlock start_block;  // its own: a block keeps columns per factor count
+  std::array<std::vector<double>, 5> start_error;
+  // Over the audited steps: the largest node motion in the step, mm, and
+  // whether it went against the node's motion in the step before (a
+  // state that only holds still, or one that rocks step to step).
+  std::vector<double> step_motion_mm;
+  std::size_t reversals = 0;
+  std::vector<double> before_m;     // positions at the start of the step
+  std::vector<double> last_step_m;  // each node's motion in the step before
 };
 
 // Leading spheres of the block whose W is audited (0: the whole block).
@@ -168,25 +192,31 @@ void start_audit(Shadow& shadow) {
   shadow.audit_assembly.build(body.node_count(), body.element_rest(), body.fixed_dofs());
   shadow.audit = std::make_unique<fahr::fem::CholmodSolver>();
   shadow.audit->analyze(shadow.audit_assembly.matrix(), body.settings().solver.cholmod);
+  shadow.start_assembly.build(body.node_count(), body.element_rest(), body.fixed_dofs());
+  shadow.start_audit = std::make_unique<fahr::fem::CholmodSolver>();
+  shadow.start_audit->analyze(shadow.start_assembly.matrix(), body.settings().solver.cholmod);
   shadow.audit_block.reserve(3 * body.node_count(), body.settings().max_compliance_spheres);
   // Every column solved again on each fresh factor.
   shadow.audit_block.set_refresh_per_call(body.settings().max_compliance_spheres);
+  shadow.start_block.reserve(3 * body.node_count(), body.settings().max_compliance_spheres);
+  shadow.start_block.set_refresh_per_call(body.settings().max_compliance_spheres);
   shadow.audit_warp.resize(body.node_count());
   shadow.audit_warp.set_enabled(false);
 }
 
-void audit_compliance(Shadow& shadow) {
+// W of a fresh factorisation of the assembled A against the W in use:
+// relative Frobenius error of each leading block, appended to `errors`.
+void audit_against(Shadow& shadow, fahr::fem::CholmodSolver& fresh_factor,
+                   fahr::fem::ComplianceBlock& block, std::array<std::vector<double>, 5>& errors) {
   const auto& step = shadow.step->contact_step();
   const auto spheres = step.compliance_spheres();
   const auto w = step.compliance();
   const std::size_t k = spheres.size();
-  if (k == 0 || w.size() != 9 * k * k) return;
   const fahr::fem::Body& body = *shadow.setup->body;
-  body.assemble_current(shadow.audit_assembly);
-  if (!shadow.audit->factorize()) return;
+  if (!fresh_factor.factorize()) return;
   shadow.audit_w.resize(w.size());
-  if (!shadow.audit_block.compute(spheres, shadow.setup->links, body.fixed_dofs(), *shadow.audit,
-                                  shadow.audit_warp, body.time_step_s(), shadow.audit_w)) {
+  if (!block.compute(spheres, shadow.setup->links, body.fixed_dofs(), fresh_factor,
+                     shadow.audit_warp, body.time_step_s(), shadow.audit_w)) {
     return;
   }
   const std::size_t rows = 3 * k;
@@ -203,8 +233,45 @@ void audit_compliance(Shadow& shadow) {
         norm += fresh * fresh;
       }
     }
-    if (norm > 0.0) shadow.audit_error[a].push_back(std::sqrt(diff / norm));
+    if (norm > 0.0) errors[a].push_back(std::sqrt(diff / norm));
   }
+}
+
+// The largest node motion of the step just made, and whether that node
+// went back against its motion of the step before.
+void record_step_motion(Shadow& shadow) {
+  const auto x = shadow.setup->body->positions_m();
+  shadow.last_step_m.resize(x.size(), 0.0);
+  double largest2 = 0.0;
+  std::size_t node = 0;
+  for (std::size_t n = 0; 3 * n < x.size(); ++n) {
+    const Eigen::Vector3d moved(x[3 * n] - shadow.before_m[3 * n],
+                                x[3 * n + 1] - shadow.before_m[3 * n + 1],
+                                x[3 * n + 2] - shadow.before_m[3 * n + 2]);
+    if (moved.squaredNorm() > largest2) {
+      largest2 = moved.squaredNorm();
+      node = n;
+    }
+  }
+  const Eigen::Vector3d now(x[3 * node] - shadow.before_m[3 * node],
+                            x[3 * node + 1] - shadow.before_m[3 * node + 1],
+                            x[3 * node + 2] - shadow.before_m[3 * node + 2]);
+  const Eigen::Vector3d before(shadow.last_step_m[3 * node], shadow.last_step_m[3 * node + 1],
+                               shadow.last_step_m[3 * node + 2]);
+  if (now.dot(before) < 0.0) ++shadow.reversals;
+  shadow.step_motion_mm.push_back(1e3 * std::sqrt(largest2));
+  for (std::size_t i = 0; i < x.size(); ++i) shadow.last_step_m[i] = x[i] - shadow.before_m[i];
+}
+
+// After the step; start_assembly holds A at the state it began from.
+void audit_compliance(Shadow& shadow) {
+  record_step_motion(shadow);
+  const auto& step = shadow.step->contact_step();
+  const std::size_t k = step.compliance_spheres().size();
+  if (k == 0 || step.compliance().size() != 9 * k * k) return;
+  audit_against(shadow, *shadow.start_audit, shadow.start_block, shadow.start_error);
+  shadow.setup->body->assemble_current(shadow.audit_assembly);
+  audit_against(shadow, *shadow.audit, shadow.audit_block, shadow.audit_error);
 }
 
 struct Run {
@@ -381,6 +448,10 @@ int main(int argc, char** argv) try {
           }
         }
       }
+      if (run.config.w_refresh > 0) {
+        run.sim->body().set_compliance_refresh(run.config.w_refresh);
+        run.shadow.setup->body->set_compliance_refresh(run.config.w_refresh);
+      }
       run.factorisations_at_start = run.sim->body().factorisations();
       run.shadow.factorisations_at_start = run.shadow.setup->body->factorisations();
       runs.push_back(std::move(run));
@@ -412,6 +483,12 @@ int main(int argc, char** argv) try {
         for (Run& run : runs) {
           Shadow& shadow = run.shadow;
           if (k > 0) shadow.step->take(exact.fed, exact.fed.header().seq());
+          const double t0_s = exact.sim->time_s();
+          if (t0_s >= audit_from_s && t0_s <= audit_to_s) {
+            shadow.setup->body->assemble_current(shadow.start_assembly);
+            const auto x0 = shadow.setup->body->positions_m();
+            shadow.before_m.assign(x0.begin(), x0.end());
+          }
           const std::int64_t cpu0 = common::thread_cpu_now_ns();
           shadow.step->step();
           const double cpu_ms = 1e-6 * static_cast<double>(common::thread_cpu_now_ns() - cpu0);
@@ -499,7 +576,7 @@ int main(int argc, char** argv) try {
       double iteration_max = 0.0;
       mean_max(shadow.iterations, iteration_mean, iteration_max);
       char audit[96] = "-";
-      const auto& whole = shadow.audit_error.back();
+      const auto& whole = shadow.start_error.back();
       std::snprintf(audit, sizeof audit, "%.3g / %.3g / %.3g (%zu)", quantile(whole, 0.5),
                     quantile(whole, 0.99), quantile(whole, 1.0), whole.size());
       std::printf("| %s | %.2f / %.2f / %.2f | %llu | %.1f / %.0f | %.3g | %.3g | %s | %d |\n",
@@ -510,19 +587,39 @@ int main(int argc, char** argv) try {
                   iteration_mean, iteration_max, shadow.max_node_mm, shadow.max_w_relative, audit,
                   shadow.max_inverted);
     }
-    std::printf(
-        "\nW against the current linearised compliance (open loop, every awake step from %.2f to "
-        "%.2f s): relative Frobenius error of the leading spheres' block, p99 / max (steps)\n\n",
-        audit_from_s, std::min(audit_to_s, seconds));
-    std::printf("| configuration | 1 sphere | 8 | 32 | 64 | whole block |\n");
-    std::printf("| --- | ---: | ---: | ---: | ---: | ---: |\n");
-    for (const Run& run : runs) {
-      std::printf("| %s", run.config.name.c_str());
-      for (const auto& errors : run.shadow.audit_error) {
-        std::printf(" | %.3g / %.3g (%zu)", quantile(errors, 0.99), quantile(errors, 1.0),
-                    errors.size());
+    const auto print_errors = [&](const char* title, auto errors_of) {
+      std::printf(
+          "\n%s (open loop, every awake step from %.2f to %.2f s): relative Frobenius error of "
+          "the leading spheres' block, p99 / max (steps)\n\n",
+          title, audit_from_s, std::min(audit_to_s, seconds));
+      std::printf("| configuration | 1 sphere | 8 | 32 | 64 | whole block |\n");
+      std::printf("| --- | ---: | ---: | ---: | ---: | ---: |\n");
+      for (const Run& run : runs) {
+        std::printf("| %s", run.config.name.c_str());
+        for (const auto& errors : errors_of(run.shadow)) {
+          std::printf(" | %.3g / %.3g (%zu)", quantile(errors, 0.99), quantile(errors, 1.0),
+                      errors.size());
+        }
+        std::printf(" |\n");
       }
-      std::printf(" |\n");
+    };
+    print_errors(
+        "W against the current linearised compliance: A at the state the step solves from, every "
+        "tangent afresh, the anatomy's supports the step holds",
+        [](const Shadow& shadow) -> const auto& { return shadow.start_error; });
+    print_errors(
+        "W against A linearised at the state after the step (the next step's system: what one "
+        "step changes in the tissue's linearisation)",
+        [](const Shadow& shadow) -> const auto& { return shadow.audit_error; });
+    std::printf(
+        "\nThe largest node motion in an audited step, mm, p50 / p99 / max, and the steps in which "
+        "that node moved against its motion in the step before:\n\n");
+    for (const Run& run : runs) {
+      const Shadow& shadow = run.shadow;
+      std::printf("- %s: %.3g / %.3g / %.3g; %zu of %zu steps reversed\n", run.config.name.c_str(),
+                  quantile(shadow.step_motion_mm, 0.5), quantile(shadow.step_motion_mm, 0.99),
+                  quantile(shadow.step_motion_mm, 1.0), shadow.reversals,
+                  shadow.step_motion_mm.size());
     }
     print_kernel_costs(runs.front().sim->body());
     return 0;

@@ -135,6 +135,9 @@ class Body {
   // step (kCholmod with refactor_period 1), the lagged A otherwise.
   bool compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links,
                   std::span<float> out);
+  // Spheres of the block whose kept columns are solved again on a newer
+  // factorisation per call (ComplianceBlock::set_refresh_per_call).
+  void set_compliance_refresh(std::size_t spheres) { compliance_.set_refresh_per_call(spheres); }
   // The same W along one normal a sphere (ComplianceBlock::compute_along):
   // (3k x k), entry (3s + d, t) = (W_st n_t)_d.
   bool compliance_along(std::span<const std::uint32_t> spheres,
