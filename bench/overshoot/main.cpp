@@ -340,7 +340,8 @@ StrainSurvey survey_strain(const fem::Body& body) {
   return out;
 }
 
-Result run(std::shared_ptr<const scene::Scene> scene, bool penalty, const RunChoices& choices) {
+Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
+           const RunChoices& choices) {
   const double factor = choices.factor;
   const double youngs_pa = choices.youngs_pa;
   const double stiffening = choices.stiffening;
