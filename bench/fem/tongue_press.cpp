@@ -181,7 +181,8 @@ struct Shadow {
   std::vector<double> step_motion_mm;
   std::size_t reversals = 0;
   std::vector<double> before_m;     // positions at the start of the step
-  std::vector<double> last_step_m;  // each node's motion in the step before
+  std::vector<double> step_m;       // each node's motion in this step
+  std::vector<double> last_step_m;  // ... and in the step before
 };
 
 // Leading spheres of the block whose W is audited (0: the whole block).
@@ -241,26 +242,23 @@ void audit_against(Shadow& shadow, fahr::fem::CholmodSolver& fresh_factor,
 // went back against its motion of the step before.
 void record_step_motion(Shadow& shadow) {
   const auto x = shadow.setup->body->positions_m();
+  shadow.step_m.resize(x.size());
   shadow.last_step_m.resize(x.size(), 0.0);
+  for (std::size_t i = 0; i < x.size(); ++i) shadow.step_m[i] = x[i] - shadow.before_m[i];
   double largest2 = 0.0;
   std::size_t node = 0;
   for (std::size_t n = 0; 3 * n < x.size(); ++n) {
-    const Eigen::Vector3d moved(x[3 * n] - shadow.before_m[3 * n],
-                                x[3 * n + 1] - shadow.before_m[3 * n + 1],
-                                x[3 * n + 2] - shadow.before_m[3 * n + 2]);
-    if (moved.squaredNorm() > largest2) {
-      largest2 = moved.squaredNorm();
+    const double moved2 = Eigen::Map<const Eigen::Vector3d>(&shadow.step_m[3 * n]).squaredNorm();
+    if (moved2 > largest2) {
+      largest2 = moved2;
       node = n;
     }
   }
-  const Eigen::Vector3d now(x[3 * node] - shadow.before_m[3 * node],
-                            x[3 * node + 1] - shadow.before_m[3 * node + 1],
-                            x[3 * node + 2] - shadow.before_m[3 * node + 2]);
-  const Eigen::Vector3d before(shadow.last_step_m[3 * node], shadow.last_step_m[3 * node + 1],
-                               shadow.last_step_m[3 * node + 2]);
+  const Eigen::Map<const Eigen::Vector3d> now(&shadow.step_m[3 * node]);
+  const Eigen::Map<const Eigen::Vector3d> before(&shadow.last_step_m[3 * node]);
   if (now.dot(before) < 0.0) ++shadow.reversals;
   shadow.step_motion_mm.push_back(1e3 * std::sqrt(largest2));
-  for (std::size_t i = 0; i < x.size(); ++i) shadow.last_step_m[i] = x[i] - shadow.before_m[i];
+  std::swap(shadow.step_m, shadow.last_step_m);
 }
 
 // After the step; start_assembly holds A at the state it began from.

@@ -463,7 +463,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         r.light_elements = survey.light;
         r.worst_1x_lightest_mass = survey.worst_lightest;
         for (const std::uint32_t n : sim.body().element_rest().tets[survey.worst])
-          r.worst_1x_rest_mm += 250.0 * sim.body().rest_position(n);
+          r.worst_1x_rest_mm += 1e3 / 4.0 * sim.body().rest_position(n);  // centroid, mm
       }
       if (c.lost_track()) {
         ++r.lost_ticks;
