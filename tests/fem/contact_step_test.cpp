@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #ifndef FAHR_SANITIZE_BUILD
@@ -130,6 +131,49 @@ TEST(ContactStep, AlongNormalsGivesTheSameFreeCentresAndTheBlocksAlongTheSetsNor
   set.contacts[2].normal = Eigen::Vector3d(1.0, 0.0, 0.0);
   along.step(&set);
   EXPECT_EQ(along.compliance_solves(), 2u);
+}
+
+TEST(ContactStep, APenetratingSphereIsCorrectedThroughTheTissueNotItsOwnNodesAlone) {
+  // The tool's plane 0.5 mm into sphere 0 (its one node), no force: the
+  // step meets the constraint with an impulse on the tissue, which moves
+  // the neighbouring top nodes as W says. Algorithm 1's projection alone
+  // would move only sphere 0's node and leave them where the free step put
+  // them.
+  Bar bar;
+  auto pressed = bar_body(bar);
+  auto free = bar_body(bar);
+  ASSERT_TRUE(pressed && free);
+  ContactStep step(*pressed, bar.links);
+  ContactStep free_step(*free, bar.links);
+  ContactSet set = press(bar, *pressed, 0.0);
+  set.contacts[0].plane_point_m = pressed->position(bar.top[0]) + Eigen::Vector3d(0, 0.0005, 0);
+  ContactSet candidates = set;
+  for (Contact& c : candidates.contacts) c.state = ContactState::kCandidate;
+  step.step(&set);
+  free_step.step(&candidates);
+  const std::size_t k = bar.top.size();
+  ASSERT_EQ(step.compliance_spheres().size(), k);
+  // Sphere 0 on its plane: radius 1 mm, plane 0.5 mm above its rest centre.
+  const double gap =
+      (bar.links.centre(0, pressed->positions_m().data()) - set.contacts[0].plane_point_m)
+          .dot(set.contacts[0].normal) -
+      bar.links.radius_m(0);
+  EXPECT_GT(gap, -1e-6);
+  // The impulse W_00 found (along -y), and what W_s0 says of each other
+  // sphere's motion under it.
+  const auto w = [&](std::size_t s, std::size_t t) {
+    return double{step.compliance()[(3 * s + 1) * 3 * k + 3 * t + 1]};
+  };
+  const double moved0 = free->position(bar.top[0]).y() - pressed->position(bar.top[0]).y();
+  ASSERT_GT(moved0, 4e-4);
+  const double impulse = moved0 / w(0, 0);
+  double largest = 0.0;
+  for (std::size_t s = 1; s < k; ++s) {
+    const double moved = free->position(bar.top[s]).y() - pressed->position(bar.top[s]).y();
+    EXPECT_NEAR(moved, w(s, 0) * impulse, 0.02 * moved0) << "sphere " << s;
+    largest = std::max(largest, moved);
+  }
+  EXPECT_GT(largest, 0.1 * moved0);
 }
 
 TEST(ContactStep, ADivergedStepResetsTheBodyToRest) {
@@ -273,8 +317,13 @@ TEST(ContactStep, StepAllocatesNothingOnceSized) {
   settings.volume_floor.ratio = 0.999;
   ContactStep step(*body, bar.links, settings);
   ContactSet set = press(bar, *body, 0.01);
+  // The tool 0.5 mm into sphere 0: the pushed sphere touches (a force on a
+  // sphere the tool does not touch is taken back by the step).
+  set.contacts[0].plane_point_m = body->position(bar.top[0]) + Eigen::Vector3d(0, 0.0005, 0);
   std::vector<double> extra(3 * body->node_count(), 0.0);
-  extra[3 * bar.top[1] + 1] = -0.001;
+  // A point load on the next node crushes its tets below the floor (the
+  // correction bends the bar as a whole, which hardly changes a volume).
+  extra[3 * bar.top[1] + 1] = -0.2;
   for (int k = 0; k < 3; ++k) step.step(&set, extra);
   fahr::test::AllocationCounter counter;
   int floor_moves = 0;

@@ -689,6 +689,18 @@ bool Body::compliance_along(std::span<const std::uint32_t> spheres,
   return compliance_.compute_along(spheres, normals, links, fixed_dof_, cholmod_, warp_, h_, out);
 }
 
+bool Body::step_motion(std::span<const double> force_n, std::span<double> dx_m) {
+  const std::size_t dofs = 3 * node_count();
+  if (force_n.size() != dofs || dx_m.size() != dofs) return false;
+  if (!prepare_compliance_factor() || !cholmod_.factorized()) return false;
+  motion_rhs_.resize(dofs);
+  for (std::size_t i = 0; i < dofs; ++i) motion_rhs_[i] = fixed_dof_[i] != 0 ? 0.0 : force_n[i];
+  warp_.solve(cholmod_, motion_rhs_.data(), dx_m.data());
+  const double h2 = h_ * h_;
+  for (std::size_t i = 0; i < dofs; ++i) dx_m[i] = fixed_dof_[i] != 0 ? 0.0 : h2 * dx_m[i];
+  return true;
+}
+
 bool Body::prepare_compliance_factor() {
   const SolverSettings& solver = settings_.solver;
   const bool factor_unused = solver.kind == LinearSolver::kConjugateGradient &&

@@ -3,11 +3,14 @@
 #include "fahr/fem/contact_step.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace fahr::fem {
 namespace {
 
 constexpr std::int32_t kNoSlot = -1;
+// Projected Gauss-Seidel sweeps of the compliance correction at most.
+constexpr int kCorrectionSweeps = 100;
 
 // Candidates carry no force; obstacle contacts are the tissue against a rigid
 // surface, not the tool's push; force-only contacts are nothing but force.
@@ -40,6 +43,15 @@ ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStep
   }
   normals_of_.reserve(k);
   free_centres_.reserve(k);
+  const std::size_t rows = 2 * k;
+  correction_slot_.assign(rows, 0);
+  correction_normal_.assign(rows, Eigen::Vector3d::Zero());
+  correction_gap_m_.assign(rows, 0.0);
+  correction_w_.assign(rows * rows, 0.0);
+  correction_mu_.assign(rows, 0.0);
+  correction_pushed_n_.assign(rows, 0.0);
+  correction_force_n_.assign(dofs, 0.0);
+  correction_dx_m_.assign(dofs, 0.0);
 }
 
 bool ContactStep::fix_compliance_spheres(std::span<const std::uint32_t> spheres) {
@@ -285,7 +297,7 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
       break;
   }
   projection_.sweeps = sweeps;
-  projection_.tool_push_kg_m = tool_push;
+  projection_.tool_push_kg_m = tool_push + compliance_push_kg_m_;
   projection_.volume_floor_below = volume_below;
   projection_.volume_floor_unresolved = volume_unresolved;
   projection_.obstacle_rounds = anatomy.obstacle_rounds;
@@ -297,8 +309,113 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
   projection_.obstacle_beyond = obstacles_ ? obstacles_->nodes_beyond() : 0;
 }
 
+// The tool's constraints on the block's spheres met through the tissue's
+// compliance before the projection. Each active tool contact on a block
+// sphere is a row: its penetration g of the free motion (which already
+// carries the set's lambda), its normal n. The step finds the change mu of
+// each row's force with lambda + mu >= 0, n^T W N mu >= g, and lambda + mu
+// > 0 only where the row then touches (projected Gauss-Seidel on the row
+// block of W), and moves every node by h^2 A^-1 J^T N mu: the implicit
+// step's own response to those forces, so the whole tissue gives way as its
+// stiffness says. The projection after it only takes up what the
+// linearisation leaves and the spheres outside the block, instead of moving
+// each sphere's own nodes, the light ones most (move_sphere_centre's spread
+// by inverse mass). The bound is on the total force, not on mu: a sphere
+// the free motion left off its plane gives back what the haptic side's
+// lambda pushed it by. With mu >= 0 the correction only ever added push, and
+// where the haptic tick lags the FEM (1 kHz FEM) the two settled into a
+// cycle of a few steps whose one-sided corrections added up to a push the
+// hand never felt (the flat punch's force 4 % under the FEM's static force,
+// drifting to 8 % over 2.5 s; -0.5 % with the bound on the total).
+void ContactStep::correct_through_compliance(const ContactSet* contacts) {
+  if (contacts == nullptr || !compliance_valid_ || along_normals() || spheres_.empty()) return;
+  const std::size_t k = spheres_.size();
+  const std::size_t capacity = correction_slot_.size();
+  std::size_t rows = 0;
+  for (const Contact& c : contacts->contacts) {
+    if (rows == capacity) break;
+    if (c.kind != ContactKind::kTool || c.state != ContactState::kActive) continue;
+    const auto found = std::find(spheres_.begin(), spheres_.end(), c.sphere_id);
+    if (found == spheres_.end()) continue;
+    const double length = c.normal.norm();
+    if (!(length > 1e-9)) continue;
+    const Eigen::Vector3d n = c.normal / length;
+    const Eigen::Vector3d centre = links_.centre(c.sphere_id, projected_.data());
+    correction_slot_[rows] = static_cast<std::size_t>(found - spheres_.begin());
+    correction_normal_[rows] = n;
+    correction_gap_m_[rows] = links_.radius_m(c.sphere_id) - (centre - c.plane_point_m).dot(n);
+    correction_pushed_n_[rows] = std::max(0.0, c.force_n);
+    ++rows;
+  }
+  if (rows == 0) return;
+  bool violated = false;
+  for (std::size_t i = 0; i < rows; ++i) {
+    violated = violated || correction_gap_m_[i] > 0.0 ||
+               (correction_gap_m_[i] < 0.0 && correction_pushed_n_[i] > 0.0);
+  }
+  if (!violated) return;
+  // n_i^T W_st n_j from the 3k x 3k block.
+  for (std::size_t i = 0; i < rows; ++i) {
+    for (std::size_t j = 0; j < rows; ++j) {
+      const std::size_t s = correction_slot_[i];
+      const std::size_t t = correction_slot_[j];
+      double v = 0.0;
+      for (std::size_t d = 0; d < 3; ++d) {
+        const float* row = compliance_.data() + (3 * s + d) * 3 * k + 3 * t;
+        v += correction_normal_[i][static_cast<Eigen::Index>(d)] *
+             (double{row[0]} * correction_normal_[j].x() +
+              double{row[1]} * correction_normal_[j].y() +
+              double{row[2]} * correction_normal_[j].z());
+      }
+      correction_w_[i * rows + j] = v;
+    }
+  }
+  std::fill(correction_mu_.begin(), correction_mu_.begin() + static_cast<std::ptrdiff_t>(rows),
+            0.0);
+  for (int sweep = 0; sweep < kCorrectionSweeps; ++sweep) {
+    double largest = 0.0;
+    for (std::size_t i = 0; i < rows; ++i) {
+      const double diagonal = correction_w_[i * rows + i];
+      if (!(diagonal > 0.0)) continue;
+      double moved = 0.0;
+      for (std::size_t j = 0; j < rows; ++j)
+        moved += correction_w_[i * rows + j] * correction_mu_[j];
+      const double mu = std::max(-correction_pushed_n_[i],
+                                 correction_mu_[i] + (correction_gap_m_[i] - moved) / diagonal);
+      largest = std::max(largest, std::abs(mu - correction_mu_[i]) * diagonal);
+      correction_mu_[i] = mu;
+    }
+    if (largest <= projection_settings_.tolerance_m) break;
+  }
+  std::fill(correction_force_n_.begin(), correction_force_n_.end(), 0.0);
+  Eigen::Vector3d impulse = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < rows; ++i) {
+    const double mu = correction_mu_[i];
+    if (mu == 0.0 || !std::isfinite(mu)) continue;
+    const std::uint32_t sphere = spheres_[correction_slot_[i]];
+    const auto nodes = links_.nodes(sphere);
+    const auto weights = links_.weights(sphere);
+    for (std::size_t m = 0; m < nodes.size(); ++m) {
+      for (std::size_t d = 0; d < 3; ++d) {
+        correction_force_n_[3 * std::size_t{nodes[m]} + d] +=
+            weights[m] * mu * correction_normal_[i][static_cast<Eigen::Index>(d)];
+      }
+    }
+    impulse += mu * correction_normal_[i];
+  }
+  if (!body_.step_motion(correction_force_n_, correction_dx_m_)) return;
+  for (std::size_t i = 0; i < projected_.size(); ++i) {
+    if (!std::isfinite(correction_dx_m_[i])) return;
+  }
+  for (std::size_t i = 0; i < projected_.size(); ++i) projected_[i] += correction_dx_m_[i];
+  const double h = body_.time_step_s();
+  compliance_push_kg_m_ = impulse * h * h;
+}
+
 void ContactStep::project(const ContactSet* contacts) {
   std::copy(free_positions_.begin(), free_positions_.end(), projected_.begin());
+  compliance_push_kg_m_.setZero();
+  correct_through_compliance(contacts);
   alternate_with_anatomy(contacts);
   const double h2 = body_.time_step_s() * body_.time_step_s();
   const auto mass = body_.mass_kg();

@@ -138,6 +138,11 @@ class Body {
   // Spheres of the block whose kept columns are solved again on a newer
   // factorisation per call (ComplianceBlock::set_refresh_per_call).
   void set_compliance_refresh(std::size_t spheres) { compliance_.set_refresh_per_call(spheres); }
+  // dx = h^2 A^-1 f on the factor W comes from: how the nodes move in one
+  // step under the extra nodal force f (N, 3 per node); fixed DOFs neither
+  // take force nor move. f and dx hold 3 * node_count() entries and may not
+  // alias. False if the factor is missing. No allocation after the first call.
+  bool step_motion(std::span<const double> force_n, std::span<double> dx_m);
   // The same W along one normal a sphere (ComplianceBlock::compute_along):
   // (3k x k), entry (3s + d, t) = (W_st n_t)_d.
   bool compliance_along(std::span<const std::uint32_t> spheres,
@@ -320,6 +325,7 @@ class Body {
   WarpedFactor warp_;
   CgSolver cg_;
   ComplianceBlock compliance_;
+  std::vector<double> motion_rhs_;  // step_motion()'s right-hand side
   SleepMonitor sleep_;
   std::vector<NodeSupport> supports_;  // capacity: every node
   std::size_t support_count_ = 0;

@@ -9,21 +9,29 @@
 //      while the spheres and the factorisation are unchanged: W depends on
 //      nothing else) and their free-motion centres c_free = c - W N lambda,
 //      the centres without this step's contact forces;
-//   3. the Algorithm 1 projection of the ContactSet on the free motion,
-//      written back to the body; its velocity correction (x~ - x_free)/h is
-//      carried into the next step as the nodal force m (x~ - x_free)/h^2, so
-//      the next right-hand side M (v + dx/h) + h f is exactly Algorithm 1's;
-//   4. with obstacles set, the body's own non-penetration of the static
+//   3. the active tool contacts on the block's spheres met through W: a
+//      change mu of each contact's force, lambda + mu >= 0 and complementary
+//      to the contact's gap, with n^T W N mu >= its penetration of the free
+//      motion, and every node moved by h^2 A^-1 J^T N mu (the step's own
+//      response to those forces, Body::step_motion), so the tissue gives
+//      way as a whole instead of the contact spheres' own nodes;
+//   4. the Algorithm 1 projection of the ContactSet on that motion (what
+//      the linearisation left and the spheres outside the block), written
+//      back to the body; the velocity correction (x~ - x_free)/h of steps 3
+//      and 4 is carried into the next step as the nodal force
+//      m (x~ - x_free)/h^2, so the next right-hand side M (v + dx/h) + h f
+//      is exactly Algorithm 1's;
+//   5. with obstacles set, the body's own non-penetration of the static
 //      anatomy on these positions (obstacle_projection.h), alternated with
 //      the ContactSet's projection so the tool cannot press a node into bone;
 //      its moves join the same carried correction; the nodes it moved are
 //      held by springs along the bone's normal in the next step's A
 //      (obstacle_support.h), so the implicit solve and W feel the bone;
-//   5. with a volume floor, each round of that alternation also keeps every
+//   6. with a volume floor, each round of that alternation also keeps every
 //      tet above a share of its rest volume (volume_floor.h), so tissue
 //      squeezed between tool and bone gives way sideways, not flat.
-// The projection is done here, not by Body::step, because step 2 needs the
-// motion before it. Staleness of a ContactSet is the caller's decision.
+// The correction and the projection are done here, not by Body::step,
+// because step 2 needs the motion before them. Staleness of a ContactSet is the caller's decision.
 // Capacities are fixed at construction: nothing allocates per step once the
 // compliance block and the contact list have reached their largest size.
 #pragma once
@@ -138,6 +146,7 @@ class ContactStep {
   // positions and the carried correction written back.
   void project(const ContactSet* contacts);
   void alternate_with_anatomy(const ContactSet* contacts);
+  void correct_through_compliance(const ContactSet* contacts);
 
   Body& body_;
   const SphereLinks& links_;
@@ -161,6 +170,18 @@ class ContactStep {
   std::uint64_t compliance_reuses_ = 0;
   std::uint64_t compliance_solves_ = 0;
   std::vector<Eigen::Vector3d> free_centres_;
+  // correct_through_compliance(): its rows (a tool contact on a block
+  // sphere each), their gaps, normals and block slots, n_i^T W_ij n_j, the
+  // impulses found, the nodal force and the motion it gives.
+  std::vector<std::size_t> correction_slot_;
+  std::vector<Eigen::Vector3d> correction_normal_;
+  std::vector<double> correction_gap_m_;
+  std::vector<double> correction_w_;
+  std::vector<double> correction_mu_;
+  std::vector<double> correction_pushed_n_;  // each row's lambda from the ContactSet
+  std::vector<double> correction_force_n_;
+  std::vector<double> correction_dx_m_;
+  Eigen::Vector3d compliance_push_kg_m_ = Eigen::Vector3d::Zero();
   ProjectionSettings projection_settings_;
   std::unique_ptr<ObstacleProjection> obstacles_;
   std::unique_ptr<ObstacleSupport> supports_;  // with obstacles_ and a ratio > 0
