@@ -61,6 +61,12 @@ ContactSet press(const Bar& bar, const Body& body, double force_n) {
   return set;
 }
 
+// The same set with every contact a candidate: no force, no projection.
+ContactSet as_candidates(ContactSet set) {
+  for (Contact& c : set.contacts) c.state = ContactState::kCandidate;
+  return set;
+}
+
 TEST(ContactStep, FreeCentresAreTheMotionWithoutTheContactForces) {
   Bar bar;
   auto pushed = bar_body(bar);
@@ -72,8 +78,7 @@ TEST(ContactStep, FreeCentresAreTheMotionWithoutTheContactForces) {
   ContactStep without(*free, bar.links, no_forces);
   ContactSet set = press(bar, *pushed, 0.01);
   // Candidates only on the second body: no projection, no force.
-  ContactSet candidates = set;
-  for (Contact& c : candidates.contacts) c.state = ContactState::kCandidate;
+  const ContactSet candidates = as_candidates(set);
   with.step(&set);
   without.step(&candidates);
   ASSERT_EQ(with.compliance_spheres().size(), bar.top.size());
@@ -147,8 +152,7 @@ TEST(ContactStep, APenetratingSphereIsCorrectedThroughTheTissueNotItsOwnNodesAlo
   ContactStep free_step(*free, bar.links);
   ContactSet set = press(bar, *pressed, 0.0);
   set.contacts[0].plane_point_m = pressed->position(bar.top[0]) + Eigen::Vector3d(0, 0.0005, 0);
-  ContactSet candidates = set;
-  for (Contact& c : candidates.contacts) c.state = ContactState::kCandidate;
+  const ContactSet candidates = as_candidates(set);
   step.step(&set);
   free_step.step(&candidates);
   const std::size_t k = bar.top.size();

@@ -19,6 +19,20 @@ bool carries_force(const Contact& c) {
   return c.kind == ContactKind::kTool && c.state != ContactState::kCandidate && c.force_n > 0.0;
 }
 
+// Adds a force of `magnitude` along `direction` on a sphere to the nodal
+// forces `out` (3 per node), through the sphere's node weights.
+void spread_force(const SphereLinks& links, std::uint32_t sphere, double magnitude,
+                  const Eigen::Vector3d& direction, std::span<double> out) {
+  const auto nodes = links.nodes(sphere);
+  const auto weights = links.weights(sphere);
+  for (std::size_t m = 0; m < nodes.size(); ++m) {
+    for (std::size_t d = 0; d < 3; ++d) {
+      out[3 * std::size_t{nodes[m]} + d] +=
+          weights[m] * magnitude * direction[static_cast<Eigen::Index>(d)];
+    }
+  }
+}
+
 }  // namespace
 
 ContactStep::ContactStep(Body& body, const SphereLinks& links, const ContactStepSettings& settings)
@@ -110,14 +124,7 @@ bool ContactStep::reset() {
 }
 
 void ContactStep::add_sphere_force(const Contact& c) {
-  const auto nodes = links_.nodes(c.sphere_id);
-  const auto weights = links_.weights(c.sphere_id);
-  for (std::size_t m = 0; m < nodes.size(); ++m) {
-    for (std::size_t d = 0; d < 3; ++d) {
-      force_n_[3 * std::size_t{nodes[m]} + d] +=
-          weights[m] * c.force_n * c.normal[static_cast<Eigen::Index>(d)];
-    }
-  }
+  spread_force(links_, c.sphere_id, c.force_n, c.normal, force_n_);
 }
 
 // The spheres of this step's block (unless fixed) and the force each
@@ -332,6 +339,7 @@ void ContactStep::correct_through_compliance(const ContactSet* contacts) {
   const std::size_t k = spheres_.size();
   const std::size_t capacity = correction_slot_.size();
   std::size_t rows = 0;
+  bool violated = false;  // a row penetrates, or pushes a sphere that left the blade
   for (const Contact& c : contacts->contacts) {
     if (rows == capacity) break;
     if (c.kind != ContactKind::kTool || c.state != ContactState::kActive) continue;
@@ -345,13 +353,9 @@ void ContactStep::correct_through_compliance(const ContactSet* contacts) {
     correction_normal_[rows] = n;
     correction_gap_m_[rows] = links_.radius_m(c.sphere_id) - (centre - c.plane_point_m).dot(n);
     correction_pushed_n_[rows] = std::max(0.0, c.force_n);
+    violated = violated || correction_gap_m_[rows] > 0.0 ||
+               (correction_gap_m_[rows] < 0.0 && correction_pushed_n_[rows] > 0.0);
     ++rows;
-  }
-  if (rows == 0) return;
-  bool violated = false;
-  for (std::size_t i = 0; i < rows; ++i) {
-    violated = violated || correction_gap_m_[i] > 0.0 ||
-               (correction_gap_m_[i] < 0.0 && correction_pushed_n_[i] > 0.0);
   }
   if (!violated) return;
   // n_i^T W_st n_j from the 3k x 3k block.
@@ -392,15 +396,8 @@ void ContactStep::correct_through_compliance(const ContactSet* contacts) {
   for (std::size_t i = 0; i < rows; ++i) {
     const double mu = correction_mu_[i];
     if (mu == 0.0 || !std::isfinite(mu)) continue;
-    const std::uint32_t sphere = spheres_[correction_slot_[i]];
-    const auto nodes = links_.nodes(sphere);
-    const auto weights = links_.weights(sphere);
-    for (std::size_t m = 0; m < nodes.size(); ++m) {
-      for (std::size_t d = 0; d < 3; ++d) {
-        correction_force_n_[3 * std::size_t{nodes[m]} + d] +=
-            weights[m] * mu * correction_normal_[i][static_cast<Eigen::Index>(d)];
-      }
-    }
+    spread_force(links_, spheres_[correction_slot_[i]], mu, correction_normal_[i],
+                 correction_force_n_);
     impulse += mu * correction_normal_[i];
   }
   if (!body_.step_motion(correction_force_n_, correction_dx_m_)) return;
