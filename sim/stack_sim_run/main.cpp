@@ -20,7 +20,9 @@
 #include <memory>
 #include <vector>
 
+#include "deformation_statePubSubTypes.h"
 #include "fahr/cli/cli.h"
+#include "fahr/common/cdr_bytes.h"
 #include "fahr/common/solver_threads.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
@@ -90,6 +92,8 @@ int main(int argc, char** argv) try {
     std::vector<double> pgs_solves;
     std::vector<double> rows;
     std::uint64_t unconverged = 0;
+    std::vector<std::uint8_t> state_bytes;  // one DeformationState's CDR
+    std::vector<double> state_sizes;
     // Wall time of the tick's phases (a preempted tick shows in the tail).
     std::vector<double> tissue_query_us, anatomy_query_us, response_us;
     std::vector<double> query_nodes, query_spheres, query_contacts,
@@ -135,6 +139,12 @@ int main(int argc, char** argv) try {
       (states != states_seen ? spheres_new_state : spheres_same_state)
           .push_back(phases.tissue_query.spheres_tested);
       states_seen = states;
+      if (sim.fem_stepped() && sim.body().step_index() % 20 == 1) {
+        // What one DeformationState of the tongue puts on the wire (CDR as
+        // sent), sampled every 20th FEM step.
+        common::encode_cdr<msg::DeformationStatePubSubType>(sim.fem().state(), state_bytes);
+        state_sizes.push_back(static_cast<double>(state_bytes.size()));
+      }
       const auto& f = sim.command().force_n();
       peak_force = std::max(peak_force, std::sqrt(f.x() * f.x() + f.y() * f.y() + f.z() * f.z()));
       const Eigen::Vector3d force(f.x(), f.y(), f.z());
@@ -231,6 +241,13 @@ int main(int argc, char** argv) try {
         quantile(pgs_solves, 1.0), quantile(pgs_cost, 0.5), quantile(pgs_cost, 0.99),
         quantile(pgs_cost, 0.999), quantile(pgs_cost, 1.0),
         static_cast<unsigned long long>(unconverged));
+    // A lab's link carries every body's state at the FEM's rate.
+    const double fem_hz = sim.scene().rates.fem_hz;
+    std::printf(
+        "stack_sim: DeformationState bytes (tongue, CDR) median %.0f max %.0f; at %.0f Hz %.1f "
+        "Mbit/s at the largest\n",
+        quantile(state_sizes, 0.5), quantile(state_sizes, 1.0), fem_hz,
+        8e-6 * fem_hz * quantile(state_sizes, 1.0));
     const auto print_phase = [&](const char* name, const std::vector<double>& wall_us) {
       std::printf("stack_sim: tick phase %-14s wall us p50 %.1f p99 %.1f p99.9 %.1f\n", name,
                   quantile(wall_us, 0.5), quantile(wall_us, 0.99), quantile(wall_us, 0.999));

@@ -164,7 +164,7 @@ void fill(msg::DeformationState& s, std::uint64_t seed, std::size_t n) {
   v.floats(s.velocities_mps(), std::min<std::size_t>(3 * n, msg::MAX_COORDS));
   const std::size_t spheres = std::min<std::size_t>(n, msg::MAX_COMPLIANCE_SPHERES);
   v.u32s(s.compliance_sphere_ids(), spheres);
-  v.floats(s.compliance_mpn(), 9 * spheres * spheres);
+  v.floats(s.compliance_mpn(), (3 * spheres) * (3 * spheres + 1) / 2);  // the upper triangle
   v.floats(s.compliance_free_centres_m(), 3 * spheres);
 }
 

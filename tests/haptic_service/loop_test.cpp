@@ -10,6 +10,7 @@
 
 #include "contact_set.h"
 #include "fahr/collision/surface_samples.h"
+#include "fahr/common/packed_symmetric.h"
 #include "fahr/common/wire_eigen.h"
 #include "fahr/device/trajectory.h"
 #include "fahr/haptic_service/haptic_loop.h"
@@ -87,8 +88,9 @@ msg::DeformationState rest_with_compliance(const HapticSetup& setup,
     if (std::find(ids.begin(), ids.end(), c.sphere_id()) == ids.end()) ids.push_back(c.sphere_id());
   }
   const std::size_t rows = 3 * ids.size();
-  state.compliance_mpn().assign(rows * rows, 0.0f);
-  for (std::size_t r = 0; r < rows; ++r) state.compliance_mpn()[r * rows + r] = w_mpn;
+  state.compliance_mpn().assign(common::packed_upper_size(rows), 0.0f);
+  for (std::size_t r = 0; r < rows; ++r)
+    state.compliance_mpn()[common::packed_upper_index(rows, r, r)] = w_mpn;
   return state;
 }
 
@@ -469,7 +471,7 @@ TEST(TissueDigest, RefusesStatesThatDoNotFit) {
   state.body_id(setup.bodies.front().body->id);
   // A non-finite W, W normal or free centre: the state is refused whole.
   state.compliance_sphere_ids().assign({3, 4});
-  state.compliance_mpn().assign(36, 0.01f);
+  state.compliance_mpn().assign(21, 0.01f);  // the upper triangle of 6 x 6
   ASSERT_TRUE(digest.digest(state, snapshot));
   state.compliance_mpn()[17] = std::numeric_limits<float>::infinity();
   EXPECT_FALSE(digest.digest(state, snapshot));
@@ -494,7 +496,7 @@ class TissueDigestAtRest : public ::testing::Test {
 
 TEST_F(TissueDigestAtRest, IndexesTheComplianceSpheres) {
   state_.compliance_sphere_ids({5, 9});
-  state_.compliance_mpn().assign(36, 1e-3f);
+  state_.compliance_mpn().assign(21, 1e-3f);
   state_.compliance_free_centres_m().assign(6, 0.01f);
   ASSERT_TRUE(digest_.digest(state_, snapshot_));
   EXPECT_EQ(snapshot_.compliance_index[5], 0);
@@ -503,7 +505,7 @@ TEST_F(TissueDigestAtRest, IndexesTheComplianceSpheres) {
   EXPECT_TRUE(snapshot_.have_free_centres);
   // The next state in the same slot forgets the old spheres.
   state_.compliance_sphere_ids({6});
-  state_.compliance_mpn().assign(9, 1e-3f);
+  state_.compliance_mpn().assign(6, 1e-3f);
   state_.compliance_free_centres_m().clear();
   ASSERT_TRUE(digest_.digest(state_, snapshot_));
   EXPECT_EQ(snapshot_.compliance_index[5], contact::kNoCompliance);
@@ -513,6 +515,33 @@ TEST_F(TissueDigestAtRest, IndexesTheComplianceSpheres) {
   state_.compliance_sphere_ids({static_cast<std::uint32_t>(setup_.layout.size())});
   ASSERT_TRUE(digest_.digest(state_, snapshot_));
   EXPECT_EQ(snapshot_.compliance_count, 0u);
+}
+
+// 3x3 blocks arrive as the upper triangle of W: the digest gives the tick
+// the whole matrix, each entry below the diagonal the one above it.
+TEST_F(TissueDigestAtRest, UnpacksWsUpperTriangle) {
+  state_.compliance_sphere_ids({5, 9});
+  const std::size_t n = 6;
+  state_.compliance_mpn().resize(common::packed_upper_size(n));
+  for (std::size_t r = 0; r < n; ++r) {
+    for (std::size_t c = r; c < n; ++c)  // distinct values, diagonal largest
+      state_.compliance_mpn()[common::packed_upper_index(n, r, c)] =
+          r == c ? 1e-2f : 1e-4f * static_cast<float>(1 + r * n + c);
+  }
+  ASSERT_TRUE(digest_.digest(state_, snapshot_));
+  const contact::TissueCompliance w = snapshot_.compliance();
+  ASSERT_TRUE(w.valid());
+  ASSERT_FALSE(w.along_normals());
+  const Eigen::Vector3d axis[3] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                   Eigen::Vector3d::UnitZ()};
+  for (std::size_t r = 0; r < n; ++r) {
+    for (std::size_t c = 0; c < n; ++c) {
+      const float expected =
+          state_.compliance_mpn()[common::packed_upper_index(n, std::min(r, c), std::max(r, c))];
+      EXPECT_NEAR(w.normal_compliance(r / 3, axis[r % 3], c / 3, axis[c % 3]), expected, 1e-9)
+          << "entry (" << r << ", " << c << ")";
+    }
+  }
 }
 
 TEST_F(TissueDigestAtRest, TakesWAlongTheFemsNormals) {
@@ -536,9 +565,9 @@ TEST_F(TissueDigestAtRest, TakesWAlongTheFemsNormals) {
   state_.compliance_normals().pop_back();
   ASSERT_TRUE(digest_.digest(state_, snapshot_));
   EXPECT_EQ(snapshot_.compliance_count, 0u);
-  // Back to 3x3 blocks: no normals, nine entries a sphere pair.
+  // Back to 3x3 blocks: no normals, the 6 x 6 block's upper triangle.
   state_.compliance_normals().clear();
-  state_.compliance_mpn().assign(36, 1e-3f);
+  state_.compliance_mpn().assign(21, 1e-3f);
   ASSERT_TRUE(digest_.digest(state_, snapshot_));
   EXPECT_EQ(snapshot_.compliance_count, 2u);
   EXPECT_FALSE(snapshot_.compliance().along_normals());

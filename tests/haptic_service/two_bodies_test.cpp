@@ -14,6 +14,7 @@
 
 #include "contact_set.h"
 #include "deformation_state.h"
+#include "fahr/common/packed_symmetric.h"
 #include "fahr/common/participant.h"
 #include "fahr/common/publisher.h"
 #include "fahr/haptic_service/haptic_loop.h"
@@ -63,8 +64,9 @@ msg::DeformationState state_of(const TissueBody& body, const Eigen::Vector3d& sh
   }
   state.compliance_sphere_ids(spheres);
   const std::size_t n = 3 * spheres.size();
-  state.compliance_mpn().assign(n * n, 0.0f);
-  for (std::size_t i = 0; i < n; ++i) state.compliance_mpn()[i * n + i] = w;
+  state.compliance_mpn().assign(common::packed_upper_size(n), 0.0f);
+  for (std::size_t i = 0; i < n; ++i)
+    state.compliance_mpn()[common::packed_upper_index(n, i, i)] = w;
   return state;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "fahr/common/clock.h"
+#include "fahr/common/packed_symmetric.h"
 #include "fahr/fem_service/contact_conversion.h"
 
 namespace fahr::fem_service {
@@ -151,8 +152,15 @@ void ServiceStep::fill_compliance() {
   const auto w = contact_step_.compliance();
   const auto free = contact_step_.free_centres();
   state_.compliance_sphere_ids().assign(ids.begin(), ids.end());
-  state_.compliance_mpn().assign(w.begin(), w.end());
   const auto normals = contact_step_.compliance_normals();
+  if (normals.empty()) {
+    // 3k x 3k and symmetric (W = h^2 J A^-1 J^T): its upper triangle.
+    const std::size_t n = 3 * ids.size();
+    state_.compliance_mpn().resize(common::packed_upper_size(n));
+    common::pack_upper(w.data(), n, state_.compliance_mpn().data());
+  } else {
+    state_.compliance_mpn().assign(w.begin(), w.end());
+  }
   auto& along = state_.compliance_normals();
   along.resize(3 * normals.size());
   for (std::size_t s = 0; s < normals.size(); ++s) {

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "fahr/common/packed_symmetric.h"
+
 namespace fahr::haptic_service {
 namespace {
 
@@ -154,7 +156,8 @@ Block usable_block(const msg::DeformationState& state, std::size_t capacity,
   block.k = std::min<std::size_t>(ids.size(), capacity);
   block.along = !state.compliance_normals().empty();
   if (block.along && state.compliance_normals().size() < 3 * block.k) return {};
-  const std::size_t entries = block.along ? 3 * block.k * block.k : 9 * block.k * block.k;
+  const std::size_t entries =
+      block.along ? 3 * block.k * block.k : common::packed_upper_size(3 * block.k);
   if (block.k == 0 || state.compliance_mpn().size() < entries) return {};
   // An id beyond the layout would index past the table: the whole block is
   // refused rather than solved with a row missing.
@@ -204,12 +207,16 @@ void TissueDigest::index_compliance(std::span<const msg::DeformationState* const
       out.compliance_ids[first + i] = ids[i] + offset;
       out.compliance_index[ids[i] + offset] = static_cast<std::int32_t>(first + i);
     }
-    // The block's rows, each into its place in the joined rows.
-    const std::size_t block_columns = along ? k : 3 * k;
-    const std::size_t column_offset = along ? first : 3 * first;
-    for (std::size_t r = 0; r < 3 * k; ++r) {
-      std::copy_n(state.compliance_mpn().data() + r * block_columns, block_columns,
-                  out.w_mpn.data() + (3 * first + r) * columns + column_offset);
+    // The block's rows, each into its place in the joined rows (3x3 blocks
+    // arrive as their upper triangle).
+    if (along) {
+      for (std::size_t r = 0; r < 3 * k; ++r) {
+        std::copy_n(state.compliance_mpn().data() + r * k, k,
+                    out.w_mpn.data() + (3 * first + r) * columns + first);
+      }
+    } else {
+      common::unpack_upper(state.compliance_mpn().data(), 3 * k,
+                           out.w_mpn.data() + 3 * first * columns + 3 * first, columns);
     }
     if (along) {
       std::copy_n(state.compliance_normals().data(), 3 * k,
