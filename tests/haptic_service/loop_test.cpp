@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -541,6 +542,22 @@ TEST_F(TissueDigestAtRest, UnpacksWsUpperTriangle) {
       EXPECT_NEAR(w.normal_compliance(r / 3, axis[r % 3], c / 3, axis[c % 3]), expected, 1e-9)
           << "entry (" << r << ", " << c << ")";
     }
+  }
+}
+
+// What the FEM sends of a W whose columns came from two factorisations
+// (not quite symmetric): the tick gets its symmetric part.
+TEST(PackedSymmetric, PackThenUnpackGivesTheSymmetricPart) {
+  constexpr std::size_t n = 5;
+  std::array<float, n * n> full{};
+  for (std::size_t i = 0; i < n * n; ++i) full.at(i) = 0.25f * static_cast<float>(i * i % 17);
+  std::array<float, common::packed_upper_size(n)> packed{};
+  common::pack_upper(full.data(), n, packed.data());
+  std::array<float, n * n> back{};
+  common::unpack_upper(packed.data(), n, back.data(), n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < n; ++j)
+      EXPECT_FLOAT_EQ(back.at(i * n + j), 0.5f * (full.at(i * n + j) + full.at(j * n + i)));
   }
 }
 
