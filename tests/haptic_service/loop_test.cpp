@@ -548,16 +548,16 @@ TEST_F(TissueDigestAtRest, UnpacksWsUpperTriangle) {
 // What the FEM sends of a W whose columns came from two factorisations
 // (not quite symmetric): the tick gets its symmetric part.
 TEST(PackedSymmetric, PackThenUnpackGivesTheSymmetricPart) {
-  constexpr std::size_t n = 5;
-  std::array<float, n * n> full{};
-  for (std::size_t i = 0; i < n * n; ++i) full.at(i) = 0.25f * static_cast<float>(i * i % 17);
-  std::array<float, common::packed_upper_size(n)> packed{};
-  common::pack_upper(full.data(), n, packed.data());
-  std::array<float, n * n> back{};
-  common::unpack_upper(packed.data(), n, back.data(), n);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = 0; j < n; ++j)
-      EXPECT_FLOAT_EQ(back.at(i * n + j), 0.5f * (full.at(i * n + j) + full.at(j * n + i)));
+  constexpr std::size_t kN = 5;
+  std::array<float, kN * kN> full{};
+  for (std::size_t i = 0; i < kN * kN; ++i) full.at(i) = 0.25f * static_cast<float>(i * i % 17);
+  std::array<float, common::packed_upper_size(kN)> packed{};
+  common::pack_upper(full.data(), kN, packed.data());
+  std::array<float, kN * kN> back{};
+  common::unpack_upper(packed.data(), kN, back.data(), kN);
+  for (std::size_t i = 0; i < kN; ++i) {
+    for (std::size_t j = 0; j < kN; ++j)
+      EXPECT_FLOAT_EQ(back.at(i * kN + j), 0.5f * (full.at(i * kN + j) + full.at(j * kN + i)));
   }
 }
 
