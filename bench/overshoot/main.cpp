@@ -261,11 +261,18 @@ int inverted_free(const stack_sim::StackSim& sim) {
 
 struct ToolContacts {
   int active = 0, frozen = 0, force_only = 0, obstacle = 0;
+  // The tool's entries' forces summed as magnitudes, and the largest, N:
+  // against their resultant they show rows that cancel (a squeeze).
+  double force_sum_n = 0.0, largest_force_n = 0.0;
 };
 
 ToolContacts count_contacts(const msg::ContactSet& set) {
   ToolContacts c;
   for (const auto& contact : set.contacts()) {
+    if (contact.kind() != msg::CONTACT_OBSTACLE) {
+      c.force_sum_n += contact.force_n();
+      c.largest_force_n = std::max(c.largest_force_n, contact.force_n());
+    }
     if (contact.kind() == msg::CONTACT_OBSTACLE) {
       ++c.obstacle;
     } else if (contact.kind() == msg::CONTACT_FORCE_ONLY) {
@@ -408,7 +415,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       "contacts,"
       "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,"
       "inverted_free,fem_cpu_ms,supported_nodes,"
-      "volume_floor_below,volume_floor_unresolved\n");
+      "volume_floor_below,volume_floor_unresolved,tool_force_sum_n,tool_largest_force_n\n");
   std::FILE* tick_trace =
       open_trace(tick_trace_path, r.name,
                  "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,"
@@ -554,18 +561,20 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         // 1 mm: a tet that close to bone or blade is pressed by it.
         const Inversions inv = locate_inversions(sim, 1e-3);
         const ToolContacts tc = count_contacts(sim.contacts());
-        std::fprintf(
-            trace,
-            "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,%d,%d\n",
-            sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
-            report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
-            report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
-            report.projection.sweeps, tc.active, tc.frozen, tc.force_only, tc.obstacle,
-            c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
-            1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio, inverted_free(sim),
-            1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
-            report.projection.obstacle_supported, report.projection.volume_floor_below,
-            report.projection.volume_floor_unresolved);
+        std::fprintf(trace,
+                     "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,"
+                     "%d,%d,%.3f,"
+                     "%.3f\n",
+                     sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
+                     report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
+                     report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
+                     report.projection.sweeps, tc.active, tc.frozen, tc.force_only, tc.obstacle,
+                     c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
+                     1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio,
+                     inverted_free(sim),
+                     1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
+                     report.projection.obstacle_supported, report.projection.volume_floor_below,
+                     report.projection.volume_floor_unresolved, tc.force_sum_n, tc.largest_force_n);
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
