@@ -73,7 +73,7 @@ grep -q "peak |F| 0.00" "$tmp/cyclonedds.txt" && { echo "FAIL: no contact force 
 # W along the normals: the shipped scene with two solver keys changed (mesh
 # paths made absolute, the copy living in $tmp).
 sed -e "s|\.\./\.\./meshes/|$repo/meshes/|" \
-    -e "s/^  max_candidate_contacts: 80/  max_candidate_contacts: 80\n  compliance_columns: normals/" \
+    -e "s/^  max_candidate_contacts: 96/  max_candidate_contacts: 96\n  compliance_columns: normals/" \
     "$repo/deployment/scenes/neonatal_intubation.yaml" >"$tmp/normals.yaml"
 grep -q "^  compliance_columns: normals" "$tmp/normals.yaml" || { echo "FAIL: could not write the normals scene"; exit 1; }
 cp "$tmp/cyclonedds.hashes" "$tmp/blocks.hashes"

@@ -71,7 +71,7 @@ inline constexpr int kDefaultCgMaxIterations = 200;
 inline constexpr int kDefaultProjectionMaxIterations = 20;
 // 1 micrometre: two orders below the 0.2 mm depth accuracy asked of contacts.
 inline constexpr double kDefaultProjectionToleranceM = 1.0e-6;
-inline constexpr int kDefaultMaxCandidateContacts = 64;
+inline constexpr int kDefaultMaxCandidateContacts = 96;
 // A ContactSet computed on a FEM state older than this is ignored. The FEM
 // service measures the age in its own steps: 20 ms is 4 steps at 200 Hz,
 // room for a haptic service that takes a few ms to digest a new state (5 ms

@@ -87,11 +87,14 @@ struct TickPhases {
 // Rows the tool may have against rigid anatomy per tick: one per tool
 // sample within the margin, the deepest kept.
 inline constexpr std::size_t kMaxAnatomyRows = 16;
-// Spheres a tick may ask the FEM's compliance for beyond its rows (contacts
-// deep enough to be rows whose sphere has no W yet): candidates at the end
-// of the ContactSet. The FEM's block holds the rows and these
-// (msg::MAX_COMPLIANCE_SPHERES).
-inline constexpr std::size_t kComplianceRequests = 16;
+// The FEM's compliance block (the scene's solver.max_candidate_contacts, at
+// most msg::MAX_COMPLIANCE_SPHERES) holds the tick's rows and, in the slots
+// left, the contacts nearest to becoming rows: W arrives one or two FEM
+// periods after a sphere enters the block, so it must be there before the
+// sphere is deep enough to be a row. At least this many slots (a third of a
+// smaller block) are kept for them; the rows take the rest, up to the
+// solve's cap.
+inline constexpr std::size_t kComplianceLookAhead = 32;
 // Largest change of the commanded force a tick after the tongue was reset
 // (DeformationState::reset_epoch), a new FEM writer appeared, the tissue
 // came back after a loss or the device (re-)engaged; and while the force
@@ -176,12 +179,12 @@ class HapticLoop {
   std::vector<std::uint32_t>
       order_;                    // indices into tool_contacts_, deepest first when over capacity
   std::vector<double> row_key_;  // per contact: select_rows' key
-  std::vector<std::uint32_t> order_scratch_;                     // select_rows: contacts with W
-  std::array<std::uint32_t, kComplianceRequests> request_of_{};  // select_rows: requests
-  std::array<fem::Contact, kComplianceRequests> requests_{};     // this tick's W requests
-  std::size_t row_pick_ = 0;                                     // rows select_rows took
-  std::size_t request_count_ = 0;                                // requests this tick
-  std::size_t rows_without_w_ = 0;  // contacts deep enough to be rows, without W
+  std::vector<std::uint32_t> order_scratch_;  // select_rows: contacts with W
+  std::vector<std::uint32_t> request_of_;     // select_rows: the block's other contacts
+  std::vector<fem::Contact> requests_;        // this tick's contacts asked for W
+  std::size_t row_pick_ = 0;                  // rows select_rows took
+  std::size_t request_count_ = 0;             // requests this tick
+  std::size_t rows_without_w_ = 0;            // contacts deep enough to be rows, without W
   // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
   std::vector<collision::TriangleContact> triangle_contacts_;
   std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1
@@ -191,6 +194,7 @@ class HapticLoop {
   std::vector<collision::RigidBody> anatomy_bodies_;
   std::vector<collision::SurfaceContact> anatomy_contacts_;
   std::vector<std::uint32_t> anatomy_order_;
+  std::size_t compliance_block_ = 0;  // spheres in the FEM's W block
   std::size_t tissue_row_budget_ = 0;
   std::vector<contact::ContactRow> rows_;
   std::size_t row_count_ = 0;
