@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 #include "contact_set.h"
 #include "fahr/collision/surface_samples.h"
@@ -258,6 +260,60 @@ double largest_step_after_change(std::uint32_t epoch, std::uint64_t* resets = nu
   }
   if (resets != nullptr) *resets = loop.metrics().tissue_resets.load();
   return largest;
+}
+
+// The FEM's W block follows the ContactSet: its rows, then the contacts
+// nearest to becoming rows. The blade held where it meets the resting
+// tongue, with far more contacts within the candidate margin than the block
+// holds: once the FEM has answered, every contact deep enough to be a row
+// has W, and a FEM state lets go of a sphere only for a deeper one. Here
+// the proxy hops between two poses 0.07 mm apart as the states come, and
+// two spheres trade places. Asking for the deepest contacts without W
+// instead let go of the whole look-ahead (kComplianceLookAhead spheres) at
+// every state, for spheres no deeper.
+TEST(HapticLoop, TheWBlockKeepsItsSpheresWhileTheyStayAmongTheDeepest) {
+  const HapticSetup& setup = neonatal_scene().setup;
+  TissueDigest digest(setup);
+  TissueSnapshot snapshot = digest.make_snapshot();
+  HapticLoop loop(setup);
+  msg::ForceCommand command;
+  msg::ContactSet contacts;
+  contacts.contacts().reserve(msg::MAX_CONTACTS);
+  std::vector<std::uint32_t> previous;
+  std::vector<std::uint32_t> named;
+  std::vector<std::uint32_t> gone;
+  std::size_t most_gone = 0;
+  int compared = 0;
+  std::uint32_t fewest_contacts = std::numeric_limits<std::uint32_t>::max();
+  for (std::uint64_t tick = 0; tick < 200; ++tick) {
+    if (tick % 5 == 0 && tick > 0) {
+      ASSERT_TRUE(digest.digest(rest_with_compliance(setup, contacts, tick / 5), snapshot));
+    }
+    loop.tick(device_pose(tick, kPressTipM, kPressPitchDeg), snapshot, command, contacts);
+    if (tick < 100 || tick % 5 != 4) continue;
+    fewest_contacts = std::min(fewest_contacts, loop.last_phases().tissue_query.contacts);
+    EXPECT_EQ(loop.metrics().missing_compliance.load(), 0u) << "tick " << tick;
+    named.clear();
+    for (const msg::Contact& c : contacts.contacts()) {
+      if (c.kind() != msg::CONTACT_OBSTACLE) named.push_back(c.sphere_id());
+    }
+    std::sort(named.begin(), named.end());
+    if (!previous.empty()) {
+      gone.clear();
+      std::set_difference(previous.begin(), previous.end(), named.begin(), named.end(),
+                          std::back_inserter(gone));
+      most_gone = std::max(most_gone, gone.size());
+      ++compared;
+    }
+    previous.swap(named);
+  }
+  std::printf(
+      "blade held at the tongue: at least %u contacts, %zu spheres named, at most %zu "
+      "let go in a FEM state (%d states)\n",
+      fewest_contacts, previous.size(), most_gone, compared);
+  ASSERT_GT(fewest_contacts, msg::MAX_COMPLIANCE_SPHERES) << "the block holds every contact";
+  EXPECT_EQ(previous.size(), msg::MAX_COMPLIANCE_SPHERES);
+  EXPECT_LT(most_gone, kComplianceLookAhead / 4);
 }
 
 // A tongue that jumped (a new reset epoch) is not rendered as it jumped:
