@@ -201,6 +201,10 @@ int main(int argc, char** argv) try {
     };
     std::printf("tissue rows solved: %llu\n", total(hm.tissue_rows_total));
     std::printf("rows without tissue compliance: %llu\n", total(hm.rows_without_compliance));
+    std::printf(
+        "stack_sim: of the rows without tissue compliance, touching the blade: %llu (the "
+        "others are candidates within the margin)\n",
+        total(hm.rows_without_compliance_touching));
     std::printf("rows dropped: %llu\n", total(hm.rows_dropped));
     std::printf(
         "stack_sim: FEM refactorisations %llu, compliance blocks solved %llu, reused %llu\n",

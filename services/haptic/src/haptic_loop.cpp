@@ -239,8 +239,10 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
   // contact of all (what a ranking by depth alone would have made rows).
   const std::size_t row_ranked = std::min(sorted, tissue_row_budget_);
   std::size_t deep_without_w = 0;
+  std::size_t touching = 0;
   if (n <= tissue_row_budget_) {
     deep_without_w = without_w;
+    for (std::size_t k = 0; k < without_w; ++k) touching += row_key_[order_[k]] > 0.0 ? 1 : 0;
   } else {
     // Merge the two descending heads (each sorted as far as the budget)
     // for the budget deepest contacts.
@@ -252,6 +254,7 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
           (b >= row_ranked || row_key_[order_scratch_[a]] >= row_key_[order_[b]])) {
         ++a;
       } else {
+        touching += row_key_[order_[b]] > 0.0 ? 1 : 0;
         ++b;
         ++deep_without_w;
       }
@@ -274,6 +277,7 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
               order_.begin() + static_cast<std::ptrdiff_t>(row_pick_));
   relaxed_add<std::uint64_t>(metrics_.rows_dropped, n - row_pick_);
   rows_without_w_ = deep_without_w;
+  touching_without_w_ = touching;
 }
 
 // The ContactSet's tool contacts: the last response's (the penalty
@@ -400,6 +404,7 @@ void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
       // first), or the baseline's rows would never get any and render
       // nothing.
       ++rows_without_w_;
+      if (c.depth_m > 0.0) ++touching_without_w_;
       if (request_count_ < compliance_block_ - keep)
         requests_[request_count_++] =
             compliance_request(sphere, c.normal, c.point_m, c.depth_m, tissue);
@@ -509,6 +514,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   row_count_ = 0;
   request_count_ = 0;
   rows_without_w_ = 0;
+  touching_without_w_ = 0;
   const auto query_start = std::chrono::steady_clock::now();
   phases_.tissue_query = {};
   if (setup_.collision == CollisionMethod::kTriangle && tissue.triangles) {
@@ -583,6 +589,7 @@ void HapticLoop::tick(const msg::DevicePose& pose, const TissueSnapshot& tissue,
   relaxed_store(metrics_.missing_compliance, without_w);
   relaxed_add<std::uint64_t>(metrics_.tissue_rows_total, tissue_rows);
   relaxed_add<std::uint64_t>(metrics_.rows_without_compliance, without_w);
+  relaxed_add<std::uint64_t>(metrics_.rows_without_compliance_touching, touching_without_w_);
   relaxed_store(metrics_.reaction_n, out.tissue_reaction_n);
   relaxed_store(metrics_.obstacle_reaction_n, response_.report().obstacle_reaction_n);
   const double force_n = out.force_n.norm();
@@ -735,6 +742,8 @@ void HapticLoop::append_metrics(std::vector<std::pair<std::string, double>>& out
   out.emplace_back("missing_compliance", get(metrics_.missing_compliance));
   out.emplace_back("tissue_rows_total", get(metrics_.tissue_rows_total));
   out.emplace_back("rows_without_compliance", get(metrics_.rows_without_compliance));
+  out.emplace_back("rows_without_compliance_touching",
+                   get(metrics_.rows_without_compliance_touching));
   out.emplace_back("lost_track_ticks", get(metrics_.lost_track_ticks));
   out.emplace_back("indefinite_w_ticks", get(metrics_.indefinite_w_ticks));
   out.emplace_back("w_diagonal_scale_max", get(metrics_.w_diagonal_scale_max));

@@ -43,6 +43,9 @@ struct LoopMetrics {
   std::atomic<std::uint32_t> missing_compliance{0};  // rows without tissue compliance, last tick
   std::atomic<std::uint64_t> tissue_rows_total{0};   // tissue rows solved, all ticks
   std::atomic<std::uint64_t> rows_without_compliance{0};  // of those, rows without W, total
+  // Of those, the ones touching the tool (depth > 0; the others are
+  // candidates within the margin), total.
+  std::atomic<std::uint64_t> rows_without_compliance_touching{0};
   std::atomic<std::uint64_t> lost_track_ticks{0};
   // Ticks whose rows' A from the FEM's W was indefinite and had its
   // diagonal scaled (contact::ContactSolver::load), and the largest scale.
@@ -185,6 +188,7 @@ class HapticLoop {
   std::size_t row_pick_ = 0;                  // rows select_rows took
   std::size_t request_count_ = 0;             // requests this tick
   std::size_t rows_without_w_ = 0;            // contacts deep enough to be rows, without W
+  std::size_t touching_without_w_ = 0;        // of those, touching the tool
   // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
   std::vector<collision::TriangleContact> triangle_contacts_;
   std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1
