@@ -192,7 +192,7 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
 // look-ahead's spheres with new ones at every FEM step although they were
 // no deeper: in the 20 s intubation the FEM solved 28 % more new columns and
 // 1.8 times as many contacts were deep enough to be rows without having W
-// (docs/design/fem-step-and-solvers.md, the compliance block).
+// (docs/design/compliance-block.md).
 //
 // A W sphere is a row whatever the depth of contacts without W around it.
 // Ranked among all contacts, the W spheres (projected onto the blade by the
