@@ -272,13 +272,9 @@ double largest_step_after_change(std::uint32_t epoch, std::uint64_t* resets = nu
 // instead let go of the whole look-ahead (kComplianceLookAhead spheres) at
 // every state, for spheres no deeper.
 TEST(HapticLoop, TheWBlockKeepsItsSpheresWhileTheyStayAmongTheDeepest) {
-  const HapticSetup& setup = neonatal_scene().setup;
-  TissueDigest digest(setup);
-  TissueSnapshot snapshot = digest.make_snapshot();
-  HapticLoop loop(setup);
-  msg::ForceCommand command;
-  msg::ContactSet contacts;
-  contacts.contacts().reserve(msg::MAX_CONTACTS);
+  PressRig rig;  // its loop and buffers only: the blade stays where it meets the tongue
+  HapticLoop& loop = rig.loop;
+  msg::ContactSet& contacts = rig.contacts;
   std::vector<std::uint32_t> previous;
   std::vector<std::uint32_t> named;
   std::vector<std::uint32_t> gone;
@@ -287,9 +283,10 @@ TEST(HapticLoop, TheWBlockKeepsItsSpheresWhileTheyStayAmongTheDeepest) {
   std::uint32_t fewest_contacts = std::numeric_limits<std::uint32_t>::max();
   for (std::uint64_t tick = 0; tick < 200; ++tick) {
     if (tick % 5 == 0 && tick > 0) {
-      ASSERT_TRUE(digest.digest(rest_with_compliance(setup, contacts, tick / 5), snapshot));
+      ASSERT_TRUE(
+          rig.digest.digest(rest_with_compliance(rig.setup, contacts, tick / 5), rig.snapshot));
     }
-    loop.tick(device_pose(tick, kPressTipM, kPressPitchDeg), snapshot, command, contacts);
+    loop.tick(device_pose(tick, kPressTipM, kPressPitchDeg), rig.snapshot, rig.command, contacts);
     if (tick < 100 || tick % 5 != 4) continue;
     fewest_contacts = std::min(fewest_contacts, loop.last_phases().tissue_query.contacts);
     EXPECT_EQ(loop.metrics().missing_compliance.load(), 0u) << "tick " << tick;

@@ -97,6 +97,8 @@ inline constexpr std::size_t kMaxAnatomyRows = 16;
 // sphere is deep enough to be a row. At least this many slots (a third of a
 // smaller block) are kept for them; the rows take the rest, up to the
 // solve's cap.
+// With several deformable bodies one block's worth is shared by all of
+// them, though each body's FEM could hold a block of its own.
 inline constexpr std::size_t kComplianceLookAhead = 32;
 // Largest change of the commanded force a tick after the tongue was reset
 // (DeformationState::reset_epoch), a new FEM writer appeared, the tissue
