@@ -119,6 +119,72 @@ TEST(ForceAware, AHeldLoadReleasesWhenTheHandDrawsBackOut) {
   EXPECT_EQ(response.state(), TrackingState::kCatchingUp);
 }
 
+// A load alone keeps no geometry: tissue reaches into the held blade and
+// over its plate. A sphere over the plate (pushed up) with the column of W
+// of one under it (pushed down), as where the tissue closed over the blade
+// in the overshoot: the pinned solve asks for two forces that cancel in the
+// resultant and grow with the overlap. What the tissue receives (the
+// ContactSet's forces) sums to at most the limit, counted as magnitudes;
+// scaled by the resultant alone the pair summed to over 200 times the limit
+// (measured when written), and the rows under the plate still carry load.
+TEST(ForceAware, AHeldLoadNeverSendsTheTissueMoreThanTheLimitInAnyForm) {
+  constexpr double kLimit = 0.5;
+  test::SyntheticPatch patch = test::make_patch(4, 0.0, 0.002, 0.005);
+  ContactResponse response{ResponseSettings{}};
+  response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
+  // The patch's W with a fifth sphere sharing sphere 0's column.
+  const std::size_t n = 5;
+  std::vector<std::uint32_t> ids{0, 1, 2, 3, 4};
+  std::vector<float> w(9 * n * n, 0.0f);
+  const auto source = [](std::size_t s) { return s == 4 ? std::size_t{0} : s; };
+  for (std::size_t a = 0; a < 3 * n; ++a) {
+    for (std::size_t b = 0; b < 3 * n; ++b) {
+      const std::size_t sa = source(a / 3), sb = source(b / 3);
+      w[a * 3 * n + b] = patch.w[(3 * sa + a % 3) * 12 + 3 * sb + b % 3];
+    }
+  }
+  for (std::size_t d = 0; d < 3; ++d) w[(12 + d) * 3 * n + 12 + d] *= 1.01f;  // just independent
+  const auto tick = [&](double y, bool over_the_plate) -> const ForceOutput& {
+    test::set_tool_height(patch, response.proxy().position_m.y());
+    std::vector<ContactRow> rows = patch.rows;
+    if (over_the_plate) {
+      ContactRow r = rows[0];
+      r.id = 4;
+      r.compliance_index = 4;
+      r.normal = Eigen::Vector3d(0, 1, 0);
+      r.tool_point_m.y() = response.proxy().position_m.y() + 0.001;  // the plate's top face
+      r.other_point_m.y() = r.tool_point_m.y() - 0.002;              // 2 mm under it
+      rows.push_back(r);
+    }
+    TickInput in;
+    in.device.position_m = Eigen::Vector3d(0, y, 0);
+    in.device.renderable_force_n = kLimit;
+    in.rows = rows;
+    in.compliance = TissueCompliance{7, ids, w, {}};
+    return response.tick(in);
+  };
+  double y = 0.002;
+  while (!tick(y, false).lost_track) {
+    y -= 1e-5;
+    ASSERT_GT(y, -0.02) << "never froze";
+  }
+  const double held_y = response.proxy().position_m.y();
+  for (int k = 0; k < 20; ++k) {
+    ASSERT_TRUE(tick(held_y - 0.005, true).lost_track);
+    double sum = 0.0, under = 0.0;
+    Eigen::Vector3d resultant = Eigen::Vector3d::Zero();
+    for (const fem::Contact& c : response.contacts()) {
+      if (c.kind == fem::ContactKind::kObstacle) continue;
+      sum += c.force_n;
+      resultant += c.force_n * c.normal;
+      if (c.sphere_id < 4) under += c.force_n;
+    }
+    EXPECT_LE(sum, kLimit * (1.0 + 1e-9)) << "tick " << k;
+    EXPECT_LE(resultant.norm(), kLimit * (1.0 + 1e-9)) << "tick " << k;
+    EXPECT_GT(under, 0.25 * kLimit) << "tick " << k;  // scaled, not dropped
+  }
+}
+
 TEST(ForceAware, DisabledNeverFreezes) {
   test::SyntheticPatch patch = test::make_patch(4, 0.0, 0.002, 0.005);
   ResponseSettings settings;

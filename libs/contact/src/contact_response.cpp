@@ -289,7 +289,7 @@ Eigen::Vector3d ContactResponse::freeze(const TissueCompliance& compliance, doub
   const Eigen::Vector3d push = solver_.resultant(RowKind::kTissue);
   held_push_direction_ =
       push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
-  const Eigen::Vector3d back =
+  Eigen::Vector3d back =
       settings_.force_aware.held_proxy == HeldProxy::kBackOff ? yield_to_limit(zero, limit) : zero;
   if (!holds_load()) capture_holds(compliance);  // kHoldLoad holds no sphere
   return back;
@@ -364,7 +364,7 @@ Eigen::Vector3d ContactResponse::keep_out_of_bone(const Eigen::Vector3d& step) {
   if (!solver_.has_obstacle_rows() ||
       (state_ == TrackingState::kTracking && !report_.implausible_step))
     return step;
-  const Eigen::Vector3d kept_out = solver_.project_on_obstacles(step, settings_.pgs);
+  Eigen::Vector3d kept_out = solver_.project_on_obstacles(step, settings_.pgs);
   if (!kept_out.allFinite() || !((kept_out - step).squaredNorm() > 0.0)) return step;
   solver_.solve_pinned(kept_out, settings_.pgs);
   return kept_out;
@@ -407,9 +407,17 @@ double ContactResponse::scale_tissue_forces(const DeviceSample& device) {
   if (holds_proxy) {
     // Held where it froze: the tissue forces are scaled to the limit; the
     // spheres stay frozen (kStay) or carry that load alone (kHoldLoad,
-    // force only: write_contacts).
-    if (load > device.renderable_force_n) {
-      tissue_force_scale_ = device.renderable_force_n / load;
+    // force only: write_contacts). A load alone keeps no geometry, so
+    // tissue reaches into the held blade and the pinned solve then asks for
+    // rows on both faces of its plate that push the two layers apart and
+    // cancel in the resultant (thousands of newtons under a 7.9 N
+    // resultant): kHoldLoad bounds the sum of the rows' magnitudes by the
+    // limit as well, so no load the device could not render reaches the
+    // tissue in any form (docs/design/force-aware-decision.md).
+    const double held_load =
+        held == HeldProxy::kHoldLoad ? std::max(load, tissue_magnitudes()) : load;
+    if (held_load > device.renderable_force_n) {
+      tissue_force_scale_ = device.renderable_force_n / held_load;
       report_.tissue_force_scaled_held = true;
     }
     // kHoldLoad: held, the tissue carries the load alone; catching up, it
@@ -433,6 +441,14 @@ double ContactResponse::tissue_load(double resultant_norm) const {
     load += solver_.resultant(RowKind::kTissue, body_first_ids_[b], end).norm();
   }
   return load;
+}
+
+double ContactResponse::tissue_magnitudes() const {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < solver_.size(); ++i) {
+    if (solver_.row(i).kind == RowKind::kTissue) sum += solver_.lambda(i);
+  }
+  return sum;
 }
 
 void ContactResponse::set_tissue_bodies(std::span<const std::uint32_t> first_ids) {

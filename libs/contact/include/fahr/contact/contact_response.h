@@ -146,6 +146,8 @@ class ContactResponse {
   // The load the tissue's rows put on the tissue, N: the resultant's norm,
   // or with several bodies the sum of theirs.
   double tissue_load(double resultant_norm) const;
+  // The tissue rows' forces summed as magnitudes, N.
+  double tissue_magnitudes() const;
   // The proxy does not follow the device this tick (held, or its catch-up bounded).
   bool pinned() const { return state_ == TrackingState::kLostTrack || report_.catch_up_limited; }
   Eigen::Vector3d catch_up_step(const Eigen::Vector3d& toward, double max_step, double dt_s) const;
