@@ -94,6 +94,11 @@ struct Result {
   double max_reengage_step_n = 0.0;
   double reengage_bound_n = 0.0;
   double max_penetration_m = 0.0;
+  // The ContactSet's tool rows on one tick: the largest sum of their forces
+  // and their resultant then. Far apart, the rows squeeze the tissue from
+  // both faces of the blade (a pinch: docs/design/force-aware-decision.md).
+  double max_row_force_sum_n = 0.0;
+  double row_resultant_at_max_sum_n = 0.0;
   double max_anatomy_depth_m = 0.0;  // deepest node into bone before the FEM moved it out
   int max_inverted = 0;
   double max_elastic_j = 0.0;
@@ -474,14 +479,22 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                    report.load.missing_compliance);
     }
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
+    double row_force_sum = 0.0;
+    Eigen::Vector3d row_resultant = Eigen::Vector3d::Zero();
     for (const auto& contact : sim.contacts().contacts()) {
       if (contact.kind() == msg::CONTACT_OBSTACLE) continue;
+      row_force_sum += contact.force_n();
+      row_resultant += contact.force_n() * common::to_eigen(contact.normal());
       r.max_penetration_m = std::max(r.max_penetration_m, contact.penetration_m());
       if (!touched && contact.state() != msg::CONSTRAINT_CANDIDATE) {
         touched = true;
         for (std::uint32_t n = 0; n < sim.body().node_count(); ++n)
           found[n] = sim.body().position(n);
       }
+    }
+    if (row_force_sum > r.max_row_force_sum_n) {
+      r.max_row_force_sum_n = row_force_sum;
+      r.row_resultant_at_max_sum_n = row_resultant.norm();
     }
     if (!penalty) {
       if (!seen_1x && commanded >= limit && limit > 0.0) {
@@ -701,6 +714,11 @@ int main(int argc, char** argv) {
                 pe.max_reaction_n);
     std::printf("| largest tool push on the tissue, FEM side N | %.3f | %.3f |\n",
                 fa.max_fem_reaction_n, pe.max_fem_reaction_n);
+    std::printf(
+        "| largest sum of the tool rows' forces on a tick N (their resultant then) | "
+        "%.3f (%.3f) | %.3f (%.3f) |\n",
+        fa.max_row_force_sum_n, fa.row_resultant_at_max_sum_n, pe.max_row_force_sum_n,
+        pe.row_resultant_at_max_sum_n);
     std::printf("| largest reaction / limit while lost track, as sent | %.4f | - |\n",
                 fa.max_reaction_lost_ratio);
     std::printf("| largest reaction / limit while lost track, FEM side | %.4f | - |\n",
