@@ -129,28 +129,32 @@ TEST(ForceAware, AHeldLoadReleasesWhenTheHandDrawsBackOut) {
 // (measured when written), and the rows under the plate still carry load.
 TEST(ForceAware, AHeldLoadNeverSendsTheTissueMoreThanTheLimitInAnyForm) {
   constexpr double kLimit = 0.5;
-  test::SyntheticPatch patch = test::make_patch(4, 0.0, 0.002, 0.005);
+  constexpr std::size_t kPatchSpheres = 4;
+  test::SyntheticPatch patch = test::make_patch(kPatchSpheres, 0.0, 0.002, 0.005);
   ContactResponse response{ResponseSettings{}};
   response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
-  // The patch's W with a fifth sphere sharing sphere 0's column.
-  const std::size_t n = 5;
+  // The patch's W (3 x 3 blocks, row stride 3 kPatchSpheres) with a fifth
+  // sphere sharing sphere 0's column.
+  constexpr std::size_t kPatchStride = 3 * kPatchSpheres;
+  const std::size_t n = kPatchSpheres + 1;
   std::vector<std::uint32_t> ids{0, 1, 2, 3, 4};
   std::vector<float> w(9 * n * n, 0.0f);
-  const auto source = [](std::size_t s) { return s == 4 ? std::size_t{0} : s; };
+  const auto source = [](std::size_t s) { return s == kPatchSpheres ? std::size_t{0} : s; };
   for (std::size_t a = 0; a < 3 * n; ++a) {
     for (std::size_t b = 0; b < 3 * n; ++b) {
       const std::size_t sa = source(a / 3), sb = source(b / 3);
-      w[a * 3 * n + b] = patch.w[(3 * sa + a % 3) * 12 + 3 * sb + b % 3];
+      w[a * 3 * n + b] = patch.w[(3 * sa + a % 3) * kPatchStride + 3 * sb + b % 3];
     }
   }
-  for (std::size_t d = 0; d < 3; ++d) w[(12 + d) * 3 * n + 12 + d] *= 1.01f;  // just independent
+  // The fifth sphere's diagonal block, just independent of sphere 0's.
+  for (std::size_t d = 0; d < 3; ++d) w[(kPatchStride + d) * 3 * n + kPatchStride + d] *= 1.01f;
   const auto tick = [&](double y, bool over_the_plate) -> const ForceOutput& {
     test::set_tool_height(patch, response.proxy().position_m.y());
     std::vector<ContactRow> rows = patch.rows;
     if (over_the_plate) {
       ContactRow r = rows[0];
-      r.id = 4;
-      r.compliance_index = 4;
+      r.id = static_cast<std::uint32_t>(kPatchSpheres);
+      r.compliance_index = static_cast<std::int32_t>(kPatchSpheres);
       r.normal = Eigen::Vector3d(0, 1, 0);
       r.tool_point_m.y() = response.proxy().position_m.y() + 0.001;  // the plate's top face
       r.other_point_m.y() = r.tool_point_m.y() - 0.002;              // 2 mm under it
@@ -177,7 +181,7 @@ TEST(ForceAware, AHeldLoadNeverSendsTheTissueMoreThanTheLimitInAnyForm) {
       if (c.kind == fem::ContactKind::kObstacle) continue;
       sum += c.force_n;
       resultant += c.force_n * c.normal;
-      if (c.sphere_id < 4) under += c.force_n;
+      if (c.sphere_id < kPatchSpheres) under += c.force_n;
     }
     EXPECT_LE(sum, kLimit * (1.0 + 1e-9)) << "tick " << k;
     EXPECT_LE(resultant.norm(), kLimit * (1.0 + 1e-9)) << "tick " << k;
