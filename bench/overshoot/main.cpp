@@ -421,13 +421,13 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,"
       "inverted_free,fem_cpu_ms,supported_nodes,"
       "volume_floor_below,volume_floor_unresolved,tool_force_sum_n,tool_largest_force_n\n");
-  std::FILE* tick_trace =
-      open_trace(tick_trace_path, r.name,
-                 "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,"
-                 "proxy_z,gap_mm,"
-                 "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,"
-                 "obstacle_reaction_n,rows,"
-                 "pgs_converged,contacts_found,fem_step,pgs_sweeps,missing_compliance\n");
+  std::FILE* tick_trace = open_trace(
+      tick_trace_path, r.name,
+      "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,"
+      "proxy_z,gap_mm,"
+      "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,"
+      "obstacle_reaction_n,rows,"
+      "pgs_converged,contacts_found,fem_step,pgs_sweeps,missing_compliance,row_force_sum_n\n");
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
   bool seen_1x = false, was_lost = false, reengaged = false, left = false, touched = false;
@@ -461,12 +461,19 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
     r.finite = r.finite && force.allFinite() && gap.allFinite();
     const double commanded = penalty ? force.norm() : k_c * gap.norm();
     r.max_commanded_n = std::max(r.max_commanded_n, commanded);
+    double row_force_sum = 0.0;
+    Eigen::Vector3d row_resultant = Eigen::Vector3d::Zero();
+    for (const auto& contact : sim.contacts().contacts()) {
+      if (contact.kind() == msg::CONTACT_OBSTACLE) continue;
+      row_force_sum += contact.force_n();
+      row_resultant += contact.force_n() * common::to_eigen(contact.normal());
+    }
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
       std::fprintf(tick_trace,
                    "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,"
-                   "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d\n",
+                   "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d,%.4f\n",
                    sim.time_s(), c.lost_track() ? 1 : 0, force.norm(), force.x(), force.y(),
                    force.z(), c.tissue_reaction_n(), 1e3 * hand.x(), 1e3 * hand.y(), 1e3 * hand.z(),
                    1e3 * proxy.x(), 1e3 * proxy.y(), 1e3 * proxy.z(), 1e3 * gap.norm(), limit,
@@ -476,15 +483,11 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                    static_cast<int>(report.load.rows), report.pgs.converged ? 1 : 0,
                    sim.haptic().last_phases().tissue_query.contacts,
                    static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps,
-                   report.load.missing_compliance);
+                   report.load.missing_compliance, row_force_sum);
     }
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
-    double row_force_sum = 0.0;
-    Eigen::Vector3d row_resultant = Eigen::Vector3d::Zero();
     for (const auto& contact : sim.contacts().contacts()) {
       if (contact.kind() == msg::CONTACT_OBSTACLE) continue;
-      row_force_sum += contact.force_n();
-      row_resultant += contact.force_n() * common::to_eigen(contact.normal());
       r.max_penetration_m = std::max(r.max_penetration_m, contact.penetration_m());
       if (!touched && contact.state() != msg::CONSTRAINT_CANDIDATE) {
         touched = true;
