@@ -108,16 +108,32 @@ int main(int argc, char** argv) try {
     // or frozen, not a candidate) and the most such contacts in one set.
     std::vector<std::uint64_t> touched_ticks(sim.body_count(), 0);
     std::vector<std::size_t> most_touching(sim.body_count(), 0);
+    // The largest sum of the tool rows' forces sent on one tick, and their
+    // resultant then: far apart, the rows squeeze the tissue from both faces
+    // of the blade (docs/design/force-aware-decision.md, a pinch).
+    double largest_row_sum = 0.0, resultant_at_largest = 0.0;
     for (std::uint64_t k = 0; k < steps; ++k) {
       sim.step();
+      double row_sum = 0.0;
+      Eigen::Vector3d row_resultant = Eigen::Vector3d::Zero();
       for (std::size_t b = 0; b < sim.body_count(); ++b) {
         const auto& contacts = sim.contacts(b).contacts();
+        for (const msg::Contact& c : contacts) {
+          if (c.kind() == msg::CONTACT_OBSTACLE) continue;
+          row_sum += c.force_n();
+          row_resultant +=
+              c.force_n() * Eigen::Vector3d(c.normal().x(), c.normal().y(), c.normal().z());
+        }
         const auto touching = static_cast<std::size_t>(
             std::count_if(contacts.begin(), contacts.end(), [](const msg::Contact& c) {
               return c.kind() != msg::CONTACT_OBSTACLE && c.state() != msg::CONSTRAINT_CANDIDATE;
             }));
         if (touching > 0) ++touched_ticks[b];
         most_touching[b] = std::max(most_touching[b], touching);
+      }
+      if (row_sum > largest_row_sum) {
+        largest_row_sum = row_sum;
+        resultant_at_largest = row_resultant.norm();
       }
       const auto& report = sim.haptic().response().report();
       pgs_cost.push_back(static_cast<double>(report.pgs_work.row_visits) *
@@ -174,6 +190,9 @@ int main(int argc, char** argv) try {
         "%llu\n",
         largest_step, static_cast<unsigned long long>(largest_step_tick),
         static_cast<unsigned long long>(steps_over_tenth));
+    std::printf(
+        "stack_sim: tool rows' forces on a tick: largest sum %.3f N, their resultant then %.3f N\n",
+        largest_row_sum, resultant_at_largest);
     std::printf(
         "stack_sim: FEM anatomy: nodes let back through a bone %llu, node-steps beyond a bone "
         "%llu\n",
