@@ -119,6 +119,47 @@ TEST(ForceAware, AHeldLoadReleasesWhenTheHandDrawsBackOut) {
   EXPECT_EQ(response.state(), TrackingState::kCatchingUp);
 }
 
+// A hand that pulls mostly sideways of the push the tool froze with is not
+// pressing on, though its stretch along that push is still past the limit
+// (a blade the tissue pushed sideways as it sank, drawn up and out): the
+// load is released, and while the proxy catches up the tissue still gets
+// no more than the limit.
+TEST(ForceAware, AHeldLoadReleasesWhenTheHandPullsAwayFromTheHeldPush) {
+  test::SyntheticPatch patch = test::make_patch(4, 0.0, 0.002, 0.005);
+  ContactResponse response{ResponseSettings{}};
+  response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
+  constexpr double kLimit = 0.5;
+  const auto tick = [&](const Eigen::Vector3d& hand) -> const ForceOutput& {
+    test::set_tool_height(patch, response.proxy().position_m.y());
+    TickInput in;
+    in.device.position_m = hand;
+    in.device.renderable_force_n = kLimit;
+    in.rows = patch.rows;
+    in.compliance = patch.compliance();
+    return response.tick(in);
+  };
+  double y = 0.002;
+  while (!tick(Eigen::Vector3d(0, y, 0)).lost_track) {
+    y -= 1e-5;
+    ASSERT_GT(y, -0.02) << "never froze";
+  }
+  const double held_y = response.proxy().position_m.y();
+  for (int k = 0; k < 50; ++k) ASSERT_TRUE(tick(Eigen::Vector3d(0, held_y - 0.005, 0)).lost_track);
+  // 5 mm into the tissue still (2 N along the held push against 0.5 N), but
+  // 30 mm to the side: the pull is 80 degrees from the held push.
+  const Eigen::Vector3d aside(0.03, held_y - 0.005, 0);
+  EXPECT_FALSE(tick(aside).lost_track);
+  EXPECT_NE(response.state(), TrackingState::kLostTrack);
+  for (int k = 0; k < 200; ++k) {
+    tick(aside);
+    double sum = 0.0;
+    for (const fem::Contact& c : response.contacts()) {
+      if (c.kind != fem::ContactKind::kObstacle) sum += c.force_n;
+    }
+    ASSERT_LE(sum, 1.05 * kLimit) << "tick " << k;
+  }
+}
+
 // A load alone keeps no geometry: tissue reaches into the held blade and
 // over its plate. A sphere over the plate (pushed up) with the column of W
 // of one under it (pushed down), as where the tissue closed over the blade

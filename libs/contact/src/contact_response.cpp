@@ -36,6 +36,9 @@ constexpr double kGrippedLoadShare = 0.25;
 // 60 degrees of the back-off: rows beside the tool (a rounded tool sunk in
 // a block) are not a grip.
 constexpr double kBehindCosine = 0.5;
+// kHoldLoad: a hand whose pull lies more than 60 degrees from the push the
+// tool froze with is not pressing into the tissue along it (move_proxy).
+constexpr double kPressingCosine = 0.5;
 // A tissue reaction above this multiple of the limit is not the force-aware
 // decision's rounding but a wedge (see tick()): the targets' 5 % band.
 constexpr double kWedgeBand = 1.05;
@@ -189,9 +192,15 @@ Eigen::Vector3d ContactResponse::move_proxy(const TickInput& input,
   // off or draws back out (the spring then stretches the other way) releases
   // it, and one that presses past the limit again while the proxy catches up
   // holds it again. No solve decides it, so the state does not flicker with
-  // the rows or with a tissue still relaxing under the released tool.
-  const double pull =
-      coupling.stiffness_npm * (device.position_m - proxy_.position_m).dot(held_push_direction_);
+  // the rows or with a tissue still relaxing under the released tool. A
+  // hand whose pull points mostly elsewhere is not pressing on, whatever
+  // its component along that push: a blade the tissue pushed sideways
+  // while it sank, drawn up and out of the mouth, kept a sideways stretch
+  // of the spring past the limit and was held for as long as the hand
+  // stayed out (docs/design/force-aware-decision.md).
+  const Eigen::Vector3d stretch = coupling.stiffness_npm * (device.position_m - proxy_.position_m);
+  const double along = stretch.dot(held_push_direction_);
+  const double pull = along >= kPressingCosine * stretch.norm() ? along : std::min(along, 0.0);
   if (state_ == TrackingState::kLostTrack) {
     if (const std::optional<Eigen::Vector3d> held = held_step(input, coupling, pull)) return *held;
     state_ = TrackingState::kCatchingUp;
