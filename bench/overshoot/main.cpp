@@ -48,6 +48,7 @@
 #include "fahr/bench_support/results_file.h"
 #include "fahr/cli/cli.h"
 #include "fahr/common/solver_threads.h"
+#include "fahr/common/tool_row_forces.h"
 #include "fahr/common/wire_eigen.h"
 #include "fahr/fem/strain.h"
 #include "fahr/geometry/tet_deformation.h"
@@ -461,13 +462,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
     r.finite = r.finite && force.allFinite() && gap.allFinite();
     const double commanded = penalty ? force.norm() : k_c * gap.norm();
     r.max_commanded_n = std::max(r.max_commanded_n, commanded);
-    double row_force_sum = 0.0;
-    Eigen::Vector3d row_resultant = Eigen::Vector3d::Zero();
-    for (const auto& contact : sim.contacts().contacts()) {
-      if (contact.kind() == msg::CONTACT_OBSTACLE) continue;
-      row_force_sum += contact.force_n();
-      row_resultant += contact.force_n() * common::to_eigen(contact.normal());
-    }
+    const common::ToolRowForces rows_sent = common::tool_row_forces(sim.contacts());
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
@@ -483,7 +478,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                    static_cast<int>(report.load.rows), report.pgs.converged ? 1 : 0,
                    sim.haptic().last_phases().tissue_query.contacts,
                    static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps,
-                   report.load.missing_compliance, row_force_sum);
+                   report.load.missing_compliance, rows_sent.magnitudes_n);
     }
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
     for (const auto& contact : sim.contacts().contacts()) {
@@ -495,9 +490,9 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
           found[n] = sim.body().position(n);
       }
     }
-    if (row_force_sum > r.max_row_force_sum_n) {
-      r.max_row_force_sum_n = row_force_sum;
-      r.row_resultant_at_max_sum_n = row_resultant.norm();
+    if (rows_sent.magnitudes_n > r.max_row_force_sum_n) {
+      r.max_row_force_sum_n = rows_sent.magnitudes_n;
+      r.row_resultant_at_max_sum_n = rows_sent.resultant_n.norm();
     }
     if (!penalty) {
       if (!seen_1x && commanded >= limit && limit > 0.0) {

@@ -24,6 +24,7 @@
 #include "fahr/cli/cli.h"
 #include "fahr/common/cdr_bytes.h"
 #include "fahr/common/solver_threads.h"
+#include "fahr/common/tool_row_forces.h"
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
 
@@ -114,16 +115,12 @@ int main(int argc, char** argv) try {
     double largest_row_sum = 0.0, resultant_at_largest = 0.0;
     for (std::uint64_t k = 0; k < steps; ++k) {
       sim.step();
-      double row_sum = 0.0;
-      Eigen::Vector3d row_resultant = Eigen::Vector3d::Zero();
+      common::ToolRowForces rows_sent;
       for (std::size_t b = 0; b < sim.body_count(); ++b) {
+        const common::ToolRowForces body_rows = common::tool_row_forces(sim.contacts(b));
+        rows_sent.resultant_n += body_rows.resultant_n;
+        rows_sent.magnitudes_n += body_rows.magnitudes_n;
         const auto& contacts = sim.contacts(b).contacts();
-        for (const msg::Contact& c : contacts) {
-          if (c.kind() == msg::CONTACT_OBSTACLE) continue;
-          row_sum += c.force_n();
-          row_resultant +=
-              c.force_n() * Eigen::Vector3d(c.normal().x(), c.normal().y(), c.normal().z());
-        }
         const auto touching = static_cast<std::size_t>(
             std::count_if(contacts.begin(), contacts.end(), [](const msg::Contact& c) {
               return c.kind() != msg::CONTACT_OBSTACLE && c.state() != msg::CONSTRAINT_CANDIDATE;
@@ -131,9 +128,9 @@ int main(int argc, char** argv) try {
         if (touching > 0) ++touched_ticks[b];
         most_touching[b] = std::max(most_touching[b], touching);
       }
-      if (row_sum > largest_row_sum) {
-        largest_row_sum = row_sum;
-        resultant_at_largest = row_resultant.norm();
+      if (rows_sent.magnitudes_n > largest_row_sum) {
+        largest_row_sum = rows_sent.magnitudes_n;
+        resultant_at_largest = rows_sent.resultant_n.norm();
       }
       const auto& report = sim.haptic().response().report();
       pgs_cost.push_back(static_cast<double>(report.pgs_work.row_visits) *

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "fahr/common/tool_row_forces.h"
+
 namespace fahr::glottic_view {
 
 BladeFromContacts blade_from_contacts(const msg::ContactSet& set) {
@@ -17,11 +19,7 @@ BladeFromContacts blade_from_contacts(const msg::ContactSet& set) {
     pose.translation() = position;
     out.world_from_tool = pose;
   }
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();
-  for (const auto& c : set.contacts()) {
-    if (c.kind() == msg::CONTACT_OBSTACLE) continue;
-    force += c.force_n() * Eigen::Vector3d(c.normal().x(), c.normal().y(), c.normal().z());
-  }
+  const Eigen::Vector3d force = common::tool_row_forces(set).resultant_n;
   out.tool_force_n = force.allFinite() ? force.norm() : 0.0;
   return out;
 }
