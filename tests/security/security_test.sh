@@ -44,18 +44,24 @@ round() {  # round LISTENER-ARGS... -- COMMANDER-ARGS...
   while [ "$1" != -- ]; do listen_args+=("$1"); shift; done
   shift
   command_args=("$@")
-  "$peer" listen --seconds 7 --dds "$vendor" --domain "$domain" "${listen_args[@]}" >"$out/listen.txt" 2>&1 &
+  # Each peer's result line on stdout, the vendor's log on stderr, in two
+  # files: Fast DDS's security log, written by its own thread into one shared
+  # file, once split the commander's "command: refused" line mid-line.
+  "$peer" listen --seconds 7 --dds "$vendor" --domain "$domain" "${listen_args[@]}" \
+    >"$out/listen.txt" 2>"$out/listen.err" &
   local listener=$!
   sleep 1.5
   "$peer" command --seconds 4 --dds "$vendor" --domain "$domain" "${command_args[@]}" \
-    >"$out/command.txt" 2>&1 || true
+    >"$out/command.txt" 2>"$out/command.err" || true
   wait "$listener" || true
   # A peer that printed no such line (it died) fails the checks below with
   # its output shown, rather than ending the script here without a word.
   command_line=$(grep -a "^command: " "$out/command.txt" | tail -n 1 || true)
   listen_line=$(grep -a "^listen: received" "$out/listen.txt" | tail -n 1 || true)
-  [ -n "$command_line" ] || { echo "  commander printed no result:"; sed 's/^/    /' "$out/command.txt"; }
-  [ -n "$listen_line" ] || { echo "  listener printed no result:"; sed 's/^/    /' "$out/listen.txt"; }
+  [ -n "$command_line" ] ||
+    { echo "  commander printed no result:"; sed 's/^/    /' "$out/command.txt" "$out/command.err"; }
+  [ -n "$listen_line" ] ||
+    { echo "  listener printed no result:"; sed 's/^/    /' "$out/listen.txt" "$out/listen.err"; }
   received=$(echo "$listen_line" | sed -n 's/^listen: received \([0-9]*\) .*/\1/p')
   echo "  commander: $command_line"
   echo "  listener:  $listen_line"
