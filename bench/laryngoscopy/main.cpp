@@ -293,6 +293,21 @@ int main(int argc, char** argv) {
     Eigen::Vector3d anatomy_normal = Eigen::Vector3d::Zero();
     double anatomy_row_n = 0.0;
     double anatomy_t = 0.0;
+    // Per rigid body (the haptic side keys an anatomy row by body id << 20
+    // | sample): the largest push it gave the blade (the length of the sum
+    // of its rows' forces on one tick) and when: the upper gum and the lips
+    // take a levered blade's load.
+    struct AnatomyPush {
+      std::uint32_t id = 0;
+      std::string name;
+      Eigen::Vector3d tick_sum = Eigen::Vector3d::Zero();
+      double peak_n = 0.0;
+      double peak_t = 0.0;
+    };
+    std::vector<AnatomyPush> pushes;
+    for (const scene::Body& body : scene->bodies) {
+      if (body.role == scene::BodyRole::kObstacle) pushes.push_back({body.id, body.name});
+    }
     double pogo_first = -1.0;
     double pogo_best = 0.0;
     double pogo_best_t = 0.0;
@@ -318,13 +333,24 @@ int main(int argc, char** argv) {
       if (sim.command().lost_track()) ++held_ticks;
       peak_anatomy = std::max(peak_anatomy, report.obstacle_reaction_n);
       const auto& solver = sim.haptic().response().solver();
+      for (AnatomyPush& push : pushes) push.tick_sum.setZero();
       for (std::size_t i = 0; i < solver.size(); ++i) {
         if (solver.row(i).kind != contact::RowKind::kObstacle) continue;
+        const std::uint32_t body_id = solver.row(i).id >> 20;
+        for (AnatomyPush& push : pushes) {
+          if (push.id == body_id) push.tick_sum -= solver.lambda(i) * solver.row(i).normal;
+        }
         if (solver.lambda(i) > anatomy_row_n) {
           anatomy_row_n = solver.lambda(i);
           anatomy_point = solver.row(i).other_point_m;
           anatomy_normal = solver.row(i).normal;
           anatomy_t = sim.time_s();
+        }
+      }
+      for (AnatomyPush& push : pushes) {
+        if (push.tick_sum.norm() > push.peak_n) {
+          push.peak_n = push.tick_sum.norm();
+          push.peak_t = sim.time_s();
         }
       }
       const auto& f = sim.command().force_n();
@@ -378,6 +404,12 @@ int main(int argc, char** argv) {
         "pushing the blade along (%.2f, %.2f, %.2f)\n",
         anatomy_row_n, anatomy_t, 1e3 * anatomy_point.x(), 1e3 * anatomy_point.y(),
         1e3 * anatomy_point.z(), -anatomy_normal.x(), -anatomy_normal.y(), -anatomy_normal.z());
+    std::printf("laryngoscopy_bench: the largest push on the blade per rigid body:");
+    for (const AnatomyPush& push : pushes) {
+      if (push.peak_n > 0.0)
+        std::printf(" %s %.3f N at %.2f s;", push.name.c_str(), push.peak_n, push.peak_t);
+    }
+    std::printf("\n");
     for (std::size_t b = 0; b < bodies; ++b) {
       std::printf(
           "laryngoscopy_bench: body '%s': peak tool force %.3f N, ticks touched %llu, largest node "

@@ -8,7 +8,9 @@
 # (miller_neutral.keyframes, miller_extended.keyframes), the extended airway
 # once more with the mouth opened wider and the hyoid let go
 # (miller_open.keyframes) and then with the larynx raised 6 mm as well
-# (miller_raised.keyframes), and the neutral Miller keyframes once more
+# (miller_raised.keyframes), with two wrong techniques beside it (the handle
+# rocked back, miller_levering.keyframes; the tip stopped short of the
+# epiglottis, miller_shallow.keyframes), and the neutral Miller keyframes once more
 # without the blade's contact with the lips; first,
 # how far the tongue and the epiglottis at rest reach above the lines of
 # sight to the glottis. Each run prints the blade's force on each body, their
@@ -132,15 +134,23 @@ grep -q '^  exclude_pairs: \[\[miller1, lips_face\]\]$' "$work/neutral_without_l
   "$bench" --scene "$work/open.yaml" --keyframes "$here/miller_open.keyframes" --seconds 13 \
     --trace-every 0.5
   echo '```'
-  echo
-  echo "### the same with the larynx raised 6 mm, the eye 30 mm above the blade, miller_raised.keyframes"
-  echo
-  echo '```'
-  # The scene's eye (300 mm along the blade, 100 mm above it) looks down
-  # over the upper lip on these airways; this run puts it 30 mm above.
-  "$bench" --scene "$work/raised.yaml" --keyframes "$here/miller_raised.keyframes" --seconds 13 \
-    --trace-every 0.5 --eye-in-tool-mm 300 30 0
-  echo '```'
+  # The larynx raised as well, with the eye 30 mm above the blade (the
+  # scene's eye, 300 mm along the blade and 100 mm above it, looks down over
+  # the upper lip on these airways): the Miller lift, then two wrong
+  # techniques on the same airway and eye (the handle rocked back behind the
+  # epiglottis instead of lifted; the tip stopped in front of it).
+  for motion in raised levering shallow; do
+    echo
+    case "$motion" in
+      raised) echo "### the same with the larynx raised 6 mm, the eye 30 mm above the blade, miller_raised.keyframes" ;;
+      *) echo "### the same airway and eye, a wrong technique: miller_$motion.keyframes" ;;
+    esac
+    echo
+    echo '```'
+    "$bench" --scene "$work/raised.yaml" --keyframes "$here/miller_$motion.keyframes" --seconds 13 \
+      --trace-every 0.5 --eye-in-tool-mm 300 30 0
+    echo '```'
+  done
   echo
   echo "### neutral airway without the blade's contact with the lips, miller_neutral.keyframes"
   echo
