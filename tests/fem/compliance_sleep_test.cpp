@@ -231,6 +231,50 @@ TEST(Compliance, TheRefreshBudgetLeavesColumnsOfAnOlderFactorUnlessRaised) {
   EXPECT_LT(largest_difference(8), 1e-6f);  // every column on the new factor
 }
 
+TEST(Compliance, TheRefreshBudgetServesTheLeadingSpheresBeforeStalerOnes) {
+  // Spheres 4-7 solved at rest, 0-3 ten refactorisations later, then ten
+  // more: asked for 0-7 in that order with the default budget (four a
+  // call), the two leading spheres (the rows the tick solved, the deepest
+  // first) are solved on the new factor although 4-7 are staler, and the
+  // two after them are not (the other half of the budget went to 4 and 5).
+  const BodyMesh mesh = test::bar_mesh(3);
+  const BodySettings settings = sagging_settings(8, CholmodFactorKind::kSupernodal);
+  const SphereLinks links = tip_spheres(mesh, 8);
+  auto used = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  auto fresh = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(used, nullptr);
+  ASSERT_NE(fresh, nullptr);
+  const std::vector<std::uint32_t> spheres = {0, 1, 2, 3, 4, 5, 6, 7};
+  const std::size_t rows = 3 * spheres.size();
+  std::vector<float> w_used(rows * rows), w_fresh(rows * rows);
+  ASSERT_TRUE(used->compliance(std::vector<std::uint32_t>{4, 5, 6, 7}, links, w_used));
+  for (int k = 0; k < 10; ++k) {
+    used->step();
+    fresh->step();
+  }
+  ASSERT_TRUE(used->compliance(std::vector<std::uint32_t>{0, 1, 2, 3}, links, w_used));
+  for (int k = 0; k < 10; ++k) {
+    used->step();
+    fresh->step();
+  }
+  ASSERT_TRUE(used->compliance(spheres, links, w_used));
+  ASSERT_TRUE(fresh->compliance(spheres, links, w_fresh));
+  // The largest difference within the diagonal blocks of spheres [first, end),
+  // relative to the largest entry of the fresh block.
+  float largest = 0.0f;
+  for (const float w : w_fresh) largest = std::max(largest, std::abs(w));
+  const auto difference = [&](std::size_t first, std::size_t end) {
+    float worst = 0.0f;
+    for (std::size_t r = 3 * first; r < 3 * end; ++r) {
+      for (std::size_t c = 3 * first; c < 3 * end; ++c)
+        worst = std::max(worst, std::abs(w_used[r * rows + c] - w_fresh[r * rows + c]));
+    }
+    return worst / largest;
+  };
+  EXPECT_LT(difference(0, 2), 1e-6f);  // the leading two: on the new factor
+  EXPECT_GT(difference(2, 4), 1e-4f);  // the next two: still from ten factorisations ago
+}
+
 TEST(Sleep, RestingBodySleepsAndWakesOnTouch) {
   const BodyMesh mesh = test::bar_mesh(2);
   BodySettings settings;

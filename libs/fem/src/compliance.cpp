@@ -48,7 +48,7 @@ void ComplianceBlock::reserve(std::size_t dofs, std::size_t max_spheres) {
   slots_.assign(kept, Slot{});
   columns_.assign(dofs * 3 * kept, 0.0);
   reaches_.assign(dofs * kept, 0);
-  sphere_dofs_.reserve(3 * 16);
+  sphere_dofs_.reserve(std::size_t{3} * 16);
   pairs_.assign(9 * kept * kept, 0.0);
   pair_known_.assign(kept * kept, 0);
   half_ = false;
@@ -228,8 +228,19 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
     if (!cached) to_solve_.push_back(request_slots_[s]);
   }
   // Spheres new to the block are solved in full; columns of an earlier
-  // factorisation are refreshed, the oldest first, up to the budget a call.
+  // factorisation are refreshed up to the budget a call: half of it to the
+  // first stale spheres in request order (the rows the tick solved, the
+  // deepest first: those whose W sets the force), the rest to the stalest,
+  // so that no column lags without bound.
   std::size_t refresh = 0;
+  const std::size_t leading = (refresh_per_call_ + 1) / 2;
+  for (std::size_t s = 0; s < k && refresh < leading; ++s) {
+    Slot& slot = slots_[request_slots_[s]];
+    if (!slot.valid || slot.factorisation == factorisation) continue;
+    slot.factorisation = factorisation;
+    to_solve_.push_back(request_slots_[s]);
+    ++refresh;
+  }
   while (refresh < refresh_per_call_) {
     std::size_t stalest = slots_.size();
     for (std::size_t s = 0; s < k; ++s) {

@@ -10,8 +10,11 @@
 // refactorisation the kept columns are those of the one before (a lagged
 // factor is refreshed when an element turned 0.1 rad: W from the previous
 // one differs by about that much); a budget of spheres a call
-// (refresh_per_call) is solved again on the new factor, the stalest first,
-// so a refactorisation costs no burst of solves for the whole block.
+// (refresh_per_call) is solved again on the new factor, so a
+// refactorisation costs no burst of solves for the whole block: half of
+// the budget goes to the first stale spheres in request order (the rows
+// the tick solved, the deepest first), the rest to the stalest, so no
+// column lags without bound.
 //
 // With a supernodal LL' factor (the tongue's) a sphere's columns are the
 // half solve Y_s = L^-1 P J_s^T, on the supernodes its DOFs reach only, and
@@ -39,7 +42,8 @@ class ComplianceBlock {
   void reserve(std::size_t dofs, std::size_t max_spheres);
   std::size_t capacity() const { return max_spheres_; }
   // Spheres whose kept columns are solved again on a newer factorisation
-  // per compute() call, oldest first (default 4); 0: never (columns of a
+  // per compute() call, half of them the first in the request, the others
+  // the stalest (default 4); 0: never (columns of a
   // sphere stay those of its first solve while it stays in the block).
   void set_refresh_per_call(std::size_t spheres) { refresh_per_call_ = spheres; }
   // The most factorisations a block's columns lagged behind since the last

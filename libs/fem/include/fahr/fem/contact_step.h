@@ -27,9 +27,10 @@
 //      its moves join the same carried correction; the nodes it moved are
 //      held by springs along the bone's normal in the next step's A
 //      (obstacle_support.h), so the implicit solve and W feel the bone;
-//   6. with a volume floor, each round of that alternation also keeps every
-//      tet above a share of its rest volume (volume_floor.h), so tissue
-//      squeezed between tool and bone gives way sideways, not flat.
+//   6. with a volume floor, in steps where the blade (or a load) presses, each
+//      round of that alternation also keeps every tet above a share of its
+//      rest volume (volume_floor.h), so tissue squeezed between tool and
+//      bone gives way sideways, not flat.
 // The correction and the projection are done here, not by Body::step,
 // because step 2 needs the motion before them. Staleness of a ContactSet is the caller's decision.
 // Capacities are fixed at construction: nothing allocates per step once the
@@ -73,7 +74,8 @@ struct ContactStepSettings {
   // and the step reports diverged_reset. 0: no check.
   double divergence_limit_m = 0.0;
   // A floor under every tet's volume, projected in each round between the
-  // tool's constraints and the anatomy's (volume_floor.h); ratio 0: off.
+  // tool's constraints and the anatomy's while the blade or an external load
+  // presses the body (volume_floor.h); ratio 0: off.
   VolumeFloorSettings volume_floor{};
 };
 
@@ -186,6 +188,7 @@ class ContactStep {
   std::unique_ptr<ObstacleProjection> obstacles_;
   std::unique_ptr<ObstacleSupport> supports_;  // with obstacles_ and a ratio > 0
   std::unique_ptr<VolumeFloor> volume_floor_;  // with a floor ratio > 0
+  bool external_load_ = false;                 // this step's extra forces are not all 0
   ProjectionReport projection_;
   Eigen::Vector3d tool_force_n_ = Eigen::Vector3d::Zero();  // this step's applied tool forces
   Eigen::Vector3d tool_reaction_n_ = Eigen::Vector3d::Zero();
