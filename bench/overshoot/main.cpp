@@ -421,7 +421,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       "contacts,"
       "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,"
       "inverted_free,fem_cpu_ms,supported_nodes,"
-      "volume_floor_below,volume_floor_unresolved,tool_force_sum_n,tool_largest_force_n\n");
+      "volume_floor_below,volume_floor_unresolved,tool_force_sum_n,tool_largest_force_n,"
+      "fem_tool_reaction_n,fem_tool_projection_n\n");
   std::FILE* tick_trace = open_trace(
       tick_trace_path, r.name,
       "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,"
@@ -575,7 +576,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         std::fprintf(trace,
                      "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,"
                      "%d,%d,%.3f,"
-                     "%.3f\n",
+                     "%.3f,%.4f,%.4f\n",
                      sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
                      report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
                      report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
@@ -585,7 +586,10 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                      inverted_free(sim),
                      1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
                      report.projection.obstacle_supported, report.projection.volume_floor_below,
-                     report.projection.volume_floor_unresolved, tc.force_sum_n, tc.largest_force_n);
+                     report.projection.volume_floor_unresolved, tc.force_sum_n, tc.largest_force_n,
+                     sim.fem().contact_step().tool_reaction_n().norm(),
+                     sim.fem().contact_step().projection().tool_push_kg_m.norm() /
+                         (sim.body().time_step_s() * sim.body().time_step_s()));
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
