@@ -74,11 +74,14 @@ struct Result {
   double max_commanded_n = 0.0;
   double max_reaction_n = 0.0;
   double max_reaction_lost_ratio = 0.0;  // reaction / limit while lost track (as sent)
-  // Measured on the FEM side, per FEM step while lost track: the tool's
-  // push on the tissue (fem::ContactStep::tool_reaction_n) over the limit,
-  // and how much deeper the tissue reached into the held blade than when
-  // it froze (nodes' depth in the blade's field at the proxy's pose).
+  // Measured on the FEM side, per FEM step on a ContactSet sent while lost
+  // track: the tool's push on the tissue (fem::ContactStep::tool_reaction_n)
+  // over the limit, and how much deeper the tissue reached into the held
+  // blade than when it froze (nodes' depth in the blade's field at the
+  // proxy's pose). The same push of a step on the last set before the hold,
+  // taken while the device was already lost, apart.
   double max_fem_reaction_lost_ratio = 0.0;
+  double max_fem_reaction_transition_ratio = 0.0;
   double max_fem_reaction_n = 0.0;
   double max_flow_into_held_m = 0.0;
   double strain_1x = 0.0, strain_3x = 0.0;
@@ -433,6 +436,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
   bool seen_1x = false, was_lost = false, reengaged = false, left = false, touched = false;
+  double set_limit = 0.0;  // the limit at the tick whose ContactSet the FEM applies next
   std::vector<Eigen::Vector3d> found(sim.body().node_count());  // the tongue the blade found
   std::uint64_t reengaged_step = 0, left_step = 0;
   Eigen::Vector3d freeze_proxy = Eigen::Vector3d::Zero(), previous_force = Eigen::Vector3d::Zero();
@@ -507,18 +511,28 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         for (const std::uint32_t n : sim.body().element_rest().tets[survey.worst])
           r.worst_1x_rest_mm += 1e3 / 4.0 * sim.body().rest_position(n);  // centroid, mm
       }
+      // A FEM step applies the ContactSet of the tick before (StackSim::step):
+      // the held tool's push is that of steps on sets the haptic side sent
+      // while it had lost track, against the limit it then rendered. The
+      // step on the last set before the hold is the free tool's; it is
+      // counted apart (transition_fem_reaction_ratio).
+      if (sim.fem_stepped() && (was_lost || c.lost_track())) {
+        const double fem_reaction = sim.fem().contact_step().tool_reaction_n().norm();
+        if (was_lost) {
+          r.max_fem_reaction_lost_ratio =
+              std::max(r.max_fem_reaction_lost_ratio, fem_reaction / set_limit);
+          r.max_flow_into_held_m =
+              std::max(r.max_flow_into_held_m, deepest_in_blade_m(sim) - depth_at_freeze_m);
+        } else {
+          r.max_fem_reaction_transition_ratio =
+              std::max(r.max_fem_reaction_transition_ratio, fem_reaction / set_limit);
+        }
+      }
       if (c.lost_track()) {
         ++r.lost_ticks;
         if (!was_lost) {
           freeze_proxy = common::to_eigen(c.world_from_proxy().position_m());
           depth_at_freeze_m = deepest_in_blade_m(sim);
-        }
-        if (sim.fem_stepped()) {
-          const double fem_reaction = sim.fem().contact_step().tool_reaction_n().norm();
-          r.max_fem_reaction_lost_ratio =
-              std::max(r.max_fem_reaction_lost_ratio, fem_reaction / limit);
-          r.max_flow_into_held_m =
-              std::max(r.max_flow_into_held_m, deepest_in_blade_m(sim) - depth_at_freeze_m);
         }
         r.max_reaction_lost_ratio =
             std::max(r.max_reaction_lost_ratio, c.tissue_reaction_n() / limit);
@@ -543,6 +557,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         reengaged_step = k;
       }
       was_lost = c.lost_track();
+      set_limit = limit;
       const Eigen::Vector3d hand_v = common::to_eigen(pose.linear_velocity_mps());
       if (reengaged && k >= reengaged_step && k < reengaged_step + 50) {
         r.max_reengage_step_n = std::max(r.max_reengage_step_n, (force - previous_force).norm());
@@ -725,6 +740,9 @@ int main(int argc, char** argv) {
                 fa.max_reaction_lost_ratio);
     std::printf("| largest reaction / limit while lost track, FEM side | %.4f | - |\n",
                 fa.max_fem_reaction_lost_ratio);
+    std::printf(
+        "| ... on the last set before the hold, applied after the device lost track | %.4f | - |\n",
+        fa.max_fem_reaction_transition_ratio);
     std::printf("| tissue into the held blade beyond its depth at the freeze mm | %.3f | - |\n",
                 mm(fa.max_flow_into_held_m));
     std::printf("| lost-track ticks | %llu | - |\n",
