@@ -6,7 +6,8 @@
 # triangle-level baseline finding the blade's contacts with the tongue;
 # prints the haptic tick's thread-CPU time (median, p99, p99.9, max over the
 # whole run) and the number of tick periods longer than 1.5 ms, each run's
-# tick parts as the haptic service prints them, and each run's summary.
+# tick parts as the haptic service prints them, the FEM service's end lines
+# (stale ContactSets, resets, its slowest step) and each run's summary.
 #
 #   bench/intubation.sh [BUILD_DIR] [--seconds 60] [--dds cyclonedds] [--scene FILE]
 #                       [--cpus-fem LIST --cpus-haptic LIST] [--only aist|triangle]
@@ -78,6 +79,15 @@ tables() {
     echo "$collision, tick parts:"
     echo
     sed -nE 's/^fahr_haptic_service: (tick part .*)/    \1/p' "$out/$collision/haptic.log"
+  done
+  # The FEM service's end lines: stale ContactSets (ignored, the tongue then
+  # stepped without the tool), resets, its slowest step and what it did.
+  for collision in "${collisions[@]}"; do
+    echo
+    echo "$collision, FEM service:"
+    echo
+    sed -nE "s/^fahr_fem_service: ((body '[^']*': )?([0-9]+ steps, stale .*|slowest step .*))/    \\1/p" \
+      "$out/$collision/fem.log"
   done
   # Each run's summary (fahr_run_summary's tables, as run_local.sh prints them).
   for collision in "${collisions[@]}"; do
