@@ -307,6 +307,20 @@ TEST(StaleRule, ASetAnsweringAnOlderStateIsAppliedUntilTheSenderIsSilent) {
   step.step(t0 + age_ns + 1);
   EXPECT_FALSE(step.last_report().contacts_applied);
   EXPECT_EQ(step.stale_sets(), 2u);
+  // The first silence (one stale step) ended with the set at t0: the sender
+  // was late. The second has no newer set after it yet: it may be the
+  // sender's end.
+  EXPECT_EQ(step.stale_sets_followed(), 1u);
+  step.step(t0 + age_ns + 2);
+  step.step(t0 + age_ns + 3);
+  EXPECT_EQ(step.stale_sets(), 4u);
+  EXPECT_EQ(step.stale_sets_followed(), 1u);
+  // A newer set ends it: its three stale steps were a late sender's too.
+  step.take(pressing_set(setup, sphere, setup.layout_fingerprint), 3, t0 + age_ns + 4);
+  step.step(t0 + age_ns + 5);
+  EXPECT_TRUE(step.last_report().contacts_applied);
+  EXPECT_EQ(step.stale_sets(), 4u);
+  EXPECT_EQ(step.stale_sets_followed(), 4u);
 }
 
 }  // namespace

@@ -216,11 +216,12 @@ void print_end_lines(const BodySteps& steps) {
     const std::string body =
         steps.size() > 1 ? "body '" + fem_step.setup().scene_body->name + "': " : "";
     std::printf(
-        "fahr_fem_service: %s%llu steps, stale contact sets %llu, refused (another sphere "
-        "layout) %llu, max inverted elements %llu, resets after divergence %llu, steps shortened "
-        "by the line search %llu\n",
+        "fahr_fem_service: %s%llu steps, stale contact sets %llu (a newer set followed %llu), "
+        "refused (another sphere layout) %llu, max inverted elements %llu, resets after "
+        "divergence %llu, steps shortened by the line search %llu\n",
         body.c_str(), static_cast<unsigned long long>(fem_step.setup().body->step_index()),
         static_cast<unsigned long long>(fem_step.stale_sets()),
+        static_cast<unsigned long long>(fem_step.stale_sets_followed()),
         static_cast<unsigned long long>(fem_step.layout_check().refused()),
         static_cast<unsigned long long>(fem_step.inverted_max()),
         static_cast<unsigned long long>(fem_step.divergence_resets()),

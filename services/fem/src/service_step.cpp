@@ -110,7 +110,13 @@ void ServiceStep::step(std::int64_t now_ns) {
   // The body judges a set by steps (fem::ContactSet::received_step): this
   // one is current at this step.
   if (usable) contacts_.received_step = setup_.body->step_index();
-  if (have_contacts_ && !usable) ++stale_sets_;
+  if (have_contacts_ && !usable) {
+    ++stale_sets_;
+    ++stale_run_;
+  } else if (usable) {
+    stale_followed_ += stale_run_;
+    stale_run_ = 0;
+  }
   const std::int64_t start_ns = common::monotonic_now_ns();
   const std::uint64_t solves_before = contact_step_.compliance_solves();
   last_report_ = contact_step_.step(usable ? &contacts_ : nullptr);
@@ -210,6 +216,7 @@ void ServiceStep::take_errors(std::vector<std::string>& errors) {
 
 void ServiceStep::metrics(std::vector<std::pair<std::string, double>>& out) const {
   out.emplace_back("stale_contact_sets", static_cast<double>(stale_sets_));
+  out.emplace_back("stale_contact_sets_followed", static_cast<double>(stale_followed_));
   out.emplace_back("layout_refused_sets", static_cast<double>(layout_check_.refused()));
   out.emplace_back("non_finite_contact_sets", static_cast<double>(non_finite_sets()));
   out.emplace_back("ahead_contact_sets", static_cast<double>(ahead_sets()));

@@ -62,6 +62,10 @@ class ServiceStep {
   LayoutCheck& layout_check() { return layout_check_; }
   const LayoutCheck& layout_check() const { return layout_check_; }
   std::uint64_t stale_sets() const { return stale_sets_; }
+  // Of those, the steps a newer set followed: the sender was late, not gone.
+  // A run's end, where the haptic service stops sending before the FEM
+  // stops stepping, leaves its last set stale for good and is not among them.
+  std::uint64_t stale_sets_followed() const { return stale_followed_; }
   std::uint64_t inverted_max() const { return inverted_max_; }
   // Steps after which the body had diverged and was reset to rest
   // (fem::StepReport::diverged_reset).
@@ -159,6 +163,8 @@ class ServiceStep {
   std::uint64_t anatomy_beyond_steps_ = 0;
   double anatomy_depth_max_m_ = 0.0;
   std::uint64_t stale_sets_ = 0;
+  std::uint64_t stale_run_ = 0;  // stale steps since the last usable set
+  std::uint64_t stale_followed_ = 0;
   std::int64_t background_cpu_taken_ns_ = 0;
 };
 
