@@ -33,7 +33,9 @@
 // bound, the tongue within 1 mm of where the blade found it 1 s after the
 // blade leaves it). --check-release: the targets for any tet mesh only (no
 // FEM step diverged, no tet inverted after the blade left, the tongue within
-// 1 mm of where the blade found it 1 s later).
+// 1 mm of where the blade found it 1 s later). --check-hold: those and the
+// hold's, all of --check but no inverted tet and no torn element while the
+// blade presses (which the shipped tongue does not meet at every pull).
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -652,6 +654,7 @@ int main(int argc, char** argv) {
   RunChoices choices;
   bool check = false;
   bool check_release = false;
+  bool check_hold = false;
   std::string response = "both";
   std::string fem_anatomy = "on";
   app.add_option("--scene", scene_path, "scene file");
@@ -712,6 +715,13 @@ int main(int argc, char** argv) {
                "no tet inverted after the blade left, the tongue within 1 mm of where the blade "
                "found it 1 s later (the targets for any tet mesh)")
       ->excludes("--check");
+  app.add_flag("--check-hold", check_hold,
+               "exit 1 unless the force-aware run holds the tool as it must and leaves the "
+               "tongue sound: --check-release's targets and the hold's (lost track for 4 s, the "
+               "FEM-side push, the tissue into the held blade, no strain growth, the gap, the "
+               "re-engagement step), not --check's no inversion and no torn element")
+      ->excludes("--check")
+      ->excludes("--check-release");
   if (const auto exit = app.parse(argc, argv)) return *exit;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
@@ -819,7 +829,7 @@ int main(int argc, char** argv) {
                   stiffening > 0.0 ? "" : " off");
       if (response != "penalty") print_radius_ratio_table(fa);
     }
-    if (!check && !check_release) return 0;
+    if (!check && !check_release && !check_hold) return 0;
     if (response == "penalty") throw std::runtime_error("--check needs the force-aware run");
     int failures = 0;
     const auto expect = [&](bool ok, const char* what) {
@@ -828,35 +838,37 @@ int main(int argc, char** argv) {
     };
     expect(fa.finite && fa.divergence_resets == 0,
            "force-aware: every force and gap finite, no FEM step diverged");
-    if (check_release) {
-      expect(fa.max_inverted_after_left == 0, "force-aware: no inverted tet after the blade left");
-      expect(
-          fa.displacement_after_from_found_m >= 0.0 && fa.displacement_after_from_found_m <= 1e-3,
-          "force-aware: tongue within 1 mm of where the blade found it, 1 s after the blade "
-          "left it");
-      return failures == 0 ? 0 : 1;
+    if (check) {
+      // What the tissue must survive: neither holds on the shipped tongue at
+      // every pull yet (robustness.sh, docs/design/anatomy-contact.md).
+      expect(fa.max_inverted == 0, "force-aware: no inverted tet");
+      expect(fa.torn_1x == 0 && fa.torn_3x == 0,
+             "force-aware: no element stretched to twice its rest length at 1x or at the end "
+             "of the hold");
     }
-    expect(fa.max_inverted == 0, "force-aware: no inverted tet");
-    // The hold is 5 s (kHoldEndS); the figure is the paper's regime only if
-    // the device was lost for most of it.
-    expect(fa.lost_ticks >= 4000,
-           "force-aware: the device lost track for at least 4 s (the hold is 5 s)");
-    expect(fa.max_fem_reaction_lost_ratio <= 1.05,
-           "force-aware: the tool's push on the tissue (FEM side) <= 1.05 x limit while lost "
-           "track");
-    expect(fa.max_flow_into_held_m <= 5e-4,
-           "force-aware: the tissue reaches at most 0.5 mm deeper into the held blade than at "
-           "the freeze");
-    expect(fa.strain_3x <= fa.strain_1x * 1.05 + 1e-3,
-           "force-aware: no strain growth from 1x to 3x");
-    expect(fa.torn_1x == 0 && fa.torn_3x == 0,
-           "force-aware: no element stretched to twice its rest length at 1x or at the end of the "
-           "hold");
-    expect(
-        fa.max_gap_error_m <= 1e-4,
-        "force-aware: published gap = (commanded - limit) / K_c within 0.1 mm at the peak limit");
-    expect(fa.max_reengage_step_n <= fa.reengage_bound_n + 1e-9,
-           "force-aware: re-engagement force step within the bound");
+    if (check || check_hold) {
+      // The hold is 5 s (kHoldEndS); the figure is the paper's regime only if
+      // the device was lost for most of it.
+      expect(fa.lost_ticks >= 4000,
+             "force-aware: the device lost track for at least 4 s (the hold is 5 s)");
+      expect(fa.max_fem_reaction_lost_ratio <= 1.05,
+             "force-aware: the tool's push on the tissue (FEM side) <= 1.05 x limit while lost "
+             "track");
+      expect(fa.max_flow_into_held_m <= 5e-4,
+             "force-aware: the tissue reaches at most 0.5 mm deeper into the held blade than at "
+             "the freeze");
+      expect(fa.strain_3x <= fa.strain_1x * 1.05 + 1e-3,
+             "force-aware: no strain growth from 1x to 3x");
+      expect(
+          fa.max_gap_error_m <= 1e-4,
+          "force-aware: published gap = (commanded - limit) / K_c within 0.1 mm at the peak limit");
+      expect(fa.max_reengage_step_n <= fa.reengage_bound_n + 1e-9,
+             "force-aware: re-engagement force step within the bound");
+    }
+    if (!check) {
+      // (--check's "no inverted tet" covers the time after the blade left.)
+      expect(fa.max_inverted_after_left == 0, "force-aware: no inverted tet after the blade left");
+    }
     expect(fa.displacement_after_from_found_m >= 0.0 && fa.displacement_after_from_found_m <= 1e-3,
            "force-aware: tongue within 1 mm of where the blade found it, 1 s after the blade left "
            "it");
