@@ -517,7 +517,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       // the held tool's push is that of steps on sets the haptic side sent
       // while it had lost track, against the limit it then rendered. The
       // step on the last set before the hold is the free tool's; it is
-      // counted apart (transition_fem_reaction_ratio).
+      // counted apart (max_fem_reaction_transition_ratio).
       if (sim.fem_stepped() && (was_lost || c.lost_track())) {
         const double fem_reaction = sim.fem().contact_step().tool_reaction_n().norm();
         if (was_lost) {
