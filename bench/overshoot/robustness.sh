@@ -94,7 +94,7 @@ field() {  # the force-aware column of a table row
       torn=$(field "elements stretched past principal Green strain 1.5 (twice the rest length) at 1x / at the end of the hold" "$file" | cut -d/ -f1)
       push=$(field "largest reaction / limit while lost track, FEM side" "$file")
       [ "${torn// /}" = 0 ] && whole=$((whole + 1))
-      awk -v p="$push" 'BEGIN { exit !(p + 0 <= 1.05) }' && held=$((held + 1))
+      [ -n "$push" ] && awk -v p="$push" 'BEGIN { exit !(p + 0 <= 1.05) }' && held=$((held + 1))
       echo "| $mesh | $f | $verdict | $(field "FEM steps that diverged (tongue reset to rest)" "$file") |" \
            "$(field "most inverted tets" "$file") ($(field "most inverted tets after the blade left" "$file")) |" \
            "$(field "tongue 1 s after the blade left: from rest / from where the blade found it mm" "$file") |" \
