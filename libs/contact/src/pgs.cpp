@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fahr/geometry/vector_clones.h"
+
 namespace fahr::contact {
 
 // The residual r = b - S lambda is kept up to date instead of recomputed row
@@ -13,8 +15,9 @@ namespace fahr::contact {
 // dependency that the compiler vectorises. Recomputing r_i as a k-long dot
 // product per row visit was a serial chain of additions, four times slower
 // per row on this machine, and paid for rows that never move.
-PgsReport solve_pgs(const double* s, std::size_t stride, std::size_t k, const double* b,
-                    double* lambda, double* residual, const PgsSettings& settings) {
+FAHR_VECTOR_CLONES PgsReport solve_pgs(const double* s, std::size_t stride, std::size_t k,
+                                       const double* b, double* lambda, double* residual,
+                                       const PgsSettings& settings) {
   PgsReport report;
   if (k == 0) return report;
   for (std::size_t i = 0; i < k; ++i) {

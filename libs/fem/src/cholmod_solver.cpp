@@ -16,6 +16,8 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/geometry/vector_clones.h"
+
 namespace fahr::fem {
 
 namespace {
@@ -400,7 +402,8 @@ std::size_t CholmodSolver::reach(std::span<const std::uint32_t> dofs, std::span<
   return count;
 }
 
-void CholmodSolver::forward3_on_reach(std::span<const int> reach, std::span<double> y) {
+FAHR_VECTOR_CLONES void CholmodSolver::forward3_on_reach(std::span<const int> reach,
+                                                         std::span<double> y) {
   State& s = *state_;
   const cholmod_factor& f = *s.factor;
   const int* super = static_cast<const int*>(f.super);

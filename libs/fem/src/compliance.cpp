@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 
+#include "fahr/geometry/vector_clones.h"
+
 namespace fahr::fem {
 namespace {
 
@@ -144,8 +146,8 @@ void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
   }
 }
 
-const double* ComplianceBlock::half_product(std::size_t s, std::size_t t,
-                                            const CholmodSolver& factor) {
+FAHR_VECTOR_CLONES const double* ComplianceBlock::half_product(std::size_t s, std::size_t t,
+                                                               const CholmodSolver& factor) {
   const std::size_t count = slots_.size();
   double* block = pairs_.data() + 9 * (s * count + t);
   if (pair_known_[s * count + t] != 0) return block;
