@@ -51,6 +51,7 @@ if [ ${#markdown[@]} -gt 0 ] && [ ! -x "$results" ]; then
   exit 2
 fi
 
+load_at_start=$(cut -d" " -f1-3 /proc/loadavg)  # for the results file, written at the end
 out=$(mktemp -d /tmp/fahr-intubation-bench-XXXXXX)
 trap 'rm -rf "$out"' EXIT
 for collision in "${collisions[@]}"; do
@@ -101,7 +102,7 @@ tables() {
 }
 
 if [ ${#markdown[@]} -gt 0 ]; then
-  tables | "$results" intubation "${markdown[@]}" -- "${command[@]}"
+  tables | "$results" intubation "${markdown[@]}" --started "$SECONDS" "$load_at_start" -- "${command[@]}"
 else
   tables
 fi
