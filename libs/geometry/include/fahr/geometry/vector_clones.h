@@ -7,8 +7,9 @@
 // give different bits and a lockstep run would hash differently on machines
 // of either kind. Without FMA, and without reassociation (no -ffast-math),
 // vectorising changes how many elements an instruction takes, never the
-// operations on each: both clones give the same bits (the lockstep hashes
-// of fahr_stack_sim_run did not move). Lives in fahr::geometry because
+// operations on each: both clones give the same bits, which the pinned
+// lockstep hashes (tests/determinism, stack_sim_pinned_hashes) check on
+// whichever clone the test machine runs. Lives in fahr::geometry because
 // every physics library links it.
 #pragma once
 
