@@ -8,7 +8,7 @@ set -euo pipefail
 run="${1:?usage: pinned_hashes_test.sh STACK_SIM_RUN SCENE}"
 scene="${2:?usage: pinned_hashes_test.sh STACK_SIM_RUN SCENE}"
 
-# Pinned on: an Intel Xeon (AVX-512; an AMD EPYC gave the same earlier ones), OpenBLAS 0.3.21 (Debian libopenblas0-pthread) held to its
+# Pinned on: an AMD EPYC (an Intel Xeon with AVX-512 gave the same earlier ones), OpenBLAS 0.3.21 (Debian libopenblas0-pthread) held to its
 # Haswell kernels and one thread, g++ 12.2 (Debian 12), CMAKE_BUILD_TYPE=Release.
 # The pinned hashes live beside this script; the DDS lockstep test compares its runs to them too.
 pinned="$(dirname "$0")/neonatal_4s.hashes"

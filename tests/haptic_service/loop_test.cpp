@@ -313,6 +313,58 @@ TEST(HapticLoop, TheWBlockKeepsItsSpheresWhileTheyStayAmongTheDeepest) {
   EXPECT_LT(most_gone, kComplianceLookAhead / 4);
 }
 
+// Rows without W as the intubation script brings the blade to the resting
+// tongue, played `speedup` times as fast, until the first tick on which the
+// blade pushes on a sphere. A FEM state every 5 ticks has W for what the
+// ContactSet named when the state before came, so W is one to two FEM
+// periods late, as from the FEM service. Only contacts within the row
+// margin are rows; the rest of the candidate margin is the block's
+// look-ahead. (Past the touch this resting tongue does not give way, so
+// more contacts crowd into the row margin than any block holds.)
+std::uint64_t rows_without_w_until_touch(double speedup) {
+  PressRig rig;           // its loop and buffers only: the script moves the blade
+  msg::ContactSet asked;  // the ContactSet when the last state came
+  const device::Trajectory script = device::intubation_script();
+  std::uint64_t margin_ticks = 0;  // ticks with contacts within the margin
+  for (std::uint64_t tick = 0; tick < 13000; ++tick) {
+    if (tick % 5 == 0 && tick > 0) {
+      EXPECT_TRUE(
+          rig.digest.digest(rest_with_compliance(rig.setup, asked, tick / 5), rig.snapshot));
+      asked = rig.contacts;
+    }
+    const auto p =
+        script.at(std::chrono::duration<double>(1e-3 * speedup * static_cast<double>(tick)));
+    rig.loop.tick(device_pose(tick, p.position_m, script_pitch_deg(p.orientation)), rig.snapshot,
+                  rig.command, rig.contacts);
+    const bool pushing = std::any_of(
+        rig.contacts.contacts().begin(), rig.contacts.contacts().end(), [](const msg::Contact& c) {
+          return c.kind() != msg::CONTACT_OBSTACLE && c.force_n() > 0.0;
+        });
+    if (pushing) {
+      EXPECT_GT(margin_ticks, 5u) << "the blade pushed on the tongue almost as it came near";
+      return rig.loop.metrics().rows_without_compliance.load();
+    }
+    margin_ticks += rig.loop.last_phases().tissue_query.contacts > 0 ? 1 : 0;
+  }
+  ADD_FAILURE() << "the blade never pushed on the tongue at " << speedup << "x";
+  return 0;
+}
+
+// W arrives one or two FEM periods after a sphere is asked for; the band
+// between the row margin (0.5 mm) and the candidate margin (1 mm) is asked
+// for before it can be a row. At the script's pace every row has its W
+// when the blade first pushes on the tongue (with rows taken within the
+// whole 1 mm margin, 333 contact-ticks had none); eight times as fast, the
+// blade outruns the band: the check can fail.
+TEST(HapticLoop, TheLookAheadBandGivesEveryRowItsWOnAnApproach) {
+  const std::uint64_t paced = rows_without_w_until_touch(1.0);
+  const std::uint64_t fast = rows_without_w_until_touch(8.0);
+  std::printf("rows without W until the blade pushes: %llu at the script's pace, %llu at 8x\n",
+              static_cast<unsigned long long>(paced), static_cast<unsigned long long>(fast));
+  EXPECT_EQ(paced, 0u);
+  EXPECT_GT(fast, 0u) << "the fast approach found W everywhere: nothing was tested";
+}
+
 // A tongue that jumped (a new reset epoch) is not rendered as it jumped:
 // the force changes by at most 0.1 N a tick until it matches what the new
 // state gives. The same stiffer tongue without a new epoch is the control:

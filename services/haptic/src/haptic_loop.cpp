@@ -109,6 +109,7 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
       order_(kToolContactCapacity, 0),
       row_key_(kToolContactCapacity, 0.0),
       order_scratch_(setup.bodies.size() * msg::MAX_COMPLIANCE_SPHERES, 0),
+      free_depth_m_(setup.bodies.size() * msg::MAX_COMPLIANCE_SPHERES, 0.0),
       request_of_(msg::MAX_COMPLIANCE_SPHERES, 0),
       requests_(msg::MAX_COMPLIANCE_SPHERES),
       anatomy_contacts_(kAnatomyContactCapacity),
@@ -119,6 +120,7 @@ HapticLoop::HapticLoop(const HapticSetup& setup)
       tissue_row_budget_(std::min<std::size_t>(
           compliance_block_ - std::min(kComplianceLookAhead, compliance_block_ / 3),
           setup.response.max_rows)),
+      row_margin_m_(std::clamp(setup.row_margin_m, 0.0, setup.candidate_margin_m)),
       rows_(setup.response.max_rows) {
   if (setup.collision == CollisionMethod::kTriangle) {
     triangle_contacts_.reserve(kToolContactCapacity);
@@ -177,12 +179,27 @@ contact::DeviceSample HapticLoop::device_sample(const msg::DevicePose& pose) {
   return d;
 }
 
-// The rows: every contact whose sphere has W in this state (the FEM's
-// block, compliance_block_ spheres), the deepest first (haptic_setup.h
-// RowCompliance: by depth, or with a W sphere's depth taken on its free
-// centre), at most the row budget. No constant stands in for the tissue: a
-// contact without W is never a row. Those among the budget's deepest
-// contacts are counted (rows without tissue compliance).
+// The rows: every contact within the row margin whose sphere has W in this
+// state (the FEM's block, compliance_block_ spheres), the deepest first, at
+// most the row budget. No constant stands in for the tissue: a contact
+// without W is never a row. Those among the budget's deepest contacts are
+// counted (rows without tissue compliance). Contacts between the row margin
+// and the candidate margin are never rows; they are the look-ahead from
+// which the block's free slots are filled, so a sphere has its W by the
+// time it enters the row margin.
+//
+// Depth is the one the solve uses: a W sphere's on its free-motion centre
+// when the FEM sent them (collect_tissue_rows), the others' on their
+// published centres, which the FEM did not project. A W sphere's published
+// depth reads about zero after the FEM's projection; ranked by it, every
+// row of the last ContactSet looked shallower than the unprojected contacts
+// beside it, those were counted as rows without W although the solve's rows
+// were deeper, and 362 solves in the 20 s intubation ran to the sweep cap
+// against 21 (docs/design/compliance-block.md). A W sphere's free depth is
+// taken once per FEM state, at the tool's pose on its first tick: taken on
+// every tick, the rows at the budget's edge changed with the proxy's motion
+// of the tick before, and on one state the force alternated by 0.08 N from
+// one tick to the next.
 //
 // The block's other slots go to the deepest of the remaining contacts, with
 // W or without (requests: candidates in the next ContactSet), so the FEM's
@@ -207,13 +224,33 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
   const std::size_t n = std::min(tool_contacts_.size(), order_.size());
   std::size_t with_w = 0;
   std::size_t without_w = 0;
+  // A W sphere's key is its free-motion depth at the tool's pose on the
+  // first tick of its FEM state: the depth its row is solved at, fixed while
+  // the state is (the penalty baseline reads the published centres).
+  const bool free_depth = tissue.from_fem && tissue.have_free_centres && !setup_.penalty;
+  if (free_depth &&
+      (!free_depth_valid_ || free_depth_step_ != tissue.fem_step ||
+       free_depth_writer_ != tissue.fem_writer || free_depth_epoch_ != tissue.reset_epoch)) {
+    const Eigen::Isometry3d tool_from_world = tool_body_.world_from_body.inverse();
+    for (std::size_t w = 0; w < tissue.compliance_count; ++w) {
+      // As the query measures a sphere: radius plus skin less the distance.
+      const float* f = tissue.free_centres_m.data() + 3 * static_cast<std::ptrdiff_t>(w);
+      const Eigen::Vector3d c = tool_from_world * Eigen::Vector3d(f[0], f[1], f[2]);
+      const double d = tool_body_.grid != nullptr ? tool_body_.grid->distance(c)
+                                                  : tool_body_.sdf->grid_distance(c);
+      free_depth_m_[w] =
+          tissue.spheres.radii_m()[tissue.compliance_ids[w]] + tool_query_.contact_skin_m - d;
+    }
+    free_depth_step_ = tissue.fem_step;
+    free_depth_writer_ = tissue.fem_writer;
+    free_depth_epoch_ = tissue.reset_epoch;
+    free_depth_valid_ = true;
+  }
   for (std::uint32_t i = 0; i < n; ++i) {
-    const std::int32_t w = tissue.compliance_index[tool_contacts_[i].sphere_id];
-    double key = tool_contacts_[i].depth_m;
-    // |c - c_free| stands for (c - c_free) . n, the FEM's shift being along
-    // the pushing normals.
-    if (w >= 0 && setup_.row_compliance == RowCompliance::kFreeDepth)
-      key += double{tissue.free_shift_m[static_cast<std::size_t>(w)]};
+    const collision::SphereContact& s = tool_contacts_[i];
+    const std::int32_t w = tissue.compliance_index[s.sphere_id];
+    const double key =
+        w >= 0 && free_depth ? free_depth_m_[static_cast<std::size_t>(w)] : s.depth_m;
     row_key_[i] = key;
     if (w >= 0 && with_w < order_scratch_.size()) {
       order_scratch_[with_w++] = i;
@@ -222,27 +259,38 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
     }
   }
   const auto deeper = [&](std::uint32_t a, std::uint32_t b) { return row_key_[a] > row_key_[b]; };
-  const auto with_w_end = order_scratch_.begin() + static_cast<std::ptrdiff_t>(with_w);
-  row_pick_ = std::min(with_w, tissue_row_budget_);
+  // Only contacts within the row margin are rows; the rest of the candidate
+  // margin is the W look-ahead.
+  const double row_floor = -row_margin_m_;
+  const auto in_row_band = [&](std::uint32_t i) { return row_key_[i] > row_floor; };
+  // The W spheres (at most the block, so all of them), deepest first: the
+  // rows, then the deepest W spheres that are not rows.
+  std::sort(order_scratch_.begin(), order_scratch_.begin() + static_cast<std::ptrdiff_t>(with_w),
+            deeper);
+  row_pick_ = 0;
+  while (row_pick_ < std::min(with_w, tissue_row_budget_) &&
+         in_row_band(order_scratch_[row_pick_])) {
+    ++row_pick_;
+  }
   const std::size_t others_wanted = compliance_block_ - row_pick_;
-  // The rows, then the deepest W spheres that are not rows.
   const auto kept_begin = order_scratch_.begin() + static_cast<std::ptrdiff_t>(row_pick_);
   const std::size_t kept = std::min(with_w - row_pick_, others_wanted);
-  std::partial_sort(order_scratch_.begin(), kept_begin + static_cast<std::ptrdiff_t>(kept),
-                    with_w_end, deeper);
   // The deepest contacts without W, as far as either use needs them.
   const auto without_w_end = order_.begin() + static_cast<std::ptrdiff_t>(without_w);
   const std::size_t sorted = std::min(without_w, std::max(tissue_row_budget_, others_wanted));
   std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(sorted),
                     without_w_end, deeper);
-  // Rows without W: contacts without W deeper than the budget-th deepest
-  // contact of all (what a ranking by depth alone would have made rows).
-  const std::size_t row_ranked = std::min(sorted, tissue_row_budget_);
+  // Rows without W: contacts without W within the row margin and deeper
+  // than the budget-th deepest contact of all (what a ranking by depth alone
+  // would have made rows).
+  std::size_t row_ranked = 0;
+  while (row_ranked < std::min(sorted, tissue_row_budget_) && in_row_band(order_[row_ranked]))
+    ++row_ranked;
   std::size_t deep_without_w = 0;
   std::size_t touching = 0;
   if (n <= tissue_row_budget_) {
-    deep_without_w = without_w;
-    for (std::size_t k = 0; k < without_w; ++k) touching += row_key_[order_[k]] > 0.0 ? 1 : 0;
+    deep_without_w = row_ranked;
+    for (std::size_t k = 0; k < row_ranked; ++k) touching += row_key_[order_[k]] > 0.0 ? 1 : 0;
   } else {
     // Merge the two descending heads (each sorted as far as the budget)
     // for the budget deepest contacts.
@@ -275,7 +323,11 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
   std::copy_n(order_scratch_.begin(), row_pick_, order_.begin());
   std::copy_n(request_of_.begin(), request_count_,
               order_.begin() + static_cast<std::ptrdiff_t>(row_pick_));
-  relaxed_add<std::uint64_t>(metrics_.rows_dropped, n - row_pick_);
+  // Dropped: contacts within the row margin that are not rows (the look-ahead
+  // band's are not rows by design).
+  std::size_t in_band = 0;
+  for (std::uint32_t i = 0; i < n; ++i) in_band += in_row_band(i) ? 1 : 0;
+  relaxed_add<std::uint64_t>(metrics_.rows_dropped, in_band - row_pick_);
   rows_without_w_ = deep_without_w;
   touching_without_w_ = touching;
 }
@@ -358,8 +410,7 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
 // sphere, radius included, onto the plane through a blade vertex.
 void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
   // The AIST rows' candidate margin: both methods hand the solve the same kind of rows.
-  tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_,
-                            tool_query_.candidate_margin_m);
+  tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_, row_margin_m_);
   const auto& vertex_sphere = setup_.triangles->vertex_sphere;
   std::size_t slots = 0;
   for (std::size_t i = 0; i < triangle_contacts_.size() && slots < sphere_contact_.size(); ++i) {

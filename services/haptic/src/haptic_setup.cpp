@@ -81,11 +81,6 @@ HapticSetup set_up(const scene::Scene& scene, CollisionMethod collision, bool fe
         " deformable bodies; the haptic service takes at most " + std::to_string(kMaxTissueBodies));
   HapticSetup setup;
   setup.scene = &scene;
-  // W along the normals covers every row the FEM was sent last: rows by
-  // their free-motion depth keep them (RowCompliance::kFreeDepth).
-  if (scene.solver.compliance_columns == scene::ComplianceColumns::kNormals) {
-    setup.row_compliance = RowCompliance::kFreeDepth;
-  }
   std::size_t nodes = 0;
   std::uint32_t spheres = 0;
   for (const std::size_t index : plan.fem_bodies) {

@@ -77,7 +77,6 @@ TissueSnapshot TissueDigest::make_snapshot() {
   s.w_mpn.assign(n * n * msg::MAX_COMPLIANCE_ENTRIES, 0.0f);
   s.free_centres_m.assign(n * msg::MAX_COMPLIANCE_COORDS, 0.0f);
   s.compliance_normals.assign(n * msg::MAX_COMPLIANCE_COORDS, 0.0f);
-  s.free_shift_m.assign(n * msg::MAX_COMPLIANCE_SPHERES, 0.0f);
   s.compliance_index.assign(setup_.layout.size(), contact::kNoCompliance);
   s.obstacle_contacts.assign(kObstacleContactCapacity, fem::Contact{});
   s.obstacle_body_ids.assign(kObstacleContactCapacity, 0);
@@ -222,8 +221,6 @@ void TissueDigest::index_compliance(std::span<const msg::DeformationState* const
       std::copy_n(state.compliance_normals().data(), 3 * k,
                   out.compliance_normals.data() + 3 * first);
     }
-    // Without free centres no sphere has moved off its published centre.
-    std::fill_n(out.free_shift_m.begin() + static_cast<std::ptrdiff_t>(first), k, 0.0f);
     if (free_centres) {
       std::copy_n(state.compliance_free_centres_m().data(), 3 * k,
                   out.free_centres_m.data() + 3 * first);
@@ -232,15 +229,7 @@ void TissueDigest::index_compliance(std::span<const msg::DeformationState* const
   }
   out.have_compliance_normals = along;
   out.compliance_count = total;
-  if (free_centres) {
-    out.have_free_centres = true;
-    const auto centres = out.spheres.centres_m();
-    for (std::size_t i = 0; i < total; ++i) {
-      const float* f = out.free_centres_m.data() + 3 * i;
-      out.free_shift_m[i] = static_cast<float>(
-          (centres[out.compliance_ids[i]] - Eigen::Vector3d(f[0], f[1], f[2])).norm());
-    }
-  }
+  out.have_free_centres = free_centres;
 }
 
 void TissueDigest::query_obstacles(TissueSnapshot& out) {

@@ -36,10 +36,10 @@ struct LoopMetrics {
   std::atomic<std::uint64_t> snapshots{0};  // distinct FEM states the ticks used
   std::atomic<std::uint32_t> tool_rows{
       0};  // tissue rows of the last tick (touching and candidates)
-  std::atomic<std::uint32_t> anatomy_rows{0};        // tool vs rigid anatomy rows of the last tick
-  std::atomic<std::uint32_t> active_contacts{0};     // rows with lambda > 0, last tick
-  std::atomic<std::uint64_t> rows_dropped{0};        // tool contacts beyond the row budget, total
-  std::atomic<std::uint64_t> query_overflows{0};     // contact buffer full, total
+  std::atomic<std::uint32_t> anatomy_rows{0};     // tool vs rigid anatomy rows of the last tick
+  std::atomic<std::uint32_t> active_contacts{0};  // rows with lambda > 0, last tick
+  std::atomic<std::uint64_t> rows_dropped{0};     // contacts within the row margin not rows, total
+  std::atomic<std::uint64_t> query_overflows{0};  // contact buffer full, total
   std::atomic<std::uint32_t> missing_compliance{0};  // rows without tissue compliance, last tick
   std::atomic<std::uint64_t> tissue_rows_total{0};   // tissue rows solved, all ticks
   std::atomic<std::uint64_t> rows_without_compliance{0};  // of those, rows without W, total
@@ -185,12 +185,19 @@ class HapticLoop {
       order_;                    // indices into tool_contacts_, deepest first when over capacity
   std::vector<double> row_key_;  // per contact: select_rows' key
   std::vector<std::uint32_t> order_scratch_;  // select_rows: contacts with W
-  std::vector<std::uint32_t> request_of_;     // select_rows: the block's other contacts
-  std::vector<fem::Contact> requests_;        // this tick's contacts asked for W
-  std::size_t row_pick_ = 0;                  // rows select_rows took
-  std::size_t request_count_ = 0;             // requests this tick
-  std::size_t rows_without_w_ = 0;            // contacts deep enough to be rows, without W
-  std::size_t touching_without_w_ = 0;        // of those, touching the tool
+  // Per W sphere (compliance index): its free-motion depth, taken on the
+  // first tick of its FEM state, and that state (step, writer, reset epoch).
+  std::vector<double> free_depth_m_;
+  std::uint64_t free_depth_step_ = 0;
+  std::uint32_t free_depth_writer_ = 0;
+  std::uint32_t free_depth_epoch_ = 0;
+  bool free_depth_valid_ = false;
+  std::vector<std::uint32_t> request_of_;  // select_rows: the block's other contacts
+  std::vector<fem::Contact> requests_;     // this tick's contacts asked for W
+  std::size_t row_pick_ = 0;               // rows select_rows took
+  std::size_t request_count_ = 0;          // requests this tick
+  std::size_t rows_without_w_ = 0;         // contacts deep enough to be rows, without W
+  std::size_t touching_without_w_ = 0;     // of those, touching the tool
   // Tool against the tongue (the triangle baseline, CollisionMethod::kTriangle).
   std::vector<collision::TriangleContact> triangle_contacts_;
   std::vector<std::int32_t> row_of_sphere_;    // per sphere: its slot in sphere_contact_, or -1
@@ -202,6 +209,7 @@ class HapticLoop {
   std::vector<std::uint32_t> anatomy_order_;
   std::size_t compliance_block_ = 0;  // spheres in the FEM's W block
   std::size_t tissue_row_budget_ = 0;
+  double row_margin_m_ = 0.0;  // HapticSetup::row_margin_m, within the candidate margin
   std::vector<contact::ContactRow> rows_;
   std::size_t row_count_ = 0;
 

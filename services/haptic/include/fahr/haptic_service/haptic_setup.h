@@ -51,17 +51,6 @@ struct TriangleCollisionSetup {
   std::vector<std::uint32_t> vertex_sphere;      // sphere id of each boundary vertex
 };
 
-// A pressed blade touches ~600 spheres; the solve takes 64 rows and the
-// neonatal scene's FEM sends W (and free centres) for 16 of them. kDeepest:
-// the 64 deepest rows; the others are on the response's fallback compliance
-// and their projected centres, and most rows change each FEM state (after
-// its projection the W spheres are the shallowest). kFreeDepth: the
-// deepest, a W sphere's depth taken on its free-motion centre (the published
-// one reads about zero after the FEM's projection; the others were not
-// projected, so theirs is already free): the depths the solve then uses.
-// The scene decides (HapticSetup::row_compliance).
-enum class RowCompliance { kDeepest, kFreeDepth };
-
 // Deformable bodies a scene may give the haptic service: each adds its W
 // block to the joined one, which grows with the square of the count.
 inline constexpr std::size_t kMaxTissueBodies = 4;
@@ -103,15 +92,20 @@ struct HapticSetup {
   contact::PenaltySettings penalty_settings;
   CollisionMethod collision = CollisionMethod::kAist;
   std::unique_ptr<TriangleCollisionSetup> triangles;  // set for kTriangle only
-  // How rows are picked when the tool touches more spheres than the solve
-  // takes (see RowCompliance): kFreeDepth where the scene has W along the
-  // normals (solver.compliance_columns), else kDeepest.
-  RowCompliance row_compliance = RowCompliance::kDeepest;
-  // Spheres within this gap of the tool are rows too (candidates, lambda = 0
-  // until the proxy moves into them), m, >= 0: the solve then stops the
-  // proxy within the tick instead of one tick late. The walk also visits
-  // spheres 1 mm beyond it, to remember their centres outside.
+  // Spheres within this gap of the tool are reported by the query
+  // (candidates), m, >= 0, and the deepest of them are the FEM's W requests.
+  // The walk also visits spheres 1 mm beyond it, to remember their centres
+  // outside.
   double candidate_margin_m = 1e-3;
+  // Candidates within this gap are rows too (lambda = 0 until the proxy
+  // moves into them), m, in [0, candidate_margin_m]: the solve then stops
+  // the proxy within the tick instead of one tick late, which takes a tick's
+  // travel (0.5 mm is a 0.5 m/s hand's). The band between it and the
+  // candidate margin is the look-ahead for W: a sphere's W arrives one or
+  // two FEM periods after it is asked for (10 ms at 200 Hz), so a sphere
+  // entering the candidate margin has W before it is a row while the hand
+  // approaches at up to 50 mm/s (docs/design/compliance-block.md).
+  double row_margin_m = 0.5e-3;
 };
 
 // The body (index into HapticSetup::bodies) a sphere of the joined layout

@@ -54,8 +54,6 @@ struct TissueSnapshot {
   // The FEM's normal of each compliance sphere when W came along normals
   // (DeformationState.compliance_normals).
   std::vector<float> compliance_normals;
-  // |published - free centre| of each compliance sphere, m (0 without free centres).
-  std::vector<float> free_shift_m;
   bool have_compliance_normals = false;
   std::size_t compliance_count = 0;
   bool have_free_centres = false;
