@@ -246,12 +246,18 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
     free_depth_epoch_ = tissue.reset_epoch;
     free_depth_valid_ = true;
   }
+  // Only contacts within the row margin are rows; the rest of the candidate
+  // margin is the W look-ahead.
+  const double row_floor = -row_margin_m_;
+  const auto in_row_band = [&](std::uint32_t i) { return row_key_[i] > row_floor; };
+  std::size_t in_band = 0;
   for (std::uint32_t i = 0; i < n; ++i) {
     const collision::SphereContact& s = tool_contacts_[i];
     const std::int32_t w = tissue.compliance_index[s.sphere_id];
     const double key =
         w >= 0 && free_depth ? free_depth_m_[static_cast<std::size_t>(w)] : s.depth_m;
     row_key_[i] = key;
+    in_band += key > row_floor ? 1 : 0;
     if (w >= 0 && with_w < order_scratch_.size()) {
       order_scratch_[with_w++] = i;
     } else {
@@ -259,10 +265,6 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
     }
   }
   const auto deeper = [&](std::uint32_t a, std::uint32_t b) { return row_key_[a] > row_key_[b]; };
-  // Only contacts within the row margin are rows; the rest of the candidate
-  // margin is the W look-ahead.
-  const double row_floor = -row_margin_m_;
-  const auto in_row_band = [&](std::uint32_t i) { return row_key_[i] > row_floor; };
   // The W spheres (at most the block, so all of them), deepest first: the
   // rows, then the deepest W spheres that are not rows.
   std::sort(order_scratch_.begin(), order_scratch_.begin() + static_cast<std::ptrdiff_t>(with_w),
@@ -325,8 +327,6 @@ void HapticLoop::select_rows(const TissueSnapshot& tissue) {
               order_.begin() + static_cast<std::ptrdiff_t>(row_pick_));
   // Dropped: contacts within the row margin that are not rows (the look-ahead
   // band's are not rows by design).
-  std::size_t in_band = 0;
-  for (std::uint32_t i = 0; i < n; ++i) in_band += in_row_band(i) ? 1 : 0;
   relaxed_add<std::uint64_t>(metrics_.rows_dropped, in_band - row_pick_);
   rows_without_w_ = deep_without_w;
   touching_without_w_ = touching;
@@ -409,7 +409,7 @@ void HapticLoop::collect_tissue_rows(const TissueSnapshot& tissue) {
 // 20 s (fahr_stack_sim_run --collision triangle), since the FEM projects that
 // sphere, radius included, onto the plane through a blade vertex.
 void HapticLoop::collect_triangle_rows(const TissueSnapshot& tissue) {
-  // The AIST rows' candidate margin: both methods hand the solve the same kind of rows.
+  // The AIST rows' row margin: both methods hand the solve the same kind of rows.
   tissue.triangles->collide(tool_body_.world_from_body, triangle_contacts_, row_margin_m_);
   const auto& vertex_sphere = setup_.triangles->vertex_sphere;
   std::size_t slots = 0;
