@@ -11,7 +11,7 @@
 #                           [--cpus-fem LIST] [--cpus-haptic LIST]
 #                           [--record FILE.mcap] [--record-decimate TOPIC=N] [--record-arg ARG]
 #                           [--replay FILE.mcap] [--security DIR] [--pace R]
-#                           [--summary-arg ARG]
+#                           [--summary-arg ARG] [--rt-priority N]
 #
 # --record FILE.mcap: fahr_logger joins first and records every topic of the
 # run to FILE.mcap (FILE.mcap.part until it closes, after the services have
@@ -41,6 +41,11 @@
 # hashes stay the same.
 # --summary-arg ARG passes one more argument to fahr_run_summary (realtime;
 # repeatable), e.g. --summary-arg --tick-spans --summary-arg FILE.csv.
+# --rt-priority N (realtime): the gateway's servo loop and the haptic tick
+# run under SCHED_FIFO at priority N, default 70 (0: the default scheduler),
+# so the FEM's steps and factorisations beside them on a machine with few
+# cores never delay a 1 kHz tick; a service the kernel refuses it to says
+# so and runs on without it. Neither loop spins unless asked (--spin).
 #
 # --dds-<service> puts one service on another vendor (a mixed-vendor run);
 # the summary listens with --dds.
@@ -72,6 +77,7 @@ replay=""
 security=""
 clock_extra=()
 summary_extra=()
+rt_priority=70
 args=("$@")
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -94,7 +100,8 @@ while [ $# -gt 0 ]; do
     --security) security=$(cd "$2" && pwd); shift 2 ;;
     --pace) clock_extra+=(--pace "$2"); shift 2 ;;
     --summary-arg) summary_extra+=("$2"); shift 2 ;;
-    -h|--help) sed -n '2,52p' "$0"; exit 0 ;;
+    --rt-priority) rt_priority="$2"; shift 2 ;;
+    -h|--help) sed -n '2,57p' "$0"; exit 0 ;;
     -*) echo "run_local: unknown flag '$1'" >&2; exit 2 ;;
     *) build="$1"; shift ;;
   esac
@@ -103,6 +110,10 @@ dds_gateway="${dds_gateway:-$dds}"
 dds_fem="${dds_fem:-$dds}"
 dds_haptic="${dds_haptic:-$dds}"
 case "$mode" in realtime|lockstep) ;; *) echo "run_local: --mode must be realtime or lockstep, not '$mode'" >&2; exit 2 ;; esac
+case "$rt_priority" in ''|*[!0-9]*) echo "run_local: --rt-priority must be 0-99, not '$rt_priority'" >&2; exit 2 ;; esac
+[ "$rt_priority" -le 99 ] || { echo "run_local: --rt-priority must be 0-99, not '$rt_priority'" >&2; exit 2; }
+rt_flags=()
+[ "$mode" = realtime ] && [ "$rt_priority" -gt 0 ] && rt_flags=(--rt-priority "$rt_priority")
 for v in "$dds" "$dds_gateway" "$dds_fem" "$dds_haptic"; do
   case "$v" in cyclonedds|fastdds) ;; *) echo "run_local: a DDS vendor must be cyclonedds or fastdds, not '$v'" >&2; exit 2 ;; esac
 done
@@ -212,7 +223,7 @@ finish_recording() {
 }
 stdbuf -oL "$fem" --scene "$scene" "${fem_flags[@]}" "${fem_extra[@]}" --mode "$mode" --duration-s 0 >"$logs/fem.log" 2>&1 &
 fem_pid=$!; pids+=("$fem_pid")
-"$haptic" --scene "$scene" "${haptic_flags[@]}" "${haptic_extra[@]}" --mode "$mode" --collision "$haptic_collision" --duration-s 0 \
+"$haptic" --scene "$scene" "${haptic_flags[@]}" "${haptic_extra[@]}" "${rt_flags[@]}" --mode "$mode" --collision "$haptic_collision" --duration-s 0 \
   >"$logs/haptic.log" 2>&1 &
 haptic_pid=$!; pids+=("$haptic_pid")
 # (stdbuf: the services print their start line with printf; line buffering
@@ -267,7 +278,7 @@ fi
   >"$logs/summary.md" 2>"$logs/summary.err" &
 summary_pid=$!; pids+=("$summary_pid")
 sleep 0.5  # the summary's readers match before the first DevicePose
-stdbuf -oL "$gateway" "${gateway_flags[@]}" --backend simulated --script "$script" \
+stdbuf -oL "$gateway" "${gateway_flags[@]}" "${rt_flags[@]}" --backend simulated --script "$script" \
   --duration-s "$duration_s" >"$logs/gateway.log" 2>&1 &
 gateway_pid=$!; pids+=("$gateway_pid")
 

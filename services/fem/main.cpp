@@ -46,7 +46,11 @@ int run(int argc, char** argv) {
   std::vector<std::unique_ptr<FemBodySetup>> setups;
   BodySteps steps;
   for (const std::size_t body : bodies) {
-    setups.push_back(std::make_unique<FemBodySetup>(set_up_body(*scene, scene->bodies[body])));
+    // In real time a step never waits for a background factorisation; in
+    // lockstep it does, so the same inputs give the same bits.
+    setups.push_back(std::make_unique<FemBodySetup>(
+        set_up_body(*scene, scene->bodies[body],
+                    lockstep ? fem::FactorInstall::kWait : fem::FactorInstall::kWhenDone)));
     steps.push_back(std::make_unique<ServiceStep>(*setups.back()));
   }
   common::Participant participant(runtime::transport_for(*scene, options.dds, options.domain,

@@ -551,9 +551,12 @@ void Body::prepare_system(StepReport& report) {
   const SolverSettings& solver = settings_.solver;
   const bool cg = solver.kind == LinearSolver::kConjugateGradient;
   const bool factor_needed = !cg || solver.preconditioner == CgPreconditioner::kLaggedCholesky;
-  if (factor_pending_ && step_ >= factor_install_step_) {
-    // The background factorisation begun factor_latency_steps_ ago: waited
-    // for if not done, so its step does not depend on the thread's speed.
+  // The background factorisation begun factor_latency_steps_ ago (or
+  // longer): waited for if not done, so its step does not depend on the
+  // thread's speed, or, in real time, taken at the first step that finds it
+  // done.
+  if (factor_pending_ && step_ >= factor_install_step_ &&
+      (solver.factor_install == FactorInstall::kWait || cholmod_.background_done())) {
     factor_pending_ = false;
     report.refactorised = cholmod_.finish_factorize();
     // A failed one (A not positive definite) leaves the factor before; the

@@ -324,6 +324,13 @@ bool CholmodSolver::finish_factorize() {
   return true;
 }
 
+bool CholmodSolver::background_done() const {
+  if (!state_->background) return true;
+  State::Background& b = *state_->background;
+  std::lock_guard lock(b.mutex);
+  return !b.job;
+}
+
 void CholmodSolver::cancel_factorize() {
   if (state_->background) state_->wait_background();
 }

@@ -92,12 +92,14 @@ fem::BodySettings body_settings(const scene::Scene& scene, const scene::Body& bo
 
 }  // namespace
 
-FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body) {
+FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body,
+                         fem::FactorInstall install) {
   FemBodySetup setup;
   setup.scene_body = &body;
   setup.mesh = runtime::world_tet_mesh(body);
   setup.fixed_nodes = fixed_nodes(body, setup.mesh);
   setup.settings = body_settings(scene, body);
+  setup.settings.solver.factor_install = install;
   setup.compliance_along_normals =
       scene.solver.compliance_columns == scene::ComplianceColumns::kNormals;
   setup.volume_floor.ratio = scene.solver.volume_floor_ratio;

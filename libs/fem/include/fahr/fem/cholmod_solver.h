@@ -85,6 +85,10 @@ class CholmodSolver {
   bool begin_factorize(FillValues fill = nullptr, void* context = nullptr);
   bool finish_factorize();
   void cancel_factorize();
+  // True when no background factorisation is under way (none begun, or the
+  // one begun has ended): finish_factorize() would not wait. Never blocks
+  // for longer than the thread's bookkeeping.
+  bool background_done() const;
   // CPU time the background thread has used so far, ns (0 without one).
   std::int64_t background_cpu_ns() const;
 

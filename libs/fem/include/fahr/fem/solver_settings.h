@@ -10,6 +10,10 @@ enum class LinearSolver {
   kConjugateGradient,  // iterative, on the current A, warm-started from v
 };
 
+// When a background factorisation replaces the factor in use
+// (SolverSettings::factor_install).
+enum class FactorInstall { kWait, kWhenDone };
+
 struct SolverSettings {
   LinearSolver kind = LinearSolver::kCholmod;
   // Steps between numeric refactorisations of A (for kCholmod the solve, for
@@ -67,6 +71,15 @@ struct SolverSettings {
   // factorisation runs inside the step that asks for it. Ignored with
   // refactor_period 1 (the exact step).
   double background_factor_latency_s = 0.0;
+  // What a step does when the background factorisation is due (the
+  // latency has passed) and not done yet. kWait: waits for it, so the step
+  // it replaces the factor in does not depend on the thread's speed and
+  // the same inputs give the same bits (lockstep, tests, benches). kWhenDone:
+  // goes on with the factor before and replaces it at the first later step
+  // that finds it done (real time: a step never waits on a factorisation,
+  // docs/design/fem-step-and-solvers.md).
+  // On a machine fast enough for the latency the two are the same.
+  FactorInstall factor_install = FactorInstall::kWait;
   // Rotate a reused factorisation per node into the current frame (see
   // warped_factor.h). Off only to measure what it buys.
   bool warp_lagged_factor = false;

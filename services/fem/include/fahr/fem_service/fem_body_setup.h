@@ -45,7 +45,10 @@ struct FemBodySetup {
   fem::VolumeFloorSettings volume_floor{};
 };
 
-// Throws std::runtime_error naming the body and what is wrong.
-FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body);
+// Throws std::runtime_error naming the body and what is wrong. `install`:
+// whether a step waits for a late background factorisation (lockstep, the
+// default) or goes on without it (real time; fem SolverSettings::factor_install).
+FemBodySetup set_up_body(const scene::Scene& scene, const scene::Body& body,
+                         fem::FactorInstall install = fem::FactorInstall::kWait);
 
 }  // namespace fahr::fem_service
