@@ -171,6 +171,7 @@ std::string Body::configure_background_factor() {
 void Body::cancel_background_factor() {
   cholmod_.cancel_factorize();
   factor_pending_ = false;
+  factor_late_ = false;
 }
 
 void Body::assemble_system() {
@@ -554,9 +555,20 @@ void Body::prepare_system(StepReport& report) {
   // The background factorisation begun factor_latency_steps_ ago (or
   // longer): waited for if not done, so its step does not depend on the
   // thread's speed, or, in real time, taken at the first step that finds it
-  // done.
-  if (factor_pending_ && step_ >= factor_install_step_ &&
-      (solver.factor_install == FactorInstall::kWait || cholmod_.background_done())) {
+  // done, and waited for once it is a second latency late (the factor in
+  // use never lags by more than that: on a starved machine the thread at
+  // nice 10 fell seconds behind and tets inverted under the stale factor).
+  const bool due = factor_pending_ && step_ >= factor_install_step_;
+  const bool done = due && cholmod_.background_done();
+  if (due && !done && !factor_late_) {
+    factor_late_ = true;
+    ++late_factorisations_;
+  }
+  const bool overdue = due && step_ >= factor_install_step_ + factor_latency_steps_;
+  if (due && (done || overdue || solver.factor_install == FactorInstall::kWait)) {
+    most_steps_late_ = std::max(most_steps_late_, step_ - factor_install_step_);
+    if (!done && solver.factor_install == FactorInstall::kWhenDone) ++overdue_waits_;
+    factor_late_ = false;
     factor_pending_ = false;
     report.refactorised = cholmod_.finish_factorize();
     // A failed one (A not positive definite) leaves the factor before; the

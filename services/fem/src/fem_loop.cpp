@@ -210,6 +210,18 @@ void print_start_lines(const common::Participant& participant, const BodySteps& 
   }
 }
 
+namespace {
+
+// What a factorisation not done at its latency cost: the step waited for it
+// (lockstep), or the factor in use lagged for that many more steps.
+std::string late_install(const fem::Body& body) {
+  if (body.settings().solver.factor_install == fem::FactorInstall::kWait) return "waited for";
+  return "taken up to " + std::to_string(body.most_steps_late()) + " steps later, " +
+         std::to_string(body.overdue_waits()) + " waited for a latency late";
+}
+
+}  // namespace
+
 void print_end_lines(const BodySteps& steps) {
   for (const auto& step : steps) {
     const ServiceStep& fem_step = *step;
@@ -218,14 +230,17 @@ void print_end_lines(const BodySteps& steps) {
     std::printf(
         "fahr_fem_service: %s%llu steps, stale contact sets %llu (a newer set followed %llu), "
         "refused (another sphere layout) %llu, max inverted elements %llu, resets after "
-        "divergence %llu, steps shortened by the line search %llu\n",
+        "divergence %llu, steps shortened by the line search %llu, factorisations not done at "
+        "their latency %llu (%s)\n",
         body.c_str(), static_cast<unsigned long long>(fem_step.setup().body->step_index()),
         static_cast<unsigned long long>(fem_step.stale_sets()),
         static_cast<unsigned long long>(fem_step.stale_sets_followed()),
         static_cast<unsigned long long>(fem_step.layout_check().refused()),
         static_cast<unsigned long long>(fem_step.inverted_max()),
         static_cast<unsigned long long>(fem_step.divergence_resets()),
-        static_cast<unsigned long long>(fem_step.shortened_steps()));
+        static_cast<unsigned long long>(fem_step.shortened_steps()),
+        static_cast<unsigned long long>(fem_step.setup().body->late_factorisations()),
+        late_install(*fem_step.setup().body).c_str());
     const ServiceStep::SlowestStep& slow = fem_step.slowest_step();
     std::printf(
         "fahr_fem_service: %sslowest step %.1f ms (step %llu): refactorised %s, W block solved "

@@ -220,6 +220,15 @@ class Body {
   // CPU time of the background factorisation thread so far, ns
   // (SolverSettings::background_factor_latency_s; 0 without it).
   std::int64_t background_cpu_ns() const { return cholmod_.background_cpu_ns(); }
+  // Background factorisations not done when their latency had passed: the
+  // step waited for them (FactorInstall::kWait) or went on with the factor
+  // before (kWhenDone). A machine too slow for the latency shows here.
+  std::uint64_t late_factorisations() const { return late_factorisations_; }
+  // With kWhenDone: the most steps one of them came after its latency (at
+  // most the latency's steps: then the step waits), and how many were waited
+  // for so.
+  std::uint64_t most_steps_late() const { return most_steps_late_; }
+  std::uint64_t overdue_waits() const { return overdue_waits_; }
 
  private:
   Body() = default;
@@ -343,6 +352,10 @@ class Body {
   std::uint64_t factor_latency_steps_ = 0;
   bool factor_pending_ = false;
   std::uint64_t factor_install_step_ = 0;
+  bool factor_late_ = false;  // the pending one was not done at its latency
+  std::uint64_t late_factorisations_ = 0;
+  std::uint64_t most_steps_late_ = 0;
+  std::uint64_t overdue_waits_ = 0;
   // A CG solve took more than cg_refresh_iterations: refactorise next step.
   bool refresh_due_ = false;
   bool external_force_set_ = false;
