@@ -248,7 +248,7 @@ TEST(Solvers, ABackgroundFactorisationUnderWayIsNotDoneUntilItEnds) {
 
 TEST(Solvers, FactorisationsTakenWhenDoneNeverComeEarlyAndReachTheSameEquilibrium) {
   // Real time: a step does not wait for a late background factorisation
-  // until it is a second latency late. It is still never installed before
+  // until ten latencies' worth of steps went on without it. It is still never installed before
   // its latency, one at a time, and the force is exact every step, so the
   // bar settles where the exact step does.
   const BodyMesh mesh = test::bar_mesh(2);
@@ -269,8 +269,8 @@ TEST(Solvers, FactorisationsTakenWhenDoneNeverComeEarlyAndReachTheSameEquilibriu
   EXPECT_EQ(body->factorisations() - 1, installed_at.size());
   for (std::size_t i = 1; i < installed_at.size(); ++i)
     EXPECT_GE(installed_at[i] - installed_at[i - 1], 3);
-  // Never more than a second latency late: then the step waits.
-  EXPECT_LE(body->most_steps_late(), 3u);
+  // Never more than ten latencies' worth of steps late: then the step waits.
+  EXPECT_LE(body->most_steps_late(), 30u);
   EXPECT_LE(body->overdue_waits(), body->late_factorisations());
   const auto reference = run(SolverSettings{}, 400);
   EXPECT_LT(largest_difference(reference, {body->positions_m().begin(), body->positions_m().end()}),

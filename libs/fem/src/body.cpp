@@ -16,6 +16,10 @@ namespace fahr::fem {
 
 namespace {
 
+// FactorInstall::kWhenDone: a background factorisation this many latencies
+// past its own is waited for (the factor in use lags by at most one more).
+constexpr std::uint64_t kOverdueLatencies = 10;
+
 std::string validate(const SolverSettings& solver) {
   if (solver.refactor_period < 0) return "solver settings: refactor_period must be >= 0";
   if (solver.cg_max_iterations < 0) return "solver settings: cg_max_iterations must be >= 0";
@@ -172,6 +176,7 @@ void Body::cancel_background_factor() {
   cholmod_.cancel_factorize();
   factor_pending_ = false;
   factor_late_ = false;
+  steps_late_ = 0;
 }
 
 void Body::assemble_system() {
@@ -555,19 +560,23 @@ void Body::prepare_system(StepReport& report) {
   // The background factorisation begun factor_latency_steps_ ago (or
   // longer): waited for if not done, so its step does not depend on the
   // thread's speed, or, in real time, taken at the first step that finds it
-  // done, and waited for once it is a second latency late (the factor in
-  // use never lags by more than that: on a starved machine the thread at
-  // nice 10 fell seconds behind and tets inverted under the stale factor).
-  const bool due = factor_pending_ && step_ >= factor_install_step_;
-  const bool done = due && cholmod_.background_done();
-  if (due && !done && !factor_late_) {
-    factor_late_ = true;
-    ++late_factorisations_;
+  // done, and waited for once kOverdueLatencies latencies' worth of steps
+  // have gone on without it (the factor in use lags by at most that).
+  bool install = false;
+  if (factor_pending_ && step_ >= factor_install_step_) {
+    const bool done = cholmod_.background_done();
+    if (!done && !factor_late_) {
+      factor_late_ = true;
+      ++late_factorisations_;
+    }
+    const bool overdue = steps_late_ >= kOverdueLatencies * factor_latency_steps_;
+    install = done || overdue || solver.factor_install == FactorInstall::kWait;
+    if (!install) ++steps_late_;  // this step goes on with the factor before
+    if (install && !done && solver.factor_install == FactorInstall::kWhenDone) ++overdue_waits_;
   }
-  const bool overdue = due && step_ >= factor_install_step_ + factor_latency_steps_;
-  if (due && (done || overdue || solver.factor_install == FactorInstall::kWait)) {
-    most_steps_late_ = std::max(most_steps_late_, step_ - factor_install_step_);
-    if (!done && solver.factor_install == FactorInstall::kWhenDone) ++overdue_waits_;
+  if (install) {
+    most_steps_late_ = std::max(most_steps_late_, steps_late_);
+    steps_late_ = 0;
     factor_late_ = false;
     factor_pending_ = false;
     report.refactorised = cholmod_.finish_factorize();

@@ -216,8 +216,8 @@ namespace {
 // (lockstep), or the factor in use lagged for that many more steps.
 std::string late_install(const fem::Body& body) {
   if (body.settings().solver.factor_install == fem::FactorInstall::kWait) return "waited for";
-  return "taken up to " + std::to_string(body.most_steps_late()) + " steps later, " +
-         std::to_string(body.overdue_waits()) + " waited for a latency late";
+  return "up to " + std::to_string(body.most_steps_late()) + " steps went on without one, " +
+         std::to_string(body.overdue_waits()) + " waited for after ten latencies";
 }
 
 }  // namespace

@@ -224,9 +224,9 @@ class Body {
   // step waited for them (FactorInstall::kWait) or went on with the factor
   // before (kWhenDone). A machine too slow for the latency shows here.
   std::uint64_t late_factorisations() const { return late_factorisations_; }
-  // With kWhenDone: the most steps one of them came after its latency (at
-  // most the latency's steps: then the step waits), and how many were waited
-  // for so.
+  // With kWhenDone: the most steps that went on without one past its
+  // latency (at most 10 latencies' worth: then the step waits), and how many
+  // were waited for so.
   std::uint64_t most_steps_late() const { return most_steps_late_; }
   std::uint64_t overdue_waits() const { return overdue_waits_; }
 
@@ -356,6 +356,7 @@ class Body {
   std::uint64_t late_factorisations_ = 0;
   std::uint64_t most_steps_late_ = 0;
   std::uint64_t overdue_waits_ = 0;
+  std::uint64_t steps_late_ = 0;  // steps gone on without the pending factor
   // A CG solve took more than cg_refresh_iterations: refactorise next step.
   bool refresh_due_ = false;
   bool external_force_set_ = false;

@@ -76,11 +76,11 @@ struct SolverSettings {
   // it replaces the factor in does not depend on the thread's speed and
   // the same inputs give the same bits (lockstep, tests, benches). kWhenDone:
   // goes on with the factor before and replaces it at the first later step
-  // that finds it done, waiting only once it is a second latency late, so
-  // the factor in use lags by at most twice the latency (real time: no step
-  // waits on a factorisation unless the machine starves its thread,
-  // docs/design/fem-step-and-solvers.md). On a machine fast enough for the
-  // latency the two are the same.
+  // that finds it done, waiting only once ten latencies' worth of steps went
+  // on without it, so the factor in use lags by at most eleven latencies
+  // (real time: no step waits on a factorisation unless the machine starves
+  // its thread, docs/design/fem-step-and-solvers.md). On a machine fast
+  // enough for the latency the two are the same.
   FactorInstall factor_install = FactorInstall::kWait;
   // Rotate a reused factorisation per node into the current frame (see
   // warped_factor.h). Off only to measure what it buys.
