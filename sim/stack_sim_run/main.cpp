@@ -223,10 +223,12 @@ int main(int argc, char** argv) try {
         total(hm.rows_without_compliance_touching));
     std::printf("rows dropped: %llu\n", total(hm.rows_dropped));
     std::printf(
-        "stack_sim: FEM refactorisations %llu, compliance blocks solved %llu, reused %llu\n",
+        "stack_sim: FEM refactorisations %llu, compliance blocks solved %llu, reused %llu; "
+        "spheres' W columns solved on the factorisation's thread %llu\n",
         static_cast<unsigned long long>(sim.fem().refactorisations()),
         static_cast<unsigned long long>(sim.fem().contact_step().compliance_solves()),
-        static_cast<unsigned long long>(sim.fem().contact_step().compliance_reuses()));
+        static_cast<unsigned long long>(sim.fem().contact_step().compliance_reuses()),
+        static_cast<unsigned long long>(sim.fem().setup().body->compliance_refreshes_adopted()));
     std::printf("stack_sim: %s\n", haptic_service::w_summary(sim.haptic().metrics()).c_str());
     std::printf("FEM step CPU ms median %.2f p99 %.2f max %.2f\n",
                 1e-6 * static_cast<double>(fem_cpu.percentile(0.5).count()),

@@ -106,6 +106,14 @@ TEST(Allocation, StepAllocatesNothing) {
 // kept, and allocates nothing once each chunk size has been seen.
 class ComplianceAllocation : public testing::TestWithParam<CholmodFactorKind> {};
 
+// A sphere on each of the mesh's first `count` tets, equal weights.
+SphereLinks spheres_on_first_tets(const BodyMesh& mesh, std::size_t count) {
+  SphereLinks links;
+  const std::array<double, 4> w = {0.25, 0.25, 0.25, 0.25};
+  for (std::size_t s = 0; s < count; ++s) EXPECT_EQ(links.add_sphere(mesh.tets[s], w, 0.001), "");
+  return links;
+}
+
 TEST_P(ComplianceAllocation, OfChangingSpheresAllocatesNothing) {
   test::hook_suitesparse_allocations();
   const BodyMesh mesh = test::bar_mesh(2);
@@ -116,9 +124,7 @@ TEST_P(ComplianceAllocation, OfChangingSpheresAllocatesNothing) {
   settings.max_compliance_spheres = 16;
   auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
   ASSERT_NE(body, nullptr);
-  SphereLinks links;
-  const std::array<double, 4> w = {0.25, 0.25, 0.25, 0.25};
-  for (std::size_t s = 0; s < 40; ++s) ASSERT_EQ(links.add_sphere(mesh.tets[s], w, 0.001), "");
+  const SphereLinks links = spheres_on_first_tets(mesh, 40);
   std::vector<float> out(std::size_t{9} * 16 * 16);
   std::vector<std::uint32_t> spheres;
   const auto window = [&](std::uint32_t first, std::uint32_t count) {
@@ -137,6 +143,46 @@ TEST_P(ComplianceAllocation, OfChangingSpheresAllocatesNothing) {
   EXPECT_TRUE(ok);
   EXPECT_EQ(news, 0);
   EXPECT_EQ(suitesparse_allocs, 0);
+}
+
+// A background factorisation that brings the block along (the spheres of
+// the last request solved on its thread, adopted at the install): the
+// step's thread allocates nothing for it, in the steps that begin, install
+// and adopt, while the spheres change.
+TEST(Allocation, TheBlockBroughtByTheFactorisationsThreadAllocatesNothingOnTheStep) {
+  const BodyMesh mesh = test::bar_mesh(2);
+  const SphereLinks links = spheres_on_first_tets(mesh, 40);
+  std::vector<std::uint32_t> spheres;
+  spheres.reserve(16);
+  std::vector<float> out(std::size_t{9} * 16 * 16);
+  BodySettings settings;
+  settings.max_compliance_spheres = 16;
+  settings.time_step = std::chrono::milliseconds(10);
+  settings.solver.refactor_period = 3;
+  settings.solver.background_factor_latency_s = 0.02;  // two 10 ms steps
+  settings.solver.cholmod.factor = CholmodFactorKind::kSupernodal;
+  settings.sleep.enabled = false;
+  auto body = test::make_body(settings, mesh, test::fixed_x0(mesh));
+  ASSERT_NE(body, nullptr);
+  int refactorisations = 0;
+  const auto step = [&](std::uint32_t first) {
+    spheres.clear();
+    for (std::uint32_t s = first; s < first + 1 + first % 16; ++s) spheres.push_back(s);
+    const bool ok = body->compliance(spheres, links, out);
+    refactorisations += body->step().refactorised ? 1 : 0;
+    return ok;
+  };
+  for (std::uint32_t first = 0; first < 24; ++first) ASSERT_TRUE(step(first));
+  const std::uint64_t adopted_before = body->compliance_refreshes_adopted();
+  refactorisations = 0;
+  fahr::test::AllocationCounter counter;
+  bool ok = true;
+  for (std::uint32_t first = 0; first < 24; ++first) ok = step(first) && ok;
+  const long news = counter.count();
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(news, 0);
+  EXPECT_GT(refactorisations, 3);
+  EXPECT_GT(body->compliance_refreshes_adopted(), adopted_before);
 }
 
 // Full solves (simplicial) and half solves on the supernodes reached.

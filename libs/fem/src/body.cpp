@@ -172,8 +172,13 @@ std::string Body::configure_background_factor() {
   return {};
 }
 
+Body::~Body() {
+  cholmod_.cancel_factorize();
+}
+
 void Body::cancel_background_factor() {
   cholmod_.cancel_factorize();
+  compliance_.drop_refresh();
   factor_pending_ = false;
   factor_late_ = false;
   steps_late_ = 0;
@@ -190,6 +195,10 @@ void Body::assemble_job(void* body, std::span<double> values) {
                   {b.job_supports_.data(), b.job_support_count_}, b.job_support_ratio_);
   const SparseMatrix& a = b.job_assembly_.matrix();
   std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), values.begin());
+}
+
+void Body::refresh_job(void* body, CholmodSolver::NewFactor& new_factor) {
+  static_cast<Body*>(body)->compliance_.refresh_on(new_factor);
 }
 
 void Body::assemble_into(SystemAssembly& out, std::span<const Eigen::Matrix3d> deformations,
@@ -580,6 +589,11 @@ void Body::prepare_system(StepReport& report) {
     factor_late_ = false;
     factor_pending_ = false;
     report.refactorised = cholmod_.finish_factorize();
+    if (report.refactorised) {
+      compliance_.adopt_refresh(cholmod_);
+    } else {
+      compliance_.drop_refresh();
+    }
     // A failed one (A not positive definite) leaves the factor before; the
     // triggers then compare against the state it failed at, so ask again.
     refresh_due_ = refresh_due_ || !report.refactorised;
@@ -601,6 +615,11 @@ void Body::prepare_system(StepReport& report) {
   if (cg || (begin && !job_assembles)) assemble_system();
   if (begin && background_factor()) {
     mark_factor_state();
+    // The block's spheres of the last W, solved again on the new factor by
+    // the factorisation's thread.
+    const bool refresh = refresh_with_factor_ && compliance_links_ != nullptr &&
+                         compliance_.begin_refresh(*compliance_links_, fixed_dof_) > 0;
+    const CholmodSolver::AfterFactor after = refresh ? &Body::refresh_job : nullptr;
     if (job_assembles) {
       std::copy(deformations_.begin(), deformations_.end(), job_deformations_.begin());
       std::copy(rotations_.begin(), rotations_.end(), job_rotations_.begin());
@@ -608,10 +627,11 @@ void Body::prepare_system(StepReport& report) {
       std::copy_n(supports_.begin(), support_count_, job_supports_.begin());
       job_support_count_ = support_count_;
       job_support_ratio_ = support_ratio_;
-      factor_pending_ = cholmod_.begin_factorize(&Body::assemble_job, this);
+      factor_pending_ = cholmod_.begin_factorize(&Body::assemble_job, this, after);
     } else {
-      factor_pending_ = cholmod_.begin_factorize();
+      factor_pending_ = cholmod_.begin_factorize(nullptr, this, after);
     }
+    if (!factor_pending_) compliance_.drop_refresh();
     factor_install_step_ = step_ + factor_latency_steps_;
   } else if (begin) {
     report.refactorised = refactorise();
@@ -703,6 +723,7 @@ StepReport Body::step(const ContactSet* contacts, const SphereLinks* links) {
 bool Body::compliance(std::span<const std::uint32_t> spheres, const SphereLinks& links,
                       std::span<float> out) {
   if (!prepare_compliance_factor()) return false;
+  compliance_links_ = &links;
   return compliance_.compute(spheres, links, fixed_dof_, cholmod_, warp_, h_, out);
 }
 

@@ -23,7 +23,92 @@ namespace fahr::fem {
 namespace {
 // The background factorisation's nice value (the logger's writer has 10).
 constexpr int kBackgroundNice = 10;
+
+// The supernodes L^-1 P b reaches for a b with non-zeros at `dofs`,
+// ascending (CholmodSolver::reach), with the given visit marks.
+std::size_t tree_reach(const std::vector<int>& column_supernode, const std::vector<int>& parent,
+                       const std::vector<int>& position, std::vector<std::uint32_t>& marks,
+                       std::uint32_t& mark, std::span<const std::uint32_t> dofs,
+                       std::span<int> out) {
+  if (++mark == 0) {  // the marks wrapped: start them again
+    std::fill(marks.begin(), marks.end(), 0u);
+    mark = 1;
+  }
+  std::size_t count = 0;
+  for (const std::uint32_t dof : dofs) {
+    int k = column_supernode[std::size_t(position[dof])];
+    while (k >= 0 && marks[std::size_t(k)] != mark) {
+      marks[std::size_t(k)] = mark;
+      out[count++] = k;
+      k = parent[std::size_t(k)];
+    }
+  }
+  // Supernodes are numbered children first (CHOLMOD postorders them).
+  std::sort(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(count));
+  return count;
+}
+
 }  // namespace
+
+// Y := L^-1 Y on the supernodes in `reach` (CholmodSolver::forward3_on_reach)
+// for the factor f of n rows, with `update` as the below-diagonal buffer.
+// External linkage: target_clones makes an ifunc of it.
+FAHR_VECTOR_CLONES void forward3_on_factor(const cholmod_factor& f, std::size_t n,
+                                           std::vector<double>& update, std::span<const int> reach,
+                                           std::span<double> y) {
+  const int* super = static_cast<const int*>(f.super);
+  const int* pi = static_cast<const int*>(f.pi);
+  const int* px = static_cast<const int*>(f.px);
+  const int* srow = static_cast<const int*>(f.s);
+  const double* lx = static_cast<const double*>(f.x);
+  double* y0 = y.data();
+  double* y1 = y0 + n;
+  double* y2 = y1 + n;
+  const std::size_t room = update.size() / 3;
+  double* u0 = update.data();
+  double* u1 = u0 + room;
+  double* u2 = u1 + room;
+  for (const int k : reach) {
+    const auto first = std::size_t(super[k]);
+    const auto columns = std::size_t(super[k + 1]) - first;
+    const auto rows_k = std::size_t(pi[k + 1] - pi[k]);
+    const auto below = rows_k - columns;
+    // The supernode's block, column-major with leading dimension rows_k:
+    // the lower-triangular diagonal block on top, the rows below under it.
+    const double* l = lx + px[k];
+    double* x0 = y0 + first;
+    double* x1 = y1 + first;
+    double* x2 = y2 + first;
+    std::fill(u0, u0 + below, 0.0);
+    std::fill(u1, u1 + below, 0.0);
+    std::fill(u2, u2 + below, 0.0);
+    for (std::size_t c = 0; c < columns; ++c) {
+      const double* lc = l + c * rows_k;
+      const double inv = 1.0 / lc[c];
+      const double a0 = x0[c] *= inv;
+      const double a1 = x1[c] *= inv;
+      const double a2 = x2[c] *= inv;
+      for (std::size_t r = c + 1; r < columns; ++r) {
+        x0[r] -= lc[r] * a0;
+        x1[r] -= lc[r] * a1;
+        x2[r] -= lc[r] * a2;
+      }
+      const double* lb = lc + columns;
+      for (std::size_t r = 0; r < below; ++r) {
+        u0[r] += lb[r] * a0;
+        u1[r] += lb[r] * a1;
+        u2[r] += lb[r] * a2;
+      }
+    }
+    const int* below_rows = srow + pi[k] + static_cast<std::ptrdiff_t>(columns);
+    for (std::size_t r = 0; r < below; ++r) {
+      const auto row = std::size_t(below_rows[r]);
+      y0[row] -= u0[r];
+      y1[row] -= u1[r];
+      y2[row] -= u2[r];
+    }
+  }
+}
 
 struct CholmodSolver::State {
   cholmod_common common{};
@@ -70,8 +155,13 @@ struct CholmodSolver::State {
     clockid_t cpu_clock{};
     std::mutex mutex;
     std::condition_variable wake;
-    FillValues fill = nullptr;  // writes `values` on the thread, or null
+    FillValues fill = nullptr;    // writes `values` on the thread, or null
+    AfterFactor after = nullptr;  // solves on the new factor, or null
     void* fill_context = nullptr;
+    // The sparse forward solves' marks and update buffer on this thread.
+    std::vector<std::uint32_t> marks;
+    std::uint32_t mark = 0;
+    std::vector<double> update;
     bool job = false;      // a factorisation was asked for and not taken yet
     bool running = false;  // begun and not finished or cancelled
     bool ok = false;
@@ -90,11 +180,16 @@ struct CholmodSolver::State {
       b.wake.wait(lock, [&] { return b.job || b.stop; });
       if (b.stop) return;
       const FillValues fill = b.fill;
+      const AfterFactor after = b.after;
       void* const context = b.fill_context;
       lock.unlock();
       if (fill != nullptr) fill(context, b.values);
       const int ok = cholmod_factorize(&b.view, b.factor, &b.common);
       const bool good = ok != 0 && b.common.status == CHOLMOD_OK;
+      if (good && after != nullptr) {
+        NewFactor new_factor(this);
+        after(context, new_factor);
+      }
       lock.lock();
       b.ok = good;
       b.job = false;
@@ -286,6 +381,8 @@ bool CholmodSolver::enable_background() {
   }
   b->factor = symbolic;
   b->values.assign(s.view.nzmax, 0.0);
+  b->marks.assign(s.marks.size(), 0);
+  b->update.assign(s.update.size(), 0.0);
   b->view = s.view;
   b->view.x = b->values.data();
   s.background = std::move(b);
@@ -295,7 +392,7 @@ bool CholmodSolver::enable_background() {
   return true;
 }
 
-bool CholmodSolver::begin_factorize(FillValues fill, void* context) {
+bool CholmodSolver::begin_factorize(FillValues fill, void* context, AfterFactor after) {
   State& s = *state_;
   if (!s.background) return false;
   State::Background& b = *s.background;
@@ -303,6 +400,7 @@ bool CholmodSolver::begin_factorize(FillValues fill, void* context) {
     std::lock_guard lock(b.mutex);
     if (b.running) return false;
     b.fill = fill;
+    b.after = after;
     b.fill_context = context;
     if (fill == nullptr) std::memcpy(b.values.data(), s.view.x, sizeof(double) * b.values.size());
     b.running = true;
@@ -389,83 +487,51 @@ int CholmodSolver::supernode_end(int k) const {
   return static_cast<const int*>(state_->factor->super)[k + 1];
 }
 
-std::size_t CholmodSolver::reach(std::span<const std::uint32_t> dofs, std::span<int> out) {
-  State& s = *state_;
-  if (++s.mark == 0) {  // the marks wrapped: start them again
-    std::fill(s.marks.begin(), s.marks.end(), 0u);
-    s.mark = 1;
-  }
-  std::size_t count = 0;
-  for (const std::uint32_t dof : dofs) {
-    int k = s.column_supernode[std::size_t(s.position[dof])];
-    while (k >= 0 && s.marks[std::size_t(k)] != s.mark) {
-      s.marks[std::size_t(k)] = s.mark;
-      out[count++] = k;
-      k = s.parent[std::size_t(k)];
-    }
-  }
-  // Supernodes are numbered children first (CHOLMOD postorders them).
-  std::sort(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(count));
-  return count;
+const int* CholmodSolver::supernode_bounds() const {
+  return static_cast<const int*>(state_->factor->super);
 }
 
-FAHR_VECTOR_CLONES void CholmodSolver::forward3_on_reach(std::span<const int> reach,
-                                                         std::span<double> y) {
+std::size_t CholmodSolver::reach(std::span<const std::uint32_t> dofs, std::span<int> out) {
   State& s = *state_;
-  const cholmod_factor& f = *s.factor;
-  const int* super = static_cast<const int*>(f.super);
-  const int* pi = static_cast<const int*>(f.pi);
-  const int* px = static_cast<const int*>(f.px);
-  const int* srow = static_cast<const int*>(f.s);
-  const double* lx = static_cast<const double*>(f.x);
-  const std::size_t n = s.rows;
-  double* y0 = y.data();
-  double* y1 = y0 + n;
-  double* y2 = y1 + n;
-  const std::size_t room = s.update.size() / 3;
-  double* u0 = s.update.data();
-  double* u1 = u0 + room;
-  double* u2 = u1 + room;
-  for (const int k : reach) {
-    const auto first = std::size_t(super[k]);
-    const auto columns = std::size_t(super[k + 1]) - first;
-    const auto rows_k = std::size_t(pi[k + 1] - pi[k]);
-    const auto below = rows_k - columns;
-    // The supernode's block, column-major with leading dimension rows_k:
-    // the lower-triangular diagonal block on top, the rows below under it.
-    const double* l = lx + px[k];
-    double* x0 = y0 + first;
-    double* x1 = y1 + first;
-    double* x2 = y2 + first;
-    std::fill(u0, u0 + below, 0.0);
-    std::fill(u1, u1 + below, 0.0);
-    std::fill(u2, u2 + below, 0.0);
-    for (std::size_t c = 0; c < columns; ++c) {
-      const double* lc = l + c * rows_k;
-      const double inv = 1.0 / lc[c];
-      const double a0 = x0[c] *= inv;
-      const double a1 = x1[c] *= inv;
-      const double a2 = x2[c] *= inv;
-      for (std::size_t r = c + 1; r < columns; ++r) {
-        x0[r] -= lc[r] * a0;
-        x1[r] -= lc[r] * a1;
-        x2[r] -= lc[r] * a2;
-      }
-      const double* lb = lc + columns;
-      for (std::size_t r = 0; r < below; ++r) {
-        u0[r] += lb[r] * a0;
-        u1[r] += lb[r] * a1;
-        u2[r] += lb[r] * a2;
-      }
-    }
-    const int* below_rows = srow + pi[k] + static_cast<std::ptrdiff_t>(columns);
-    for (std::size_t r = 0; r < below; ++r) {
-      const auto row = std::size_t(below_rows[r]);
-      y0[row] -= u0[r];
-      y1[row] -= u1[r];
-      y2[row] -= u2[r];
-    }
-  }
+  return tree_reach(s.column_supernode, s.parent, s.position, s.marks, s.mark, dofs, out);
+}
+
+void CholmodSolver::forward3_on_reach(std::span<const int> reach, std::span<double> y) {
+  State& s = *state_;
+  forward3_on_factor(*s.factor, s.rows, s.update, reach, y);
+}
+
+std::size_t CholmodSolver::NewFactor::reach(std::span<const std::uint32_t> dofs,
+                                            std::span<int> out) {
+  State& s = *state_;
+  State::Background& b = *s.background;
+  return tree_reach(s.column_supernode, s.parent, s.position, b.marks, b.mark, dofs, out);
+}
+
+void CholmodSolver::NewFactor::forward3_on_reach(std::span<const int> reach, std::span<double> y) {
+  State& s = *state_;
+  forward3_on_factor(*s.background->factor, s.rows, s.background->update, reach, y);
+}
+
+int CholmodSolver::NewFactor::permuted(std::size_t dof) const {
+  return state_->position[dof];
+}
+
+int CholmodSolver::NewFactor::supernode_first(int k) const {
+  return static_cast<const int*>(state_->background->factor->super)[k];
+}
+
+int CholmodSolver::NewFactor::supernode_end(int k) const {
+  return static_cast<const int*>(state_->background->factor->super)[k + 1];
+}
+
+const int* CholmodSolver::NewFactor::supernode_bounds() const {
+  return static_cast<const int*>(state_->background->factor->super);
+}
+
+bool CholmodSolver::NewFactor::sparse_forward_ready() const {
+  const cholmod_factor* f = state_->background->factor;
+  return f != nullptr && f->is_super != 0 && f->is_ll != 0 && !state_->parent.empty();
 }
 
 double CholmodSolver::factor_nonzeros() const {

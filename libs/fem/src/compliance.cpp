@@ -48,8 +48,15 @@ void ComplianceBlock::reserve(std::size_t dofs, std::size_t max_spheres) {
   // few steps and come back keep their columns.
   const std::size_t kept = max_spheres + max_spheres / 2;
   slots_.assign(kept, Slot{});
-  columns_.assign(dofs * 3 * kept, 0.0);
-  reaches_.assign(dofs * kept, 0);
+  columns_.assign(2 * dofs * 3 * kept, 0.0);
+  reaches_.assign(2 * dofs * kept, 0);
+  area_.assign(kept, 0);
+  pending_.assign(max_spheres, Pending{});
+  pending_count_ = 0;
+  pending_pairs_.assign(9 * max_spheres * max_spheres, 0.0);
+  pending_sphere_dofs_.reserve(std::size_t{3} * 16);
+  last_request_.assign(max_spheres, 0);
+  last_request_count_ = 0;
   sphere_dofs_.reserve(std::size_t{3} * 16);
   pairs_.assign(9 * kept * kept, 0.0);
   pair_known_.assign(kept * kept, 0);
@@ -104,29 +111,31 @@ void ComplianceBlock::solve_chunk(std::span<const std::size_t> slots, const Sphe
   for (std::size_t s = 0; s < slots.size(); ++s) {
     slots_[slots[s]].factorisation = factor.factorisations();
     const auto from = solution_.begin() + static_cast<std::ptrdiff_t>(dofs_ * 3 * s);
-    std::copy(from, from + static_cast<std::ptrdiff_t>(3 * dofs_),
-              columns_.begin() + static_cast<std::ptrdiff_t>(dofs_ * 3 * slots[s]));
+    std::copy(from, from + static_cast<std::ptrdiff_t>(3 * dofs_), column(slots[s], 0));
     slots_[slots[s]].valid = true;
   }
 }
 
-void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
-                                 std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor) {
-  Slot& kept = slots_[slot];
-  const auto nodes = links.nodes(kept.sphere);
-  const auto weights = links.weights(kept.sphere);
-  sphere_dofs_.clear();
+template <typename Factor>
+std::size_t ComplianceBlock::solve_half_into(std::size_t slot, std::size_t area,
+                                             std::uint32_t sphere, const SphereLinks& links,
+                                             std::span<const std::uint8_t> fixed_dof,
+                                             Factor& factor,
+                                             std::vector<std::uint32_t>& sphere_dofs) {
+  const auto nodes = links.nodes(sphere);
+  const auto weights = links.weights(sphere);
+  sphere_dofs.clear();
   for (const std::uint32_t node : nodes) {
     for (std::uint32_t d = 0; d < 3; ++d) {
       const std::uint32_t dof = 3 * node + d;
-      if (fixed_dof[dof] == 0) sphere_dofs_.push_back(dof);
+      if (fixed_dof[dof] == 0) sphere_dofs.push_back(dof);
     }
   }
-  int* reach = reaches_.data() + dofs_ * slot;
-  kept.reach = factor.reach(sphere_dofs_, {reach, dofs_});
-  const std::span<const int> supernodes{reach, kept.reach};
+  int* reach = reach_in(slot, area);
+  const std::size_t count = factor.reach(sphere_dofs, {reach, dofs_});
+  const std::span<const int> supernodes{reach, count};
   for (std::size_t d = 0; d < 3; ++d) {
-    double* y = column(slot, d);
+    double* y = column_in(slot, area, d);
     for (const int k : supernodes)
       std::fill(y + factor.supernode_first(k), y + factor.supernode_end(k), 0.0);
     // P J_s^T along d: w_i on node i's DOF d, at that DOF's row in the ordering.
@@ -135,7 +144,15 @@ void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
       if (fixed_dof[dof] == 0) y[factor.permuted(dof)] += weights[m];
     }
   }
-  factor.forward3_on_reach(supernodes, {column(slot, 0), 3 * dofs_});
+  factor.forward3_on_reach(supernodes, {column_in(slot, area, 0), 3 * dofs_});
+  return count;
+}
+
+void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
+                                 std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor) {
+  Slot& kept = slots_[slot];
+  kept.reach =
+      solve_half_into(slot, area_[slot], kept.sphere, links, fixed_dof, factor, sphere_dofs_);
   kept.factorisation = factor.factorisations();
   kept.valid = true;
   // Its products with the others are computed again when asked for.
@@ -146,31 +163,26 @@ void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
   }
 }
 
-FAHR_VECTOR_CLONES const double* ComplianceBlock::half_product(std::size_t s, std::size_t t,
-                                                               const CholmodSolver& factor) {
-  const std::size_t count = slots_.size();
-  double* block = pairs_.data() + 9 * (s * count + t);
-  if (pair_known_[s * count + t] != 0) return block;
-  // The supernodes both reach: a merge of two ascending lists.
-  const int* a = reach(s);
-  const int* b = reach(t);
-  const int* a_end = a + slots_[s].reach;
-  const int* b_end = b + slots_[t].reach;
-  const double* ys[3] = {column(s, 0), column(s, 1), column(s, 2)};
-  const double* yt[3] = {column(t, 0), column(t, 1), column(t, 2)};
-  // Partial sums in kLanes interleaved lanes (vector registers), added in a
-  // fixed order at the end: the same bits on every run.
+// Y_s^T Y_t (row-major 3x3, into `sum`) of two half solves, summed over
+// the supernodes both reach (a merge of two ascending lists); `bounds` are
+// the supernodes' column ranges. Partial sums in kLanes interleaved lanes
+// (vector registers), added in a fixed order at the end: the same bits on
+// every run and on either thread. External linkage: target_clones makes an
+// ifunc of it.
+FAHR_VECTOR_CLONES void reach_product(const int* bounds, const double* const ys[3], const int* a,
+                                      const int* a_end, const double* const yt[3], const int* b,
+                                      const int* b_end, double sum[9]) {
   constexpr std::size_t kLanes = 4;
   double lanes[9][kLanes] = {};
-  double sum[9] = {};
+  for (std::size_t i = 0; i < 9; ++i) sum[i] = 0.0;
   while (a != a_end && b != b_end) {
     if (*a < *b) {
       ++a;
     } else if (*b < *a) {
       ++b;
     } else {
-      const auto first = std::size_t(factor.supernode_first(*a));
-      const auto end = std::size_t(factor.supernode_end(*a));
+      const auto first = std::size_t(bounds[*a]);
+      const auto end = std::size_t(bounds[*a + 1]);
       std::size_t j = first;
       for (; j + kLanes <= end; j += kLanes) {
         for (std::size_t d = 0; d < 3; ++d) {
@@ -192,6 +204,18 @@ FAHR_VECTOR_CLONES const double* ComplianceBlock::half_product(std::size_t s, st
   for (std::size_t i = 0; i < 9; ++i) {
     for (std::size_t q = 0; q < kLanes; ++q) sum[i] += lanes[i][q];
   }
+}
+
+const double* ComplianceBlock::half_product(std::size_t s, std::size_t t,
+                                            const CholmodSolver& factor) {
+  const std::size_t count = slots_.size();
+  double* block = pairs_.data() + 9 * (s * count + t);
+  if (pair_known_[s * count + t] != 0) return block;
+  const double* ys[3] = {column(s, 0), column(s, 1), column(s, 2)};
+  const double* yt[3] = {column(t, 0), column(t, 1), column(t, 2)};
+  double sum[9];
+  reach_product(factor.supernode_bounds(), ys, reach(s), reach(s) + slots_[s].reach, yt, reach(t),
+                reach(t) + slots_[t].reach, sum);
   double* mirror = pairs_.data() + 9 * (t * count + s);
   for (std::size_t d = 0; d < 3; ++d) {
     for (std::size_t e = 0; e < 3; ++e) {
@@ -202,6 +226,98 @@ FAHR_VECTOR_CLONES const double* ComplianceBlock::half_product(std::size_t s, st
   pair_known_[s * count + t] = 1;
   pair_known_[t * count + s] = 1;
   return block;
+}
+
+std::size_t ComplianceBlock::begin_refresh(const SphereLinks& links,
+                                           std::span<const std::uint8_t> fixed_dof) {
+  pending_count_ = 0;
+  if (!half_) return 0;
+  for (std::size_t r = 0; r < last_request_count_; ++r) {
+    const std::size_t slot = last_request_[r];
+    const Slot& kept = slots_[slot];
+    if (!kept.valid || kept.sphere >= links.size()) continue;
+    pending_[pending_count_++] = Pending{.slot = slot, .sphere = kept.sphere};
+  }
+  pending_links_ = &links;
+  pending_fixed_dof_ = fixed_dof;
+  return pending_count_;
+}
+
+void ComplianceBlock::refresh_on(CholmodSolver::NewFactor& factor) {
+  if (pending_count_ == 0 || !factor.sparse_forward_ready()) {
+    pending_count_ = 0;
+    return;
+  }
+  // Into each slot's buffer not in use: the step reads and writes only the
+  // other until adopt_refresh().
+  for (std::size_t i = 0; i < pending_count_; ++i) {
+    Pending& p = pending_[i];
+    const std::size_t spare = 1 - area_[p.slot];
+    p.reach = solve_half_into(p.slot, spare, p.sphere, *pending_links_, pending_fixed_dof_, factor,
+                              pending_sphere_dofs_);
+  }
+  const int* bounds = factor.supernode_bounds();
+  for (std::size_t i = 0; i < pending_count_; ++i) {
+    const Pending& p = pending_[i];
+    const std::size_t area_p = 1 - area_[p.slot];
+    const double* ys[3] = {column_in(p.slot, area_p, 0), column_in(p.slot, area_p, 1),
+                           column_in(p.slot, area_p, 2)};
+    const int* a = reach_in(p.slot, area_p);
+    for (std::size_t j = i; j < pending_count_; ++j) {
+      const Pending& q = pending_[j];
+      const std::size_t area_q = 1 - area_[q.slot];
+      const double* yt[3] = {column_in(q.slot, area_q, 0), column_in(q.slot, area_q, 1),
+                             column_in(q.slot, area_q, 2)};
+      const int* b = reach_in(q.slot, area_q);
+      reach_product(bounds, ys, a, a + p.reach, yt, b, b + q.reach,
+                    pending_pairs_.data() + 9 * (i * pending_count_ + j));
+    }
+  }
+}
+
+void ComplianceBlock::adopt_refresh(const CholmodSolver& factor) {
+  const std::size_t listed = pending_count_;
+  pending_count_ = 0;
+  if (listed == 0 || !half_ || !factor.sparse_forward_ready()) return;
+  const std::size_t count = slots_.size();
+  const std::uint64_t factorisation = factor.factorisations();
+  // A slot whose sphere left it (another took it) keeps what it has; the
+  // others take the new columns, and their products with the others are
+  // computed again when asked for.
+  for (std::size_t i = 0; i < listed; ++i) {
+    Pending& p = pending_[i];
+    Slot& kept = slots_[p.slot];
+    p.adopted = kept.sphere == p.sphere;
+    if (!p.adopted) continue;
+    area_[p.slot] = static_cast<std::uint8_t>(1 - area_[p.slot]);
+    kept.reach = p.reach;
+    kept.factorisation = factorisation;
+    kept.valid = true;
+    for (std::size_t other = 0; other < count; ++other) {
+      pair_known_[p.slot * count + other] = 0;
+      pair_known_[other * count + p.slot] = 0;
+    }
+    ++adopted_;
+  }
+  for (std::size_t i = 0; i < listed; ++i) {
+    const Pending& p = pending_[i];
+    if (!p.adopted) continue;
+    for (std::size_t j = i; j < listed; ++j) {
+      const Pending& q = pending_[j];
+      if (!q.adopted) continue;
+      const double* sum = pending_pairs_.data() + 9 * (i * listed + j);
+      double* block = pairs_.data() + 9 * (p.slot * count + q.slot);
+      double* mirror = pairs_.data() + 9 * (q.slot * count + p.slot);
+      for (std::size_t d = 0; d < 3; ++d) {
+        for (std::size_t e = 0; e < 3; ++e) {
+          block[3 * d + e] = sum[3 * d + e];
+          mirror[3 * e + d] = sum[3 * d + e];
+        }
+      }
+      pair_known_[p.slot * count + q.slot] = 1;
+      pair_known_[q.slot * count + p.slot] = 1;
+    }
+  }
 }
 
 bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const SphereLinks& links,
@@ -259,7 +375,9 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
   for (std::size_t s = 0; s < k; ++s) {
     const std::uint64_t lag = factorisation - slots_[request_slots_[s]].factorisation;
     oldest_lag_ = std::max<std::uint64_t>(oldest_lag_, lag);
+    last_request_[s] = request_slots_[s];
   }
+  last_request_count_ = k;
   const double h2 = time_step_s * time_step_s;
   if (half_solves) {
     for (const std::size_t slot : to_solve_) solve_half(slot, links, fixed_dof, factor);

@@ -231,7 +231,8 @@ void print_end_lines(const BodySteps& steps) {
         "fahr_fem_service: %s%llu steps, stale contact sets %llu (a newer set followed %llu), "
         "refused (another sphere layout) %llu, max inverted elements %llu, resets after "
         "divergence %llu, steps shortened by the line search %llu, factorisations not done at "
-        "their latency %llu (%s)\n",
+        "their latency %llu (%s), spheres' W columns solved on the factorisation's thread "
+        "%llu\n",
         body.c_str(), static_cast<unsigned long long>(fem_step.setup().body->step_index()),
         static_cast<unsigned long long>(fem_step.stale_sets()),
         static_cast<unsigned long long>(fem_step.stale_sets_followed()),
@@ -240,7 +241,8 @@ void print_end_lines(const BodySteps& steps) {
         static_cast<unsigned long long>(fem_step.divergence_resets()),
         static_cast<unsigned long long>(fem_step.shortened_steps()),
         static_cast<unsigned long long>(fem_step.setup().body->late_factorisations()),
-        late_install(*fem_step.setup().body).c_str());
+        late_install(*fem_step.setup().body).c_str(),
+        static_cast<unsigned long long>(fem_step.setup().body->compliance_refreshes_adopted()));
     const ServiceStep::SlowestStep& slow = fem_step.slowest_step();
     std::printf(
         "fahr_fem_service: %sslowest step %.1f ms (step %llu): refactorised %s, W block solved "

@@ -138,6 +138,13 @@ class Body {
   // Spheres of the block whose kept columns are solved again on a newer
   // factorisation per call (ComplianceBlock::set_refresh_per_call).
   void set_compliance_refresh(std::size_t spheres) { compliance_.set_refresh_per_call(spheres); }
+  // Whether a background factorisation solves the block's spheres again on
+  // its new factor, on its thread, so the install brings them along
+  // (default; ComplianceBlock::begin_refresh). Off: only the budget above
+  // refreshes them, on the step's thread (benches compare the two).
+  void set_compliance_refresh_with_factor(bool on) { refresh_with_factor_ = on; }
+  // Spheres' columns taken from the factorisation's thread so far.
+  std::uint64_t compliance_refreshes_adopted() const { return compliance_.adopted_refreshes(); }
   // dx = h^2 A^-1 f on the factor W comes from: how the nodes move in one
   // step under the extra nodal force f (N, 3 per node); fixed DOFs neither
   // take force nor move. f and dx hold 3 * node_count() entries and may not
@@ -230,6 +237,12 @@ class Body {
   std::uint64_t most_steps_late() const { return most_steps_late_; }
   std::uint64_t overdue_waits() const { return overdue_waits_; }
 
+  // Waits for a background factorisation under way: its thread writes into
+  // the body's assembly copy and compliance block.
+  ~Body();
+  Body(const Body&) = delete;
+  Body& operator=(const Body&) = delete;
+
  private:
   Body() = default;
   std::string initialise(std::span<const Eigen::Vector3d> rest_positions_m,
@@ -266,6 +279,9 @@ class Body {
   // The background factorisation's own assembly (CholmodSolver::FillValues):
   // A at the state copied when the job began, off the step's thread.
   static void assemble_job(void* body, std::span<double> values);
+  // Then, on the same thread, the compliance block's spheres on the new
+  // factor (CholmodSolver::AfterFactor).
+  static void refresh_job(void* body, CholmodSolver::NewFactor& new_factor);
   bool refactorise();
   // What refactorise() records of the state A was assembled at (the
   // triggers compare against it), without the factorisation.
@@ -353,6 +369,8 @@ class Body {
   bool factor_pending_ = false;
   std::uint64_t factor_install_step_ = 0;
   bool factor_late_ = false;  // the pending one was not done at its latency
+  bool refresh_with_factor_ = true;
+  const SphereLinks* compliance_links_ = nullptr;  // of the last compliance()
   std::uint64_t late_factorisations_ = 0;
   std::uint64_t most_steps_late_ = 0;
   std::uint64_t overdue_waits_ = 0;

@@ -35,6 +35,8 @@ struct CholmodOptions {
 };
 
 class CholmodSolver {
+  struct State;
+
  public:
   // Multi-column solves keep their buffers per column count, for this many
   // counts (the compliance block solves a full block and fixed-size chunks).
@@ -80,9 +82,19 @@ class CholmodSolver {
   // first: fill(context, values) with one entry per non-zero of the
   // analysed pattern (the caller's assembly, off its own thread); the
   // caller keeps what fill reads unchanged until finish or cancel.
+  //
+  // begin_factorize(fill, context, after) has the thread go on, once the
+  // factorisation succeeded and before finish_factorize() can take it, with
+  // after(context, new_factor): sparse forward solves on the new factor
+  // (the compliance block solves its spheres' columns again there, so the
+  // install brings them along). Same rule as for fill: what it reads and
+  // writes is the caller's to leave alone until finish or cancel.
+  class NewFactor;
   using FillValues = void (*)(void* context, std::span<double> values);
+  using AfterFactor = void (*)(void* context, NewFactor& new_factor);
   bool enable_background();
-  bool begin_factorize(FillValues fill = nullptr, void* context = nullptr);
+  bool begin_factorize(FillValues fill = nullptr, void* context = nullptr,
+                       AfterFactor after = nullptr);
   bool finish_factorize();
   void cancel_factorize();
   // True when no background factorisation is under way (none begun, or the
@@ -107,9 +119,11 @@ class CholmodSolver {
   // ascending (children before parents), into `out` (room for supernodes());
   // returns their count. No allocation.
   std::size_t reach(std::span<const std::uint32_t> dofs, std::span<int> out);
-  // The columns [first, last) of supernode k in the factor's ordering.
+  // The columns [first, last) of supernode k in the factor's ordering;
+  // supernode_bounds()[k] and [k + 1] are the same (the analysis's).
   int supernode_first(int k) const;
   int supernode_end(int k) const;
+  const int* supernode_bounds() const;
   // Y := L^-1 Y, in place, for three columns of A.rows() entries each,
   // one after the other in `y`, in the factor's ordering, that hold P B on
   // the rows of the supernodes in `reach` (the caller zeroes those rows
@@ -117,12 +131,33 @@ class CholmodSolver {
   // read once for the three. No allocation.
   void forward3_on_reach(std::span<const int> reach, std::span<double> y);
 
+  // The sparse forward solve above on a background factorisation's new
+  // factor, on its thread (AfterFactor), with visit marks and an update
+  // buffer of its own: the step's thread meanwhile solves on the factor in
+  // use. The supernodes and the ordering are the analysis's, the same for
+  // both factors.
+  class NewFactor {
+   public:
+    std::size_t reach(std::span<const std::uint32_t> dofs, std::span<int> out);
+    void forward3_on_reach(std::span<const int> reach, std::span<double> y);
+    int permuted(std::size_t dof) const;
+    int supernode_first(int k) const;
+    int supernode_end(int k) const;
+    const int* supernode_bounds() const;
+    // True when the new factor is a numeric supernodal LL' factor.
+    bool sparse_forward_ready() const;
+
+   private:
+    friend class CholmodSolver;
+    explicit NewFactor(State* state) : state_(state) {}
+    State* state_;
+  };
+
   // Non-zeros of the factor L, for reports.
   double factor_nonzeros() const;
   bool supernodal() const;
 
  private:
-  struct State;
   std::unique_ptr<State> state_;
 };
 

@@ -16,6 +16,14 @@
 // the tick solved, the deepest first), the rest to the stalest, so no
 // column lags without bound.
 //
+// A background factorisation brings the block along: when it begins, the
+// spheres of the last request are listed, its thread solves their columns
+// and products again on the new factor once it is made, and the install
+// takes them with it (begin_refresh, refresh_on, adopt_refresh), so the
+// block the tick solves on is that of the factor in use, not of the ones
+// before, at no cost to the step. Spheres that joined meanwhile are
+// refreshed by the budget.
+//
 // With a supernodal LL' factor (the tongue's) a sphere's columns are the
 // half solve Y_s = L^-1 P J_s^T, on the supernodes its DOFs reach only, and
 // W_st = h^2 Y_s^T Y_t, summed over the supernodes both reach (the paths to
@@ -53,6 +61,25 @@ class ComplianceBlock {
     oldest_lag_ = 0;
     return lag;
   }
+
+  // The refresh on the factorisation's thread (supernodal factors only).
+  // begin_refresh(), on the step's thread just before a background
+  // factorisation begins, lists the spheres of the last compute() whose
+  // columns are half solves; `links` and `fixed_dof` must stay unchanged
+  // until the refresh is adopted or dropped. Returns how many it listed.
+  // refresh_on(), on the factorisation's thread once the new factor is
+  // made (CholmodSolver::AfterFactor), solves their columns and products
+  // into buffers the step does not read. adopt_refresh(), on the step's
+  // thread right after the install, makes them the kept columns, tagged
+  // with the installed factorisation, for the spheres still in their
+  // slots; drop_refresh() when the factorisation was cancelled or failed.
+  // No allocation.
+  std::size_t begin_refresh(const SphereLinks& links, std::span<const std::uint8_t> fixed_dof);
+  void refresh_on(CholmodSolver::NewFactor& factor);
+  void adopt_refresh(const CholmodSolver& factor);
+  void drop_refresh() { pending_count_ = 0; }
+  // Spheres adopted from the factorisation's thread so far.
+  std::uint64_t adopted_refreshes() const { return adopted_; }
 
   // Writes W, (3k x 3k) row-major float, m/N, for the k spheres listed, from
   // `factor` (a factorisation of A = M + h D + h^2 K, kg), solving only the
@@ -93,24 +120,61 @@ class ComplianceBlock {
   void solve_chunk(std::span<const std::size_t> slots, const SphereLinks& links,
                    std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
                    WarpedFactor& warp);
+  // The half solve of `sphere` on `factor` into the slot's buffer `area`
+  // (0 or 1) and its reach; returns the reach's length.
+  template <typename Factor>
+  std::size_t solve_half_into(std::size_t slot, std::size_t area, std::uint32_t sphere,
+                              const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
+                              Factor& factor, std::vector<std::uint32_t>& sphere_dofs);
   void solve_half(std::size_t slot, const SphereLinks& links,
                   std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor);
   // Y_s^T Y_t of two half-solved slots (row-major 3x3), kept until either
   // is solved again.
   const double* half_product(std::size_t s, std::size_t t, const CholmodSolver& factor);
+  // Each slot has two buffers (columns and reach): the one in use
+  // (area_[slot]) and the one the factorisation's thread may fill.
   const double* column(std::size_t slot, std::size_t d) const {
-    return columns_.data() + dofs_ * (3 * slot + d);
+    return column_in(slot, area_[slot], d);
   }
-  double* column(std::size_t slot, std::size_t d) {
-    return columns_.data() + dofs_ * (3 * slot + d);
+  double* column(std::size_t slot, std::size_t d) { return column_in(slot, area_[slot], d); }
+  const double* column_in(std::size_t slot, std::size_t area, std::size_t d) const {
+    return columns_.data() + dofs_ * (3 * (2 * slot + area) + d);
   }
-  const int* reach(std::size_t slot) const { return reaches_.data() + dofs_ * slot; }
+  double* column_in(std::size_t slot, std::size_t area, std::size_t d) {
+    return columns_.data() + dofs_ * (3 * (2 * slot + area) + d);
+  }
+  const int* reach(std::size_t slot) const { return reach_in(slot, area_[slot]); }
+  const int* reach_in(std::size_t slot, std::size_t area) const {
+    return reaches_.data() + dofs_ * (2 * slot + area);
+  }
+  int* reach_in(std::size_t slot, std::size_t area) {
+    return reaches_.data() + dofs_ * (2 * slot + area);
+  }
 
   std::size_t dofs_ = 0;
   std::size_t max_spheres_ = 0;
   std::vector<Slot> slots_;
-  std::vector<double> columns_;             // 3 columns of dofs_ per slot
-  std::vector<int> reaches_;                // per slot, room for dofs_ supernodes
+  std::vector<double> columns_;     // 2 x 3 columns of dofs_ per slot
+  std::vector<int> reaches_;        // 2 per slot, room for dofs_ supernodes each
+  std::vector<std::uint8_t> area_;  // the buffer in use per slot
+  // The refresh on the factorisation's thread: the listed slots and their
+  // spheres, the reach lengths and products it computed (9 per pair of
+  // listed spheres), the links it reads.
+  struct Pending {
+    std::size_t slot = 0;
+    std::uint32_t sphere = 0;
+    std::size_t reach = 0;
+    bool adopted = false;
+  };
+  std::vector<Pending> pending_;
+  std::size_t pending_count_ = 0;
+  std::vector<double> pending_pairs_;
+  std::vector<std::uint32_t> pending_sphere_dofs_;
+  const SphereLinks* pending_links_ = nullptr;
+  std::span<const std::uint8_t> pending_fixed_dof_;
+  std::vector<std::size_t> last_request_;  // slots of the last compute(), in request order
+  std::size_t last_request_count_ = 0;
+  std::uint64_t adopted_ = 0;
   std::vector<std::uint32_t> sphere_dofs_;  // the free DOFs of one sphere
   bool half_ = false;                       // the kept columns are half solves
   std::vector<double> pairs_;               // Y_s^T Y_t per pair of slots, 9 each
