@@ -17,7 +17,7 @@
 //
 //   fem_tongue_press [--scene FILE] [--seconds 8] [--configs shipped,pcg-it8,...]
 //                    [--script intubation|overshoot] [--support-ratio R]
-//                    [--audit-from S] [--audit-to S] [--markdown [FILE]]
+//                    [--audit-from S] [--audit-to S] [--corrections] [--markdown [FILE]]
 //
 // --audit-from/--audit-to: W's audit only in that window of simulated time
 // (a held state, e.g. the overshoot's hold at 3x, 5.5-10.5 s).
@@ -33,8 +33,11 @@
 // leading 1, 8, 32 and 64 spheres; the
 // largest and RMS difference of the force sent to the device (N); the most
 // inverted tets.
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -181,6 +184,16 @@ struct Shadow {
   fahr::fem::SystemAssembly start_assembly;
   fahr::fem::ComplianceBlock start_block;  // its own: a block keeps columns per factor count
   std::array<std::vector<double>, 5> start_error;
+  // The lagged factor's W corrected towards the start state's A (an
+  // experiment, audit_corrections): every column solved on the factor in
+  // use, then W1 = 2 J X - X^T A X with X = A_f^-1 J^T (first order in
+  // A - A_f), and the same after one refinement of X.
+  std::array<std::vector<double>, 5> lagged_error, first_order_error, refined_error;
+  double correction_ms_max = 0.0;
+  // Per corrections' audit: the held set's changes since the factor, and
+  // the lagged and first-order errors for one sphere.
+  std::vector<std::size_t> support_changes;
+  std::vector<double> lagged_one, first_one;
   // Over the audited steps: the largest node motion in the step, mm, and
   // whether it went against the node's motion in the step before (a
   // state that only holds still, or one that rocks step to step).
@@ -193,6 +206,8 @@ struct Shadow {
 
 // Leading spheres of the block whose W is audited (0: the whole block).
 constexpr std::array<std::size_t, 5> kAuditSpheres{1, 8, 32, 64, 0};
+// --corrections: the first-order corrections of W are audited as well.
+bool g_corrections = false;
 
 void start_audit(Shadow& shadow) {
   const fahr::fem::Body& body = *shadow.setup->body;
@@ -267,6 +282,101 @@ void record_step_motion(Shadow& shadow) {
   std::swap(shadow.step_m, shadow.last_step_m);
 }
 
+// Relative Frobenius error of each leading block of `used` against `fresh`
+// (both 3k x 3k row-major), appended to `errors`.
+template <typename Fresh, typename Used>
+void leading_errors(std::size_t k, const Fresh& fresh, const Used& used,
+                    std::array<std::vector<double>, 5>& errors) {
+  const std::size_t rows = 3 * k;
+  for (std::size_t a = 0; a < kAuditSpheres.size(); ++a) {
+    const std::size_t lead = kAuditSpheres[a] == 0 ? k : kAuditSpheres[a];
+    if (lead > k) continue;
+    double diff = 0.0;
+    double norm = 0.0;
+    for (std::size_t i = 0; i < 3 * lead; ++i) {
+      for (std::size_t j = 0; j < 3 * lead; ++j) {
+        const double f = fresh(i * rows + j);
+        const double u = used(i * rows + j);
+        diff += (u - f) * (u - f);
+        norm += f * f;
+      }
+    }
+    if (norm > 0.0) errors[a].push_back(std::sqrt(diff / norm));
+  }
+}
+
+// W = h^2 J A^-1 J^T corrected for the lag of the factor it is solved on
+// (A_f, the factor in use) towards A, the start state's linearisation. With
+// X = A_f^-1 J^T, W(X) = h^2 (2 J X - X^T A X) is stationary at the exact
+// X = A^-1 J^T, so an X with error e gives W with error O(e^2): X from the
+// lagged factor gives W to first order in A - A_f, and one refinement step
+// X' = X + A_f^-1 (J^T - A X) to second. Compared with W from the same
+// columns uncorrected (2 J X - X^T A_f X = J X). shadow.audit_w must hold
+// the fresh W of the start state (audit_against with start_audit).
+void audit_corrections(Shadow& shadow) {
+  fahr::fem::Body& body = *shadow.setup->body;
+  const auto spheres = shadow.step->contact_step().compliance_spheres();
+  const std::size_t k = spheres.size();
+  const std::size_t n = 3 * body.node_count();
+  const std::size_t cols = 3 * k;
+  const auto started = std::chrono::steady_clock::now();
+  Eigen::MatrixXd f =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(cols));
+  for (std::size_t s = 0; s < k; ++s) {
+    const auto nodes = shadow.setup->links.nodes(spheres[s]);
+    const auto weights = shadow.setup->links.weights(spheres[s]);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      for (std::size_t d = 0; d < 3; ++d) {
+        const auto row = static_cast<Eigen::Index>(3 * static_cast<std::size_t>(nodes[i]) + d);
+        f(row, static_cast<Eigen::Index>(3 * s + d)) += weights[i];
+      }
+    }
+  }
+  const double h2 = body.time_step_s() * body.time_step_s();
+  Eigen::MatrixXd dx(f.rows(), f.cols());  // h^2 X
+  Eigen::VectorXd col(f.rows());
+  const auto solve_columns = [&](const Eigen::MatrixXd& rhs, Eigen::MatrixXd& out) {
+    for (Eigen::Index c = 0; c < rhs.cols(); ++c) {
+      col = rhs.col(c);
+      if (!body.step_motion({col.data(), n}, {out.col(c).data(), n})) return false;
+    }
+    return true;
+  };
+  if (!solve_columns(f, dx)) return;
+  const fahr::fem::SparseMatrix& a = shadow.start_assembly.matrix();
+  const Eigen::SparseMatrix<double> jt = f.sparseView();
+  const auto corrected = [&](const Eigen::MatrixXd& x) {
+    const Eigen::MatrixXd ax = a * x;
+    Eigen::MatrixXd w = 2.0 * (jt.transpose() * x) - (x.transpose() * ax) / h2;
+    return Eigen::MatrixXd(0.5 * (w + w.transpose()));
+  };
+  const Eigen::MatrixXd jdx = jt.transpose() * dx;
+  const Eigen::MatrixXd lagged = 0.5 * (jdx + jdx.transpose());
+  const Eigen::MatrixXd first = corrected(dx);
+  // X' = X + A_f^-1 (J^T - A X): in dx's units, dx' = dx + step_motion(f - A dx / h^2).
+  const Eigen::MatrixXd residual = f - (a * dx) / h2;
+  Eigen::MatrixXd step(f.rows(), f.cols());
+  if (!solve_columns(residual, step)) return;
+  const Eigen::MatrixXd refined = corrected(dx + step);
+  shadow.correction_ms_max =
+      std::max(shadow.correction_ms_max,
+               std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+                   .count());
+  const auto fresh = [&](std::size_t i) { return static_cast<double>(shadow.audit_w[i]); };
+  const auto entry = [&](const Eigen::MatrixXd& m) {
+    // Row-major (3k x 3k) as W; m is symmetric, so the storage order is moot.
+    return [&m, cols](std::size_t i) {
+      return m(static_cast<Eigen::Index>(i / cols), static_cast<Eigen::Index>(i % cols));
+    };
+  };
+  leading_errors(k, fresh, entry(lagged), shadow.lagged_error);
+  leading_errors(k, fresh, entry(first), shadow.first_order_error);
+  leading_errors(k, fresh, entry(refined), shadow.refined_error);
+  shadow.support_changes.push_back(body.support_changes_since_factor());
+  shadow.lagged_one.push_back(shadow.lagged_error[0].back());
+  shadow.first_one.push_back(shadow.first_order_error[0].back());
+}
+
 // After the step; start_assembly holds A at the state it began from.
 void audit_compliance(Shadow& shadow) {
   record_step_motion(shadow);
@@ -274,6 +384,7 @@ void audit_compliance(Shadow& shadow) {
   const std::size_t k = step.compliance_spheres().size();
   if (k == 0 || step.compliance().size() != 9 * k * k) return;
   audit_against(shadow, *shadow.start_audit, shadow.start_block, shadow.start_error);
+  if (g_corrections) audit_corrections(shadow);
   shadow.setup->body->assemble_current(shadow.audit_assembly);
   audit_against(shadow, *shadow.audit, shadow.audit_block, shadow.audit_error);
 }
@@ -412,6 +523,9 @@ int main(int argc, char** argv) try {
       ->check(fahr::cli::Range(0.0, 3600.0));
   app.add_option("--audit-to", audit_to_s, "... and up to this time, s")
       ->check(fahr::cli::Range(0.0, 3600.0));
+  app.add_flag("--corrections", g_corrections,
+               "also audit W corrected for the factor's lag to first order (dense solves of every "
+               "column: slow)");
   app.add_option("--configs", config_list,
                  "comma-separated: exact, shipped, lagged, pcg-rot, pcg-rest, pcg-itN (the exact "
                  "run is always made)");
@@ -620,6 +734,42 @@ int main(int argc, char** argv) try {
         "W against A linearised at the state after the step (the next step's system: what one "
         "step changes in the tissue's linearisation)",
         [](const Shadow& shadow) -> const auto& { return shadow.audit_error; });
+    if (g_corrections) {
+      print_errors(
+          "Every column solved on the factor in use (dense solves), against the start state's A",
+          [](const Shadow& shadow) -> const auto& { return shadow.lagged_error; });
+      print_errors(
+          "The same columns corrected to first order in A - A_f (W = h^2 (2 J X - X^T A X)), "
+          "against the start state's A",
+          [](const Shadow& shadow) -> const auto& { return shadow.first_order_error; });
+      print_errors(
+          "... after one refinement of the columns (X + A_f^-1 (J^T - A X)), against the start "
+          "state's A",
+          [](const Shadow& shadow) -> const auto& { return shadow.refined_error; });
+      for (const Run& run : runs) {
+        std::printf(
+            "- %s: the corrections' audit took at most %.1f ms a step (dense, not the "
+            "shipped cost)\n",
+            run.config.name.c_str(), run.shadow.correction_ms_max);
+        // One sphere's error by the held set's changes since the factor.
+        const Shadow& sh = run.shadow;
+        for (const auto& [low, high] :
+             {std::pair<std::size_t, std::size_t>{0, 0}, {1, 3}, {4, 1000000}}) {
+          std::vector<double> lagged, first;
+          for (std::size_t i = 0; i < sh.support_changes.size(); ++i) {
+            if (sh.support_changes[i] < low || sh.support_changes[i] > high) continue;
+            lagged.push_back(sh.lagged_one[i]);
+            first.push_back(sh.first_one[i]);
+          }
+          if (lagged.empty()) continue;
+          std::printf(
+              "  - held set changed by %zu-%zu nodes since the factor: %zu steps, one "
+              "sphere p50 / p99: lagged %.3g / %.3g, first order %.3g / %.3g\n",
+              low, high, lagged.size(), quantile(lagged, 0.5), quantile(lagged, 0.99),
+              quantile(first, 0.5), quantile(first, 0.99));
+        }
+      }
+    }
     std::printf(
         "\nThe largest node motion in an audited step, mm, p50 / p99 / max, and the steps in which "
         "that node moved against its motion in the step before:\n\n");

@@ -163,6 +163,9 @@ class Body {
   // are ignored. No allocation.
   void set_supports(std::span<const NodeSupport> supports, double stiffness_ratio);
   std::size_t support_count() const { return support_count_; }
+  // Nodes that joined or left the held set since the factorisation in use
+  // (its A holds the old set's springs; audits of W read it).
+  std::size_t support_changes_since_factor() const { return support_changes_; }
 
   // External nodal force, N, held until changed; a non-zero force wakes.
   void set_external_force(std::uint32_t node, const Eigen::Vector3d& force_n);
