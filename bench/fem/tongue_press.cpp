@@ -226,6 +226,29 @@ void start_audit(Shadow& shadow) {
   shadow.audit_warp.set_enabled(false);
 }
 
+// Relative Frobenius error of each leading block of `used` against `fresh`
+// (both 3k x 3k row-major), appended to `errors`.
+template <typename Fresh, typename Used>
+void leading_errors(std::size_t k, const Fresh& fresh, const Used& used,
+                    std::array<std::vector<double>, 5>& errors) {
+  const std::size_t rows = 3 * k;
+  for (std::size_t a = 0; a < kAuditSpheres.size(); ++a) {
+    const std::size_t lead = kAuditSpheres[a] == 0 ? k : kAuditSpheres[a];
+    if (lead > k) continue;
+    double diff = 0.0;
+    double norm = 0.0;
+    for (std::size_t i = 0; i < 3 * lead; ++i) {
+      for (std::size_t j = 0; j < 3 * lead; ++j) {
+        const double f = fresh(i * rows + j);
+        const double u = used(i * rows + j);
+        diff += (u - f) * (u - f);
+        norm += f * f;
+      }
+    }
+    if (norm > 0.0) errors[a].push_back(std::sqrt(diff / norm));
+  }
+}
+
 // W of a fresh factorisation of the assembled A against the W in use:
 // relative Frobenius error of each leading block, appended to `errors`.
 void audit_against(Shadow& shadow, fahr::fem::CholmodSolver& fresh_factor,
@@ -241,22 +264,9 @@ void audit_against(Shadow& shadow, fahr::fem::CholmodSolver& fresh_factor,
                      shadow.audit_warp, body.time_step_s(), shadow.audit_w)) {
     return;
   }
-  const std::size_t rows = 3 * k;
-  for (std::size_t a = 0; a < kAuditSpheres.size(); ++a) {
-    const std::size_t lead = kAuditSpheres[a] == 0 ? k : kAuditSpheres[a];
-    if (lead > k) continue;
-    double diff = 0.0;
-    double norm = 0.0;
-    for (std::size_t i = 0; i < 3 * lead; ++i) {
-      for (std::size_t j = 0; j < 3 * lead; ++j) {
-        const double fresh = shadow.audit_w[i * rows + j];
-        const double used = w[i * rows + j];
-        diff += (used - fresh) * (used - fresh);
-        norm += fresh * fresh;
-      }
-    }
-    if (norm > 0.0) errors[a].push_back(std::sqrt(diff / norm));
-  }
+  leading_errors(
+      k, [&](std::size_t i) { return static_cast<double>(shadow.audit_w[i]); },
+      [&](std::size_t i) { return static_cast<double>(w[i]); }, errors);
 }
 
 // The largest node motion of the step just made, and whether that node
@@ -280,29 +290,6 @@ void record_step_motion(Shadow& shadow) {
   if (now.dot(before) < 0.0) ++shadow.reversals;
   shadow.step_motion_mm.push_back(1e3 * std::sqrt(largest2));
   std::swap(shadow.step_m, shadow.last_step_m);
-}
-
-// Relative Frobenius error of each leading block of `used` against `fresh`
-// (both 3k x 3k row-major), appended to `errors`.
-template <typename Fresh, typename Used>
-void leading_errors(std::size_t k, const Fresh& fresh, const Used& used,
-                    std::array<std::vector<double>, 5>& errors) {
-  const std::size_t rows = 3 * k;
-  for (std::size_t a = 0; a < kAuditSpheres.size(); ++a) {
-    const std::size_t lead = kAuditSpheres[a] == 0 ? k : kAuditSpheres[a];
-    if (lead > k) continue;
-    double diff = 0.0;
-    double norm = 0.0;
-    for (std::size_t i = 0; i < 3 * lead; ++i) {
-      for (std::size_t j = 0; j < 3 * lead; ++j) {
-        const double f = fresh(i * rows + j);
-        const double u = used(i * rows + j);
-        diff += (u - f) * (u - f);
-        norm += f * f;
-      }
-    }
-    if (norm > 0.0) errors[a].push_back(std::sqrt(diff / norm));
-  }
 }
 
 // W = h^2 J A^-1 J^T corrected for the lag of the factor it is solved on
