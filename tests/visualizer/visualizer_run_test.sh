@@ -109,14 +109,25 @@ case "$mode" in
   browser)
     start_visualizer --dds cyclonedds --domain 42
     # 7 s of the intubation script: the blade reaches the tongue about 3 s
-    # in and presses from 5 s. The page is open before the clock grants
-    # step 0 (run_local.sh starts it once the services are set up, 6-15 s),
-    # so it sees the rest frame.
+    # in and presses from 5 s. The run starts once the page is open (the
+    # check writes page_open), so the page sees the rest frame however
+    # slowly the browser starts.
+    node "$js/browser_check.mjs" "$url" "$out" 300 live >"$out/browser.json" &
+    checker=$!
+    pids+=("$checker")
+    for _ in $(seq 1800); do
+      [ -f "$out/page_open" ] || ! kill -0 "$checker" 2>/dev/null && break
+      sleep 0.1
+    done
+    [ -f "$out/page_open" ] || echo "visualizer_run_test: the page did not open within 180 s" >&2
     bash "$repo/deployment/run_local.sh" "$build" --dds cyclonedds --domain 42 --mode lockstep \
       --pace 1 --script intubation --duration-s 7 >"$out/run.log" 2>&1 &
     pids+=($!)
-    node "$js/browser_check.mjs" "$url" "$out" 300 live | tee "$out/browser.json"
+    status=0
+    wait "$checker" || status=$?
+    cat "$out/browser.json"
     stop_visualizer
+    [ "$status" -eq 0 ] || exit "$status"
     ;;
   replay)
     # The overshoot script: the hand presses at 4.5 s and pushes past the

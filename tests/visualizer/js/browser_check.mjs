@@ -55,6 +55,9 @@ page.on("console", (m) => {
 });
 page.on("pageerror", (e) => consoleErrors.push(String(e)));
 await page.goto(url, { waitUntil: "load" });
+// The page is open: a live run may start (visualizer_run_test.sh waits for
+// this, so a browser slower to start than the services still sees the rest).
+writeFileSync(join(out, "page_open"), "");
 
 const stats = () => page.evaluate(() => JSON.parse(JSON.stringify(window.fahrStats)));
 // Luminance of the canvas on a 48 x 48 grid over a rectangle (whole
