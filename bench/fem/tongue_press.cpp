@@ -190,10 +190,9 @@ struct Shadow {
   // A - A_f), and the same after one refinement of X.
   std::array<std::vector<double>, 5> lagged_error, first_order_error, refined_error;
   double correction_ms_max = 0.0;
-  // Per corrections' audit: the held set's changes since the factor, and
-  // the lagged and first-order errors for one sphere.
+  // Per corrections' audit, beside lagged_error[0] and first_order_error[0]:
+  // the held set's changes since the factor.
   std::vector<std::size_t> support_changes;
-  std::vector<double> lagged_one, first_one;
   // Over the audited steps: the largest node motion in the step, mm, and
   // whether it went against the node's motion in the step before (a
   // state that only holds still, or one that rocks step to step).
@@ -359,9 +358,10 @@ void audit_corrections(Shadow& shadow) {
   leading_errors(k, fresh, entry(lagged), shadow.lagged_error);
   leading_errors(k, fresh, entry(first), shadow.first_order_error);
   leading_errors(k, fresh, entry(refined), shadow.refined_error);
-  shadow.support_changes.push_back(body.support_changes_since_factor());
-  shadow.lagged_one.push_back(shadow.lagged_error[0].back());
-  shadow.first_one.push_back(shadow.first_order_error[0].back());
+  // Kept in step with the one-sphere errors (a zero fresh W adds none).
+  if (shadow.lagged_error[0].size() > shadow.support_changes.size()) {
+    shadow.support_changes.push_back(body.support_changes_since_factor());
+  }
 }
 
 // After the step; start_assembly holds A at the state it began from.
@@ -722,17 +722,24 @@ int main(int argc, char** argv) try {
         "step changes in the tissue's linearisation)",
         [](const Shadow& shadow) -> const auto& { return shadow.audit_error; });
     if (g_corrections) {
-      print_errors(
-          "Every column solved on the factor in use (dense solves), against the start state's A",
-          [](const Shadow& shadow) -> const auto& { return shadow.lagged_error; });
-      print_errors(
-          "The same columns corrected to first order in A - A_f (W = h^2 (2 J X - X^T A X)), "
-          "against the start state's A",
-          [](const Shadow& shadow) -> const auto& { return shadow.first_order_error; });
-      print_errors(
-          "... after one refinement of the columns (X + A_f^-1 (J^T - A X)), against the start "
-          "state's A",
-          [](const Shadow& shadow) -> const auto& { return shadow.refined_error; });
+      using Errors = std::array<std::vector<double>, 5> Shadow::*;
+      const std::array<std::pair<const char*, Errors>, 3> corrections{{
+          {"Every column solved on the factor in use (dense solves), against the start state's A",
+           &Shadow::lagged_error},
+          {"The same columns corrected to first order in A - A_f (W = h^2 (2 J X - X^T A X)), "
+           "against the start state's A",
+           &Shadow::first_order_error},
+          {"... after one refinement of the columns (X + A_f^-1 (J^T - A X)), against the start "
+           "state's A",
+           &Shadow::refined_error},
+      }};
+      for (const auto& correction : corrections) {
+        const Errors member = correction.second;  // a structured binding is not capturable here
+        print_errors(
+            correction.first, [member](const Shadow& shadow) -> const auto& {
+              return shadow.*member;
+            });
+      }
       for (const Run& run : runs) {
         std::printf(
             "- %s: the corrections' audit took at most %.1f ms a step (dense, not the "
@@ -745,8 +752,8 @@ int main(int argc, char** argv) try {
           std::vector<double> lagged, first;
           for (std::size_t i = 0; i < sh.support_changes.size(); ++i) {
             if (sh.support_changes[i] < low || sh.support_changes[i] > high) continue;
-            lagged.push_back(sh.lagged_one[i]);
-            first.push_back(sh.first_one[i]);
+            lagged.push_back(sh.lagged_error[0][i]);
+            first.push_back(sh.first_order_error[0][i]);
           }
           if (lagged.empty()) continue;
           std::printf(
