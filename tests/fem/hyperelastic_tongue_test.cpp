@@ -1,5 +1,5 @@
 // The shipped neonatal tongue with the floor of the mouth (meshes/neonatal,
-// 8,337 tets, fixed where the floor meets the mandible and the hyoid, as the
+// 7,758 tets, fixed where the floor meets the mandible and the hyoid, as the
 // scene fixes it) under a blade's load: 7.9 N (the Touch X's peak
 // force) pushing down (-y, towards the floor of the mouth) on the dorsal
 // surface under a 10 x 40 mm patch along the mid-line, as a uniform
@@ -155,6 +155,7 @@ double percentile(std::vector<double> v, double q) {
 }
 
 struct PressResult {
+  int tets = 0;                   // of the loaded mesh
   int most_inverted_hold = 0;     // most tets inverted after any step of the hold
   int most_inverted_release = 0;  // ... of the 100 ms after release
   int inverted_end = 0;           // 1 s after release
@@ -178,7 +179,8 @@ PressResult press_and_release(MaterialModel model, bool on_anatomy, int ramp_ste
   NeonatalTongue tongue;
   std::string error;
   EXPECT_TRUE(load_neonatal_tongue(tongue, error)) << error;
-  EXPECT_EQ(tongue.mesh.tets.size(), 8337u);
+  EXPECT_GE(tongue.mesh.tets.size(), 5603u);  // at least the tongue alone had before the floor
+  result.tets = static_cast<int>(tongue.mesh.tets.size());
   BodySettings settings;
   settings.material = scene_tongue(model);
   settings.time_step = std::chrono::milliseconds(5);  // the scene's 200 Hz
@@ -335,16 +337,16 @@ TEST(HyperelasticTongue, DISABLED_StepCostByPart) {
 // of the mouth, 58 mm when the tongue was held at its whole base); the tets
 // next to the fixed nodes are crushed through J = 0 (the bending stress
 // there is several times lambda, and Stable Neo-Hookean has no barrier at
-// J = 0, only a finite push back): 106 inverted at most, 57 100 ms after
-// release. What is asserted: a small share inverted (the corotational
-// tongue inverts about a quarter under the same load, the test below), none
-// left 1 s after release, and the tongue back within 1 mm of rest.
+// J = 0, only a finite push back): 77 inverted at most, 59 100 ms after
+// release (106 and 57 on the mesh before its light nodes were peeled). What is asserted: a small
+// share inverted (the corotational tongue inverts about a quarter under the same load, the test
+// below), none left 1 s after release, and the tongue back within 1 mm of rest.
 TEST(HyperelasticTongue, BaseOnlyBladeLoadFor5sInvertsFewTetsAndTheTongueRecovers) {
   ASSERT_TRUE(std::filesystem::exists(std::string(FAHR_NEONATAL_DIR) + "/tongue.node"));
   const PressResult r = press_and_release(MaterialModel::kStableNeoHookean, false, 1);
   ASSERT_TRUE(r.finite);
-  EXPECT_LT(r.most_inverted_hold, 8337 / 50);
-  EXPECT_LT(r.most_inverted_release, 8337 / 50);
+  EXPECT_LT(r.most_inverted_hold, r.tets / 50);
+  EXPECT_LT(r.most_inverted_release, r.tets / 50);
   EXPECT_EQ(r.inverted_end, 0);
   EXPECT_LT(r.back_m, 1e-3);
   EXPECT_GT(r.deepest_m, 1e-3);  // the load does press the tongue

@@ -164,6 +164,7 @@ int main(int argc, char** argv) {
   settings.cell_mm = params.tongue.cell_mm;
   settings.min_dihedral_deg = params.tongue.snap_min_dihedral_deg;
   settings.min_volume_fraction = params.tongue.snap_min_volume_fraction;
+  settings.min_node_mass_fraction = params.tongue.min_node_mass_fraction;
   // The grid follows the attachment plane, with a level on the floor's
   // underside: the floor's free underside then lies on grid faces instead of
   // a staircase the snapping has to flatten.
@@ -197,10 +198,12 @@ int main(int argc, char** argv) {
       quality.radius_ratio_below_0_1, quality.radius_ratio_below_0_3);
   std::printf(
       "tongue snapping: %d boundary nodes, %d fully, %d partly, %d not moved; max surface"
-      " gap %.3f mm; non-manifold boundary edges %d\n",
+      " gap %.3f mm; non-manifold boundary edges %d; %d tets peeled off around light nodes,"
+      " %d light nodes left\n",
       mesher_report.boundary_nodes, mesher_report.snapped_fully, mesher_report.snapped_partly,
       mesher_report.not_snapped, mesher_report.max_surface_gap_mm,
-      mesher_report.nonmanifold_boundary_edges);
+      mesher_report.nonmanifold_boundary_edges, mesher_report.peeled_tets,
+      mesher_report.light_nodes);
 
   // Rigid bodies, in write order.
   const double res = params.surface_resolution_mm;

@@ -34,6 +34,8 @@ std::vector<Flag> flag_table(SceneParameters& p) {
       {"tongue-floor-y-mm", &t.floor_y_at_x15_mm, "attachment plane height at x = -15"},
       {"tongue-floor-slope", &t.floor_slope, "attachment plane dy/dx"},
       {"tongue-snap-min-dihedral-deg", &t.snap_min_dihedral_deg, "quality floor for snapping"},
+      {"tongue-min-node-mass-fraction", &t.min_node_mass_fraction,
+       "tets around a node lighter than this fraction of the median node are peeled off"},
       {"palate-front-x-mm", &pa.front_x_mm, "upper gum ridge, labial face"},
       {"palate-length-mm", &pa.length_mm, "hard palate length"},
       {"palate-front-half-width-mm", &pa.front_half_width_mm, "arch half width, front"},

@@ -242,17 +242,14 @@ std::vector<std::array<int, 3>> boundary_faces(const std::vector<std::array<int,
   return faces;
 }
 
-MeshedSolid mesh_implicit_solid(const ImplicitSolid& shape, const TetMesherSettings& settings,
-                                TetMesherReport& report) {
-  const Grid grid = make_grid(shape, settings);
-  report.grid_cells = grid.nx * grid.ny * grid.nz;
-  auto tets = inside_tets(shape, grid);
-  constexpr int kMaxTopologyPasses = 10;
-  for (int pass = 0; pass < kMaxTopologyPasses; ++pass) {
-    remove_nonmanifold_edges(tets);
-    if (!remove_pinched_vertices(tets)) break;
-  }
+namespace {
 
+// The grid's tets (grid node indices) as a mesh of their own nodes, with the
+// boundary nodes pulled onto the surface. The mesh's tets are in the order
+// of `tets`.
+MeshedSolid snap_grid_tets(const ImplicitSolid& shape, const Grid& grid,
+                           std::vector<std::array<int, 4>> tets, const TetMesherSettings& settings,
+                           TetMesherReport& report) {
   // Compact the used grid nodes, in grid order (deterministic numbering).
   std::map<int, int> renumber;
   for (const auto& t : tets) {
@@ -353,6 +350,66 @@ MeshedSolid mesh_implicit_solid(const ImplicitSolid& shape, const TetMesherSetti
   TriangleMesh surface{mesh.nodes, mesh.boundary};
   report.nonmanifold_boundary_edges = check_closed(surface).bad_edges;
   return mesh;
+}
+
+void make_boundary_manifold(std::vector<std::array<int, 4>>& tets) {
+  constexpr int kMaxTopologyPasses = 10;
+  for (int pass = 0; pass < kMaxTopologyPasses; ++pass) {
+    remove_nonmanifold_edges(tets);
+    if (!remove_pinched_vertices(tets)) break;
+  }
+}
+
+// Nodes whose lumped mass (a quarter of each incident tet's volume) is under
+// `fraction` of the median node's.
+std::vector<bool> light_nodes(const MeshedSolid& mesh, double fraction) {
+  std::vector<double> mass(mesh.nodes.size(), 0.0);
+  for (const auto& t : mesh.tets) {
+    const double quarter = 0.25 * tet_signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]],
+                                                    mesh.nodes[t[2]], mesh.nodes[t[3]]);
+    for (const int v : t) mass[v] += quarter;
+  }
+  std::vector<double> sorted = mass;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
+                   sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  std::vector<bool> light(mass.size(), false);
+  for (size_t v = 0; v < mass.size(); ++v) light[v] = mass[v] < fraction * median;
+  return light;
+}
+
+}  // namespace
+
+MeshedSolid mesh_implicit_solid(const ImplicitSolid& shape, const TetMesherSettings& settings,
+                                TetMesherReport& report) {
+  const Grid grid = make_grid(shape, settings);
+  auto tets = inside_tets(shape, grid);
+  make_boundary_manifold(tets);
+  // A boundary node the centroid rule left with a tet or two snaps into a
+  // node far lighter than its neighbours, and under a tool such a node is
+  // pushed on its own: its few small tets stretch many times their length.
+  // Its tets are peeled off the grid and the rest snapped again, until no
+  // node is light (or the rounds run out; the report says how many remain).
+  int peeled = 0;
+  for (int round = 0;; ++round) {
+    report = TetMesherReport{};
+    report.grid_cells = grid.nx * grid.ny * grid.nz;
+    report.peeled_tets = peeled;
+    MeshedSolid mesh = snap_grid_tets(shape, grid, tets, settings, report);
+    const std::vector<bool> light = light_nodes(mesh, settings.min_node_mass_fraction);
+    report.light_nodes = static_cast<int>(std::count(light.begin(), light.end(), true));
+    if (report.light_nodes == 0 || round == settings.peel_rounds) return mesh;
+    std::vector<std::array<int, 4>> kept;
+    for (size_t t = 0; t < tets.size(); ++t) {
+      const auto& local = mesh.tets[t];
+      const bool on_light =
+          light[local[0]] || light[local[1]] || light[local[2]] || light[local[3]];
+      if (!on_light) kept.push_back(tets[t]);
+    }
+    peeled += static_cast<int>(tets.size() - kept.size());
+    tets.swap(kept);
+    make_boundary_manifold(tets);
+  }
 }
 
 }  // namespace fahr::scenegen

@@ -22,6 +22,7 @@ struct TongueParameters {
   double floor_slope = 0.42;              // dy/dx of the attachment plane (rises anteriorly)
   double snap_min_dihedral_deg = 8.0;     // boundary snapping never goes below this
   double snap_min_volume_fraction = 0.1;  // ... nor below this fraction of a grid tet
+  double min_node_mass_fraction = 0.1;    // lighter boundary nodes have their tets peeled off
 };
 
 struct PalateParameters {

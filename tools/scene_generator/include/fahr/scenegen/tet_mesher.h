@@ -2,7 +2,9 @@
 // split into the six Kuhn (Freudenthal) tets around its main diagonal, which
 // is conforming across all cubes; tets whose centroid is inside are kept, then
 // boundary nodes are pulled onto the implicit surface, each move shortened or
-// refused when it would invert a tet or push it below the quality floor.
+// refused when it would invert a tet or push it below the quality floor;
+// the tets of nodes left far lighter than the median node are then peeled
+// off and the rest snapped again.
 #pragma once
 
 #include <array>
@@ -22,6 +24,11 @@ struct TetMesherSettings {
   int snap_passes = 3;
   // Rounds of interior smoothing, each followed by the snap passes again.
   int smoothing_rounds = 2;
+  // After snapping, the tets of a node lighter than this fraction of the
+  // median node are peeled off and the rest snapped again, for at most
+  // `peel_rounds` rounds.
+  double min_node_mass_fraction = 0.1;
+  int peel_rounds = 4;
   // The grid turned about z by this angle (a plane of the solid can then lie
   // along grid faces), and optionally one grid level put on y = this value
   // in the turned frame.
@@ -37,6 +44,8 @@ struct TetMesherReport {
   int not_snapped = 0;
   double max_surface_gap_mm = 0.0;  // |implicit value| at boundary nodes after snapping
   int nonmanifold_boundary_edges = 0;
+  int peeled_tets = 0;  // tets peeled off around light nodes
+  int light_nodes = 0;  // light nodes left after the last round
 };
 
 // The faces that belong to one tet only, outward for positively oriented
