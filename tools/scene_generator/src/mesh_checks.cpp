@@ -259,4 +259,20 @@ std::array<Vec3, 2> bounds(const std::vector<Vec3>& points) {
   return {lo, hi};
 }
 
+std::vector<double> node_mass_over_median(const MeshedSolid& mesh) {
+  std::vector<double> mass(mesh.nodes.size(), 0.0);
+  for (const auto& t : mesh.tets) {
+    const double quarter = 0.25 * tet_signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]],
+                                                    mesh.nodes[t[2]], mesh.nodes[t[3]]);
+    for (const int v : t) mass[v] += quarter;
+  }
+  if (mass.empty()) return mass;
+  std::vector<double> sorted = mass;
+  const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+  std::nth_element(sorted.begin(), middle, sorted.end());
+  const double median = *middle;
+  for (double& m : mass) m /= median;
+  return mass;
+}
+
 }  // namespace fahr::scenegen

@@ -360,21 +360,11 @@ void make_boundary_manifold(std::vector<std::array<int, 4>>& tets) {
   }
 }
 
-// Nodes whose lumped mass (a quarter of each incident tet's volume) is under
-// `fraction` of the median node's.
+// Nodes whose lumped mass is under `fraction` of the median node's.
 std::vector<bool> light_nodes(const MeshedSolid& mesh, double fraction) {
-  std::vector<double> mass(mesh.nodes.size(), 0.0);
-  for (const auto& t : mesh.tets) {
-    const double quarter = 0.25 * tet_signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]],
-                                                    mesh.nodes[t[2]], mesh.nodes[t[3]]);
-    for (const int v : t) mass[v] += quarter;
-  }
-  std::vector<double> sorted = mass;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
-                   sorted.end());
-  const double median = sorted[sorted.size() / 2];
+  const std::vector<double> mass = node_mass_over_median(mesh);
   std::vector<bool> light(mass.size(), false);
-  for (size_t v = 0; v < mass.size(); ++v) light[v] = mass[v] < fraction * median;
+  for (size_t v = 0; v < mass.size(); ++v) light[v] = mass[v] < fraction;
   return light;
 }
 

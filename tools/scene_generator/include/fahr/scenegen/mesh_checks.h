@@ -69,6 +69,10 @@ struct TetQuality {
 };
 TetQuality tet_quality(const MeshedSolid& mesh);
 
+// Each node's lumped mass (a quarter of each incident tet's volume) over the
+// median node's.
+std::vector<double> node_mass_over_median(const MeshedSolid& mesh);
+
 // Axis-aligned bounds of a point set.
 std::array<Vec3, 2> bounds(const std::vector<Vec3>& points);
 
