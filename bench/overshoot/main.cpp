@@ -45,6 +45,8 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "fahr/bench_support/results_file.h"
@@ -90,8 +92,10 @@ struct Result {
   // Elements stretched beyond kTornStrain at 1x and at the end of the hold,
   // and where the most strained one lay at 1x.
   int torn_1x = 0, torn_3x = 0;
-  int torn_1x_light = 0;   // torn at 1x with a node under kLightNode x the median node's mass
-  int light_elements = 0;  // elements with such a node
+  int torn_1x_light = 0;       // torn at 1x with a node under kLightNode x the median node's mass
+  int light_elements = 0;      // elements with such a node
+  int torn_1x_near_bone = 0;   // torn at 1x with a node within kNearM of a bone
+  int torn_1x_near_blade = 0;  // ... with its centroid within kNearM of the blade
   Eigen::Vector3d worst_1x_rest_mm = Eigen::Vector3d::Zero();
   double worst_1x_lightest_mass = 0.0;  // its lightest node's mass / the median node's
   double max_gap_error_m = 0.0;         // while lost track at the device's peak limit
@@ -229,14 +233,30 @@ struct Inversions {
       1.0;  // of the inverted tets at rest: are they the mesh's slivers?
 };
 
+// Whether element e has a node within near_m of a bone, and its centroid
+// within near_m of the blade (at the proxy's pose).
+std::pair<bool, bool> near_bone_and_blade(const stack_sim::StackSim& sim, std::size_t e,
+                                          double near_m) {
+  const fem::Body& body = sim.body();
+  const auto& proxy = sim.command().world_from_proxy();
+  const Eigen::Quaterniond q = common::to_eigen(proxy.orientation());
+  const Eigen::Vector3d t = common::to_eigen(proxy.position_m());
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  double nearest_bone = std::numeric_limits<double>::infinity();
+  for (const auto node : body.element_rest().tets[e]) {
+    const Eigen::Vector3d x = body.position(node);
+    centroid += 0.25 * x;
+    for (const auto& field : sim.fem().setup().anatomy)
+      nearest_bone = std::min(nearest_bone, field->sample(x).distance_m);
+  }
+  const auto& blade = *sim.haptic_setup().tool->sdf;
+  return {nearest_bone < near_m, blade.query(q.conjugate() * (centroid - t)).distance_m < near_m};
+}
+
 Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
   Inversions out;
   const fem::Body& body = sim.body();
   const geometry::TetMesh& mesh = sim.tongue_mesh();
-  const auto& proxy = sim.command().world_from_proxy();
-  const Eigen::Quaterniond q = common::to_eigen(proxy.orientation());
-  const Eigen::Vector3d t = common::to_eigen(proxy.position_m());
-  const auto& blade = *sim.haptic_setup().tool->sdf;
   const fem::ElementRest& elements = body.element_rest();
   for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
     const auto& tet = mesh.tets()[e];
@@ -249,16 +269,9 @@ Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
     out.worst_rest_radius_ratio = std::min(
         out.worst_rest_radius_ratio,
         geometry::tet_shape(rest[tet[0]], rest[tet[1]], rest[tet[2]], rest[tet[3]]).radius_ratio);
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    double nearest_bone = std::numeric_limits<double>::infinity();
-    for (const auto node : tet) {
-      const Eigen::Vector3d x = body.position(node);
-      centroid += 0.25 * x;
-      for (const auto& field : sim.fem().setup().anatomy)
-        nearest_bone = std::min(nearest_bone, field->sample(x).distance_m);
-    }
-    if (nearest_bone < near_m) ++out.near_anatomy;
-    if (blade.query(q.conjugate() * (centroid - t)).distance_m < near_m) ++out.near_blade;
+    const auto [bone, blade] = near_bone_and_blade(sim, e, near_m);
+    out.near_anatomy += bone ? 1 : 0;
+    out.near_blade += blade ? 1 : 0;
   }
   return out;
 }
@@ -342,6 +355,26 @@ struct StrainSurvey {
 // sphere's centre far larger than the centre's (the mass-weighted spread,
 // contact-contract.md).
 constexpr double kLightNode = 0.25;
+
+// Where the torn elements lie: this close (m) to a bone or to the blade.
+constexpr double kNearM = 1e-3;
+
+// Elements past kTornStrain with a node within kNearM of a bone, and with
+// their centroid within kNearM of the blade.
+std::pair<int, int> torn_near_bone_and_blade(const stack_sim::StackSim& sim) {
+  const fem::Body& body = sim.body();
+  const fem::ElementRest& elements = body.element_rest();
+  std::pair<int, int> count{0, 0};
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    const double strain = fem::principal_green_strain(geometry::deformation_gradient(
+        body.positions_m().data(), elements.tets[e], elements.dm_inv[e]));
+    if (!(strain > kTornStrain)) continue;
+    const auto [bone, blade] = near_bone_and_blade(sim, e, kNearM);
+    count.first += bone ? 1 : 0;
+    count.second += blade ? 1 : 0;
+  }
+  return count;
+}
 
 StrainSurvey survey_strain(const fem::Body& body) {
   StrainSurvey out;
@@ -509,6 +542,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         r.torn_1x = survey.beyond;
         r.torn_1x_light = survey.beyond_light;
         r.light_elements = survey.light;
+        std::tie(r.torn_1x_near_bone, r.torn_1x_near_blade) = torn_near_bone_and_blade(sim);
         r.worst_1x_lightest_mass = survey.worst_lightest;
         for (const std::uint32_t n : sim.body().element_rest().tets[survey.worst])
           r.worst_1x_rest_mm += 1e3 / 4.0 * sim.body().rest_position(n);  // centroid, mm
@@ -769,6 +803,11 @@ int main(int argc, char** argv) {
         "| ... of those at 1x, with a node lighter than %.2f x the median node (elements with one: "
         "%d) | %d | - |\n",
         kLightNode, fa.light_elements, fa.torn_1x_light);
+    std::printf(
+        "| ... of those at 1x, with a node within %.0f mm of a bone / with the centroid within "
+        "%.0f "
+        "mm of the blade | %d / %d | - |\n",
+        1e3 * kNearM, 1e3 * kNearM, fa.torn_1x_near_bone, fa.torn_1x_near_blade);
     std::printf(
         "| the most strained element at 1x: rest centroid mm; its lightest node's mass / the "
         "median node's | (%.1f, %.1f, %.1f); %.2f | - |\n",
