@@ -2,6 +2,7 @@
 // their output and workspace buffers (cholmod_solve2) and allocate nothing.
 #include "fahr/fem/cholmod_solver.h"
 
+#include <cblas.h>
 #include <cholmod.h>
 #include <pthread.h>
 #include <sys/resource.h>
@@ -107,6 +108,92 @@ FAHR_VECTOR_CLONES void forward3_on_factor(const cholmod_factor& f, std::size_t 
       y1[row] -= u1[r];
       y2[row] -= u2[r];
     }
+  }
+}
+
+// forward_gram_on_reach on the factor f of n rows (see the header).
+void forward_gram_on_factor(const cholmod_factor& f, std::size_t n,
+                            std::span<const HalfSolveColumns> groups, PanelWorkspace& work,
+                            std::span<double> gram) {
+  const int* super = static_cast<const int*>(f.super);
+  const int* pi = static_cast<const int*>(f.pi);
+  const int* px = static_cast<const int*>(f.px);
+  const int* srow = static_cast<const int*>(f.s);
+  const double* lx = static_cast<const double*>(f.x);
+  const std::size_t count = groups.size();
+  const std::size_t width = 3 * count;
+  std::fill(gram.begin(), gram.begin() + static_cast<std::ptrdiff_t>(width * width), 0.0);
+  if (count == 0) return;
+  std::size_t widest = 1;
+  std::size_t deepest = 1;
+  for (std::size_t k = 0; k < f.nsuper; ++k) {
+    const auto columns = std::size_t(super[k + 1] - super[k]);
+    widest = std::max(widest, columns);
+    deepest = std::max(deepest, std::size_t(pi[k + 1] - pi[k]) - columns);
+  }
+  if (work.panel.size() < widest * width) work.panel.resize(widest * width);
+  if (work.below.size() < deepest * width) work.below.resize(deepest * width);
+  if (work.gram.size() < width * width) work.gram.resize(width * width);
+  work.cursor.assign(count, 0);
+  work.active.resize(count);
+  double* panel = work.panel.data();
+  double* below_update = work.below.data();
+  double* panel_gram = work.gram.data();
+  for (std::size_t k = 0; k < f.nsuper; ++k) {
+    std::size_t active = 0;
+    for (std::size_t g = 0; g < count; ++g) {
+      const HalfSolveColumns& group = groups[g];
+      if (work.cursor[g] < group.count && std::size_t(group.reach[work.cursor[g]]) == k) {
+        work.active[active++] = g;
+        ++work.cursor[g];
+      }
+    }
+    if (active == 0) continue;
+    const auto first = std::size_t(super[k]);
+    const auto columns = std::size_t(super[k + 1]) - first;
+    const auto rows_k = std::size_t(pi[k + 1] - pi[k]);
+    const auto below = rows_k - columns;
+    const int panel_columns = static_cast<int>(3 * active);
+    const int m = static_cast<int>(columns);
+    const int ld = static_cast<int>(rows_k);
+    const double* l = lx + px[k];
+    // The panel: the active columns' rows of this supernode, column-major.
+    for (std::size_t a = 0; a < active; ++a) {
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double* from = groups[work.active[a]].y + d * n + first;
+        std::copy(from, from + columns, panel + (3 * a + d) * columns);
+      }
+    }
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, m, panel_columns,
+                1.0, l, ld, panel, m);
+    if (below > 0) {
+      cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, static_cast<int>(below), panel_columns,
+                  m, 1.0, l + columns, ld, panel, m, 0.0, below_update, static_cast<int>(below));
+    }
+    cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, panel_columns, m, 1.0, panel, m, 0.0,
+                panel_gram, panel_columns);
+    const int* below_rows = srow + pi[k] + static_cast<std::ptrdiff_t>(columns);
+    for (std::size_t a = 0; a < active; ++a) {
+      for (std::size_t d = 0; d < 3; ++d) {
+        const std::size_t c = 3 * a + d;
+        double* y = groups[work.active[a]].y + d * n;
+        std::copy(panel + c * columns, panel + (c + 1) * columns, y + first);
+        const double* u = below_update + c * below;
+        for (std::size_t r = 0; r < below; ++r) y[std::size_t(below_rows[r])] -= u[r];
+      }
+    }
+    // The panel's upper triangle into the groups' rows and columns (the
+    // active groups ascend, so it lands on the upper triangle there too).
+    for (std::size_t j = 0; j < std::size_t(panel_columns); ++j) {
+      const std::size_t big_j = 3 * work.active[j / 3] + j % 3;
+      for (std::size_t i = 0; i <= j; ++i) {
+        const std::size_t big_i = 3 * work.active[i / 3] + i % 3;
+        gram[big_i * width + big_j] += panel_gram[i + j * std::size_t(panel_columns)];
+      }
+    }
+  }
+  for (std::size_t i = 0; i < width; ++i) {
+    for (std::size_t j = 0; j < i; ++j) gram[i * width + j] = gram[j * width + i];
   }
 }
 
@@ -501,6 +588,12 @@ void CholmodSolver::forward3_on_reach(std::span<const int> reach, std::span<doub
   forward3_on_factor(*s.factor, s.rows, s.update, reach, y);
 }
 
+void CholmodSolver::forward_gram_on_reach(std::span<const HalfSolveColumns> groups,
+                                          PanelWorkspace& work, std::span<double> gram) {
+  State& s = *state_;
+  forward_gram_on_factor(*s.factor, s.rows, groups, work, gram);
+}
+
 std::size_t CholmodSolver::NewFactor::reach(std::span<const std::uint32_t> dofs,
                                             std::span<int> out) {
   State& s = *state_;
@@ -511,6 +604,12 @@ std::size_t CholmodSolver::NewFactor::reach(std::span<const std::uint32_t> dofs,
 void CholmodSolver::NewFactor::forward3_on_reach(std::span<const int> reach, std::span<double> y) {
   State& s = *state_;
   forward3_on_factor(*s.background->factor, s.rows, s.background->update, reach, y);
+}
+
+void CholmodSolver::NewFactor::forward_gram_on_reach(std::span<const HalfSolveColumns> groups,
+                                                     PanelWorkspace& work, std::span<double> gram) {
+  State& s = *state_;
+  forward_gram_on_factor(*s.background->factor, s.rows, groups, work, gram);
 }
 
 int CholmodSolver::NewFactor::permuted(std::size_t dof) const {

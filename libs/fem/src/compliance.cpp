@@ -54,6 +54,10 @@ void ComplianceBlock::reserve(std::size_t dofs, std::size_t max_spheres) {
   pending_.assign(max_spheres, Pending{});
   pending_count_ = 0;
   pending_pairs_.assign(9 * max_spheres * max_spheres, 0.0);
+  pending_groups_.assign(max_spheres, HalfSolveColumns{});
+  pending_gram_.assign(9 * max_spheres * max_spheres, 0.0);
+  step_groups_.assign(max_spheres, HalfSolveColumns{});
+  step_gram_.assign(9 * max_spheres * max_spheres, 0.0);
   pending_sphere_dofs_.reserve(std::size_t{3} * 16);
   last_request_.assign(max_spheres, 0);
   last_request_count_ = 0;
@@ -117,7 +121,7 @@ void ComplianceBlock::solve_chunk(std::span<const std::size_t> slots, const Sphe
 }
 
 template <typename Factor>
-std::size_t ComplianceBlock::solve_half_into(std::size_t slot, std::size_t area,
+std::size_t ComplianceBlock::place_half_into(std::size_t slot, std::size_t area,
                                              std::uint32_t sphere, const SphereLinks& links,
                                              std::span<const std::uint8_t> fixed_dof,
                                              Factor& factor,
@@ -144,7 +148,18 @@ std::size_t ComplianceBlock::solve_half_into(std::size_t slot, std::size_t area,
       if (fixed_dof[dof] == 0) y[factor.permuted(dof)] += weights[m];
     }
   }
-  factor.forward3_on_reach(supernodes, {column_in(slot, area, 0), 3 * dofs_});
+  return count;
+}
+
+template <typename Factor>
+std::size_t ComplianceBlock::solve_half_into(std::size_t slot, std::size_t area,
+                                             std::uint32_t sphere, const SphereLinks& links,
+                                             std::span<const std::uint8_t> fixed_dof,
+                                             Factor& factor,
+                                             std::vector<std::uint32_t>& sphere_dofs) {
+  const std::size_t count =
+      place_half_into(slot, area, sphere, links, fixed_dof, factor, sphere_dofs);
+  factor.forward3_on_reach({reach_in(slot, area), count}, {column_in(slot, area, 0), 3 * dofs_});
   return count;
 }
 
@@ -160,6 +175,48 @@ void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
   for (std::size_t other = 0; other < count; ++other) {
     pair_known_[slot * count + other] = 0;
     pair_known_[other * count + slot] = 0;
+  }
+}
+
+// The slots of to_solve_ solved in one pass over the factor, their
+// products with each other from the same pass; their products with the
+// other slots are computed again when asked for.
+void ComplianceBlock::solve_halves(const SphereLinks& links,
+                                   std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor) {
+  const std::size_t solving = to_solve_.size();
+  if (solving == 0) return;
+  if (solving == 1) {
+    solve_half(to_solve_.front(), links, fixed_dof, factor);
+    return;
+  }
+  const std::size_t count = slots_.size();
+  const std::uint64_t factorisation = factor.factorisations();
+  for (std::size_t i = 0; i < solving; ++i) {
+    const std::size_t slot = to_solve_[i];
+    Slot& kept = slots_[slot];
+    kept.reach =
+        place_half_into(slot, area_[slot], kept.sphere, links, fixed_dof, factor, sphere_dofs_);
+    kept.factorisation = factorisation;
+    kept.valid = true;
+    for (std::size_t other = 0; other < count; ++other) {
+      pair_known_[slot * count + other] = 0;
+      pair_known_[other * count + slot] = 0;
+    }
+    step_groups_[i] = HalfSolveColumns{
+        .y = column(slot, 0), .reach = reach_in(slot, area_[slot]), .count = kept.reach};
+  }
+  const std::size_t width = 3 * solving;
+  factor.forward_gram_on_reach({step_groups_.data(), solving}, step_work_,
+                               {step_gram_.data(), width * width});
+  for (std::size_t i = 0; i < solving; ++i) {
+    for (std::size_t j = 0; j < solving; ++j) {
+      double* block = pairs_.data() + 9 * (to_solve_[i] * count + to_solve_[j]);
+      for (std::size_t d = 0; d < 3; ++d) {
+        for (std::size_t e = 0; e < 3; ++e)
+          block[3 * d + e] = step_gram_[(3 * i + d) * width + 3 * j + e];
+      }
+      pair_known_[to_solve_[i] * count + to_solve_[j]] = 1;
+    }
   }
 }
 
@@ -249,28 +306,27 @@ void ComplianceBlock::refresh_on(CholmodSolver::NewFactor& factor) {
     return;
   }
   // Into each slot's buffer not in use: the step reads and writes only the
-  // other until adopt_refresh().
+  // other until adopt_refresh(). All of them in one pass over the factor:
+  // the supernodes near the root, which every sphere reaches, are read once
+  // instead of once per sphere, and their products come as one Gram matrix.
   for (std::size_t i = 0; i < pending_count_; ++i) {
     Pending& p = pending_[i];
     const std::size_t spare = 1 - area_[p.slot];
-    p.reach = solve_half_into(p.slot, spare, p.sphere, *pending_links_, pending_fixed_dof_, factor,
+    p.reach = place_half_into(p.slot, spare, p.sphere, *pending_links_, pending_fixed_dof_, factor,
                               pending_sphere_dofs_);
+    pending_groups_[i] = HalfSolveColumns{
+        .y = column_in(p.slot, spare, 0), .reach = reach_in(p.slot, spare), .count = p.reach};
   }
-  const int* bounds = factor.supernode_bounds();
+  const std::size_t width = 3 * pending_count_;
+  factor.forward_gram_on_reach({pending_groups_.data(), pending_count_}, pending_work_,
+                               {pending_gram_.data(), width * width});
   for (std::size_t i = 0; i < pending_count_; ++i) {
-    const Pending& p = pending_[i];
-    const std::size_t area_p = 1 - area_[p.slot];
-    const double* ys[3] = {column_in(p.slot, area_p, 0), column_in(p.slot, area_p, 1),
-                           column_in(p.slot, area_p, 2)};
-    const int* a = reach_in(p.slot, area_p);
     for (std::size_t j = i; j < pending_count_; ++j) {
-      const Pending& q = pending_[j];
-      const std::size_t area_q = 1 - area_[q.slot];
-      const double* yt[3] = {column_in(q.slot, area_q, 0), column_in(q.slot, area_q, 1),
-                             column_in(q.slot, area_q, 2)};
-      const int* b = reach_in(q.slot, area_q);
-      reach_product(bounds, ys, a, a + p.reach, yt, b, b + q.reach,
-                    pending_pairs_.data() + 9 * (i * pending_count_ + j));
+      double* sum = pending_pairs_.data() + 9 * (i * pending_count_ + j);
+      for (std::size_t d = 0; d < 3; ++d) {
+        for (std::size_t e = 0; e < 3; ++e)
+          sum[3 * d + e] = pending_gram_[(3 * i + d) * width + 3 * j + e];
+      }
     }
   }
 }
@@ -380,7 +436,7 @@ bool ComplianceBlock::compute(std::span<const std::uint32_t> spheres, const Sphe
   last_request_count_ = k;
   const double h2 = time_step_s * time_step_s;
   if (half_solves) {
-    for (const std::size_t slot : to_solve_) solve_half(slot, links, fixed_dof, factor);
+    solve_halves(links, fixed_dof, factor);
     for (std::size_t s = 0; s < k; ++s) {
       for (std::size_t t = 0; t < k; ++t) {
         const double* block = half_product(request_slots_[s], request_slots_[t], factor);

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "fahr/fem/assembly.h"
 
@@ -32,6 +33,25 @@ enum class CholmodOrdering {
 struct CholmodOptions {
   CholmodFactorKind factor = CholmodFactorKind::kAuto;
   CholmodOrdering ordering = CholmodOrdering::kMetis;
+};
+
+// Three columns of rows() entries each, one after the other at `y`, in the
+// factor's ordering, holding P B on the rows of the ascending supernodes
+// reach[0, count) (as forward3_on_reach wants them): one sphere's half solve.
+struct HalfSolveColumns {
+  double* y = nullptr;
+  const int* reach = nullptr;
+  std::size_t count = 0;
+};
+
+// Scratch of forward_gram_on_reach: it grows to the largest call's size
+// (the first refresh of a full block), then nothing allocates.
+struct PanelWorkspace {
+  std::vector<double> panel;  // one supernode's rows of the active columns
+  std::vector<double> below;  // their update to the rows below it
+  std::vector<double> gram;   // the active columns' products on it
+  std::vector<std::size_t> cursor;
+  std::vector<std::size_t> active;
 };
 
 class CholmodSolver {
@@ -130,6 +150,15 @@ class CholmodSolver {
   // before scattering B; other rows are neither read nor written). L is
   // read once for the three. No allocation.
   void forward3_on_reach(std::span<const int> reach, std::span<double> y);
+  // Y := L^-1 Y for several spheres' columns at once, and gram := Y^T Y,
+  // row-major, (3 x groups) squared. Each supernode of L is read once for
+  // all the groups that reach it, as one dense panel (BLAS level 3: the
+  // triangular solve, the update below, the panel's Gram product); a group
+  // is zero outside its reach, so the sum over the supernodes a pair shares
+  // is the pair's product. The same Y as forward3_on_reach within rounding.
+  // No allocation once `work` has grown to the largest count of groups.
+  void forward_gram_on_reach(std::span<const HalfSolveColumns> groups, PanelWorkspace& work,
+                             std::span<double> gram);
 
   // The sparse forward solve above on a background factorisation's new
   // factor, on its thread (AfterFactor), with visit marks and an update
@@ -140,6 +169,9 @@ class CholmodSolver {
    public:
     std::size_t reach(std::span<const std::uint32_t> dofs, std::span<int> out);
     void forward3_on_reach(std::span<const int> reach, std::span<double> y);
+    // As CholmodSolver's, on the new factor.
+    void forward_gram_on_reach(std::span<const HalfSolveColumns> groups, PanelWorkspace& work,
+                               std::span<double> gram);
     int permuted(std::size_t dof) const;
     int supernode_first(int k) const;
     int supernode_end(int k) const;

@@ -122,12 +122,20 @@ class ComplianceBlock {
                    WarpedFactor& warp);
   // The half solve of `sphere` on `factor` into the slot's buffer `area`
   // (0 or 1) and its reach; returns the reach's length.
+  // The sphere's right-hand side P J_s^T on its reach (returned: its
+  // supernode count), ready for a forward solve.
+  template <typename Factor>
+  std::size_t place_half_into(std::size_t slot, std::size_t area, std::uint32_t sphere,
+                              const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
+                              Factor& factor, std::vector<std::uint32_t>& sphere_dofs);
   template <typename Factor>
   std::size_t solve_half_into(std::size_t slot, std::size_t area, std::uint32_t sphere,
                               const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
                               Factor& factor, std::vector<std::uint32_t>& sphere_dofs);
   void solve_half(std::size_t slot, const SphereLinks& links,
                   std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor);
+  void solve_halves(const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
+                    CholmodSolver& factor);
   // Y_s^T Y_t of two half-solved slots (row-major 3x3), kept until either
   // is solved again.
   const double* half_product(std::size_t s, std::size_t t, const CholmodSolver& factor);
@@ -169,6 +177,12 @@ class ComplianceBlock {
   std::vector<Pending> pending_;
   std::size_t pending_count_ = 0;
   std::vector<double> pending_pairs_;
+  std::vector<HalfSolveColumns> pending_groups_;  // the pending spheres' columns
+  std::vector<double> pending_gram_;              // their products, 3 x pending squared
+  PanelWorkspace pending_work_;
+  std::vector<HalfSolveColumns> step_groups_;  // the same for the step's own solves
+  std::vector<double> step_gram_;
+  PanelWorkspace step_work_;
   std::vector<std::uint32_t> pending_sphere_dofs_;
   const SphereLinks* pending_links_ = nullptr;
   std::span<const std::uint8_t> pending_fixed_dof_;
