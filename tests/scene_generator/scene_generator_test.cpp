@@ -25,6 +25,7 @@
 #include "fahr/geometry/tet_quality.h"
 #include "fahr/scenegen/mesh_checks.h"
 #include "fahr/scenegen/mesh_readers.h"
+#include "fahr/scenegen/scene_parameters.h"
 #include "fahr/scenegen/tet_mesher.h"
 
 namespace {
@@ -181,6 +182,37 @@ TEST_F(SceneGeneratorTest, TetsHavePositiveVolumeAndBoundaryIsClosed) {
   EXPECT_GE(tongue.tets.size(), 5600u);
   EXPECT_LE(tongue.tets.size(), 10000u);
   expect_valid_tets(tongue);
+}
+
+// Snapping and smoothing shorten or refuse every move that would leave a
+// tet flatter or smaller than the floor (the generator's
+// --tongue-snap-min-dihedral-deg and --tongue-snap-min-volume-fraction of
+// a grid tet); the grid's Kuhn tets start well above it. So no tet of the
+// tongue ends under it (less the written coordinates' rounding). A refused
+// smoothing move that was not undone left the shipped tongue a tet 2 %
+// under the volume floor.
+TEST_F(SceneGeneratorTest, NoTongueTetIsUnderTheSnappingFloor) {
+  MeshedSolid tongue;
+  std::string error;
+  ASSERT_TRUE(fahr::scenegen::read_tetgen((*first_ / "tongue").string(), tongue, error)) << error;
+  const fahr::scenegen::TongueParameters defaults;
+  const double floor_volume =
+      defaults.snap_min_volume_fraction * std::pow(defaults.cell_mm, 3) / 6.0;
+  int under = 0;
+  double smallest = floor_volume;
+  for (const auto& t : tongue.tets) {
+    const Vec3& a = tongue.nodes[t[0]];
+    const Vec3& b = tongue.nodes[t[1]];
+    const Vec3& c = tongue.nodes[t[2]];
+    const Vec3& d = tongue.nodes[t[3]];
+    const double volume = fahr::scenegen::tet_signed_volume(a, b, c, d);
+    smallest = std::min(smallest, volume);
+    const bool flat =
+        fahr::scenegen::tet_min_dihedral_deg(a, b, c, d) < defaults.snap_min_dihedral_deg - 0.01;
+    under += volume < 0.999 * floor_volume || flat ? 1 : 0;
+  }
+  EXPECT_EQ(under, 0) << "smallest volume " << smallest << " mm^3 against the floor "
+                      << floor_volume;
 }
 
 // The generator's radius ratio (which its quality line prints) is the

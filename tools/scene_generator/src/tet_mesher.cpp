@@ -286,7 +286,7 @@ MeshedSolid snap_grid_tets(const ImplicitSolid& shape, const Grid& grid,
   const double grid_tet_volume = std::pow(settings.cell_mm, 3) / 6.0;
   const double min_volume = settings.min_volume_fraction * grid_tet_volume;
   std::vector<double> moved_fraction(mesh.nodes.size(), 0.0);
-  const auto move_guarded = [&](int v, const Vec3& start, const Vec3& target,
+  const auto move_guarded = [&](int v, const Vec3 start, const Vec3 target,
                                 std::initializer_list<double> fractions) {
     for (const double fraction : fractions) {
       mesh.nodes[v] = start + fraction * (target - start);
