@@ -286,8 +286,12 @@ MeshedSolid snap_grid_tets(const ImplicitSolid& shape, const Grid& grid,
   const double grid_tet_volume = std::pow(settings.cell_mm, 3) / 6.0;
   const double min_volume = settings.min_volume_fraction * grid_tet_volume;
   std::vector<double> moved_fraction(mesh.nodes.size(), 0.0);
-  const auto move_guarded = [&](int v, const Vec3 start, const Vec3 target,
+  // Moves node v towards `target`, the first of `fractions` of the way
+  // that keeps its tets above the floor, or not at all. Its start is a
+  // copy: the tries overwrite the node, and a refused move puts it back.
+  const auto move_guarded = [&](int v, const Vec3& target,
                                 std::initializer_list<double> fractions) {
+    const Vec3 start = mesh.nodes[v];
     for (const double fraction : fractions) {
       mesh.nodes[v] = start + fraction * (target - start);
       bool ok = true;
@@ -323,14 +327,13 @@ MeshedSolid snap_grid_tets(const ImplicitSolid& shape, const Grid& grid,
         Vec3 mean = Vec3::Zero();
         for (const int u : neighbours[v]) mean += mesh.nodes[u];
         mean /= static_cast<double>(neighbours[v].size());
-        move_guarded(static_cast<int>(v), mesh.nodes[v], mean, {0.5, 0.25});
+        move_guarded(static_cast<int>(v), mean, {0.5, 0.25});
       }
     }
     for (int pass = 0; pass < settings.snap_passes; ++pass) {
       for (const int v : boundary_nodes) {
-        const Vec3 start = mesh.nodes[v];
         moved_fraction[v] =
-            move_guarded(v, start, shape.project_to_surface(start), {1.0, 0.5, 0.25});
+            move_guarded(v, shape.project_to_surface(mesh.nodes[v]), {1.0, 0.5, 0.25});
       }
     }
   }
