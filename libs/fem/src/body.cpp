@@ -150,6 +150,7 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
   warp_.set_enabled(settings_.solver.warp_lagged_factor);
   if (!cholmod_.analyze(assembly_.matrix(), settings_.solver.cholmod))
     return "CHOLMOD symbolic analysis failed";
+  compliance_.reserve_panels(cholmod_);
   assemble_system();
   if (!refactorise()) return "the rest system matrix is not positive definite";
   return configure_background_factor();
@@ -294,6 +295,7 @@ std::string Body::set_solver(const SolverSettings& solver) {
   warp_.set_enabled(solver.warp_lagged_factor);
   if (reanalyse && !cholmod_.analyze(assembly_.matrix(), solver.cholmod))
     return "CHOLMOD symbolic analysis failed";
+  if (reanalyse) compliance_.reserve_panels(cholmod_);
   warp_.update_rotations(rest_, rotations_);
   if (snh_) update_deformations();
   assemble_system();

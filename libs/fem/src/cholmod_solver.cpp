@@ -111,6 +111,26 @@ FAHR_VECTOR_CLONES void forward3_on_factor(const cholmod_factor& f, std::size_t 
   }
 }
 
+// Room in `work` for `groups` spheres' panels on the supernodal factor f:
+// its widest supernode's columns and deepest rows below one.
+void size_panels(const cholmod_factor& f, std::size_t groups, PanelWorkspace& work) {
+  const int* super = static_cast<const int*>(f.super);
+  const int* pi = static_cast<const int*>(f.pi);
+  std::size_t widest = 1;
+  std::size_t deepest = 1;
+  for (std::size_t k = 0; k < f.nsuper; ++k) {
+    const auto columns = std::size_t(super[k + 1] - super[k]);
+    widest = std::max(widest, columns);
+    deepest = std::max(deepest, std::size_t(pi[k + 1] - pi[k]) - columns);
+  }
+  const std::size_t width = 3 * groups;
+  if (work.panel.size() < widest * width) work.panel.resize(widest * width);
+  if (work.below.size() < deepest * width) work.below.resize(deepest * width);
+  if (work.gram.size() < width * width) work.gram.resize(width * width);
+  if (work.cursor.size() < groups) work.cursor.resize(groups);
+  if (work.active.size() < groups) work.active.resize(groups);
+}
+
 // forward_gram_on_reach on the factor f of n rows (see the header).
 void forward_gram_on_factor(const cholmod_factor& f, std::size_t n,
                             std::span<const HalfSolveColumns> groups, PanelWorkspace& work,
@@ -124,18 +144,8 @@ void forward_gram_on_factor(const cholmod_factor& f, std::size_t n,
   const std::size_t width = 3 * count;
   std::fill(gram.begin(), gram.begin() + static_cast<std::ptrdiff_t>(width * width), 0.0);
   if (count == 0) return;
-  std::size_t widest = 1;
-  std::size_t deepest = 1;
-  for (std::size_t k = 0; k < f.nsuper; ++k) {
-    const auto columns = std::size_t(super[k + 1] - super[k]);
-    widest = std::max(widest, columns);
-    deepest = std::max(deepest, std::size_t(pi[k + 1] - pi[k]) - columns);
-  }
-  if (work.panel.size() < widest * width) work.panel.resize(widest * width);
-  if (work.below.size() < deepest * width) work.below.resize(deepest * width);
-  if (work.gram.size() < width * width) work.gram.resize(width * width);
-  work.cursor.assign(count, 0);
-  work.active.resize(count);
+  size_panels(f, count, work);  // nothing if reserve_panels() made room
+  std::fill(work.cursor.begin(), work.cursor.begin() + static_cast<std::ptrdiff_t>(count), 0);
   double* panel = work.panel.data();
   double* below_update = work.below.data();
   double* panel_gram = work.gram.data();
@@ -592,6 +602,11 @@ void CholmodSolver::forward_gram_on_reach(std::span<const HalfSolveColumns> grou
                                           PanelWorkspace& work, std::span<double> gram) {
   State& s = *state_;
   forward_gram_on_factor(*s.factor, s.rows, groups, work, gram);
+}
+
+void CholmodSolver::reserve_panels(PanelWorkspace& work, std::size_t groups) const {
+  const State& s = *state_;
+  if (s.factor != nullptr && s.factor->is_super != 0) size_panels(*s.factor, groups, work);
 }
 
 std::size_t CholmodSolver::NewFactor::reach(std::span<const std::uint32_t> dofs,

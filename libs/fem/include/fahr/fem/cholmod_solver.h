@@ -44,8 +44,9 @@ struct HalfSolveColumns {
   std::size_t count = 0;
 };
 
-// Scratch of forward_gram_on_reach: it grows to the largest call's size
-// (the first refresh of a full block), then nothing allocates.
+// Scratch of forward_gram_on_reach, sized for a count of spheres by
+// CholmodSolver::reserve_panels after the analysis (a call for more grows
+// it once).
 struct PanelWorkspace {
   std::vector<double> panel;  // one supernode's rows of the active columns
   std::vector<double> below;  // their update to the rows below it
@@ -159,6 +160,9 @@ class CholmodSolver {
   // No allocation once `work` has grown to the largest count of groups.
   void forward_gram_on_reach(std::span<const HalfSolveColumns> groups, PanelWorkspace& work,
                              std::span<double> gram);
+  // Room in `work` for up to `groups` spheres on this analysis's supernodes
+  // (set-up: it allocates).
+  void reserve_panels(PanelWorkspace& work, std::size_t groups) const;
 
   // The sparse forward solve above on a background factorisation's new
   // factor, on its thread (AfterFactor), with visit marks and an update

@@ -48,6 +48,12 @@ class ComplianceBlock {
   // Sizes the cache and the right-hand sides for up to max_spheres
   // candidates. Allocates.
   void reserve(std::size_t dofs, std::size_t max_spheres);
+  // After the factor's analysis: room for the panel solves of a full block
+  // on its supernodes (set-up: it allocates).
+  void reserve_panels(const CholmodSolver& factor) {
+    factor.reserve_panels(step_work_, max_spheres_);
+    factor.reserve_panels(pending_work_, max_spheres_);
+  }
   std::size_t capacity() const { return max_spheres_; }
   // Spheres whose kept columns are solved again on a newer factorisation
   // per compute() call, half of them the first in the request, the others
