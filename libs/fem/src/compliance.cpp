@@ -151,44 +151,14 @@ std::size_t ComplianceBlock::place_half_into(std::size_t slot, std::size_t area,
   return count;
 }
 
-template <typename Factor>
-std::size_t ComplianceBlock::solve_half_into(std::size_t slot, std::size_t area,
-                                             std::uint32_t sphere, const SphereLinks& links,
-                                             std::span<const std::uint8_t> fixed_dof,
-                                             Factor& factor,
-                                             std::vector<std::uint32_t>& sphere_dofs) {
-  const std::size_t count =
-      place_half_into(slot, area, sphere, links, fixed_dof, factor, sphere_dofs);
-  factor.forward3_on_reach({reach_in(slot, area), count}, {column_in(slot, area, 0), 3 * dofs_});
-  return count;
-}
-
-void ComplianceBlock::solve_half(std::size_t slot, const SphereLinks& links,
-                                 std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor) {
-  Slot& kept = slots_[slot];
-  kept.reach =
-      solve_half_into(slot, area_[slot], kept.sphere, links, fixed_dof, factor, sphere_dofs_);
-  kept.factorisation = factor.factorisations();
-  kept.valid = true;
-  // Its products with the others are computed again when asked for.
-  const std::size_t count = slots_.size();
-  for (std::size_t other = 0; other < count; ++other) {
-    pair_known_[slot * count + other] = 0;
-    pair_known_[other * count + slot] = 0;
-  }
-}
-
-// The slots of to_solve_ solved in one pass over the factor, their
-// products with each other from the same pass; their products with the
-// other slots are computed again when asked for.
+// The slots of to_solve_ solved on the factor, their products with the
+// other slots computed again when asked for. One slot reads L along its
+// reach (forward3_on_reach); several go through it in one pass, their
+// products with each other from the same pass.
 void ComplianceBlock::solve_halves(const SphereLinks& links,
                                    std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor) {
   const std::size_t solving = to_solve_.size();
   if (solving == 0) return;
-  if (solving == 1) {
-    solve_half(to_solve_.front(), links, fixed_dof, factor);
-    return;
-  }
   const std::size_t count = slots_.size();
   const std::uint64_t factorisation = factor.factorisations();
   for (std::size_t i = 0; i < solving; ++i) {
@@ -204,6 +174,11 @@ void ComplianceBlock::solve_halves(const SphereLinks& links,
     }
     step_groups_[i] = HalfSolveColumns{
         .y = column(slot, 0), .reach = reach_in(slot, area_[slot]), .count = kept.reach};
+  }
+  if (solving == 1) {
+    const HalfSolveColumns& one = step_groups_.front();
+    factor.forward3_on_reach({one.reach, one.count}, {one.y, 3 * dofs_});
+    return;
   }
   const std::size_t width = 3 * solving;
   factor.forward_gram_on_reach({step_groups_.data(), solving}, step_work_,

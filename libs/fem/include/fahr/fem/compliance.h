@@ -126,20 +126,13 @@ class ComplianceBlock {
   void solve_chunk(std::span<const std::size_t> slots, const SphereLinks& links,
                    std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor,
                    WarpedFactor& warp);
-  // The half solve of `sphere` on `factor` into the slot's buffer `area`
-  // (0 or 1) and its reach; returns the reach's length.
-  // The sphere's right-hand side P J_s^T on its reach (returned: its
-  // supernode count), ready for a forward solve.
+  // The right-hand side P J_s^T of `sphere` on its reach, into the slot's
+  // buffer `area` (0 or 1), ready for a forward solve on `factor`; returns
+  // the reach's length.
   template <typename Factor>
   std::size_t place_half_into(std::size_t slot, std::size_t area, std::uint32_t sphere,
                               const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
                               Factor& factor, std::vector<std::uint32_t>& sphere_dofs);
-  template <typename Factor>
-  std::size_t solve_half_into(std::size_t slot, std::size_t area, std::uint32_t sphere,
-                              const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
-                              Factor& factor, std::vector<std::uint32_t>& sphere_dofs);
-  void solve_half(std::size_t slot, const SphereLinks& links,
-                  std::span<const std::uint8_t> fixed_dof, CholmodSolver& factor);
   void solve_halves(const SphereLinks& links, std::span<const std::uint8_t> fixed_dof,
                     CholmodSolver& factor);
   // Y_s^T Y_t of two half-solved slots (row-major 3x3), kept until either
