@@ -28,6 +28,70 @@
 #include "fahr/scene/load_scene.h"
 #include "fahr/stack_sim/stack_sim.h"
 
+namespace {
+
+// Where the FEM step thread's CPU goes: per part, its median and p99 over
+// all steps and its mean over the slowest 1 % of steps (those at or above
+// the step thread's p99), in the order a step runs them.
+void print_fem_step_parts(const std::vector<fahr::stack_sim::StackSim::FemStepCpu>& steps) {
+  if (steps.empty()) return;
+  std::vector<std::int64_t> thread;
+  thread.reserve(steps.size());
+  for (const auto& s : steps) thread.push_back(s.thread_ns);
+  std::sort(thread.begin(), thread.end());
+  const std::int64_t slow =
+      thread[static_cast<std::size_t>(0.99 * static_cast<double>(thread.size() - 1))];
+  struct Part {
+    const char* name;
+    std::int64_t fahr::fem::StepParts::*field;
+  };
+  const Part parts[] = {
+      {"forces", &fahr::fem::StepParts::forces_ns},
+      {"system", &fahr::fem::StepParts::system_ns},
+      {"solve", &fahr::fem::StepParts::solve_ns},
+      {"line search", &fahr::fem::StepParts::line_search_ns},
+      {"compliance", &fahr::fem::StepParts::compliance_ns},
+      {"projection", &fahr::fem::StepParts::projection_ns},
+      {"supports", &fahr::fem::StepParts::supports_ns},
+  };
+  std::vector<std::int64_t> values(steps.size());
+  std::size_t slow_count = 0;
+  double slow_thread = 0.0;
+  for (const auto& s : steps) {
+    if (s.thread_ns >= slow) {
+      ++slow_count;
+      slow_thread += static_cast<double>(s.thread_ns);
+    }
+  }
+  std::printf(
+      "stack_sim: FEM step thread CPU by part, ms: median, p99 over %zu steps; mean over the %zu "
+      "slowest (thread >= %.2f ms, mean %.2f)\n",
+      steps.size(), slow_count, 1e-6 * static_cast<double>(slow),
+      1e-6 * slow_thread / static_cast<double>(slow_count));
+  double slow_parts = 0.0;
+  for (const Part& part : parts) {
+    double slow_sum = 0.0;
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+      values[i] = steps[i].parts.*part.field;
+      if (steps[i].thread_ns >= slow) slow_sum += static_cast<double>(values[i]);
+    }
+    std::sort(values.begin(), values.end());
+    const auto at = [&values](double q) {
+      return 1e-6 *
+             static_cast<double>(
+                 values[static_cast<std::size_t>(q * static_cast<double>(values.size() - 1))]);
+    };
+    slow_parts += slow_sum;
+    std::printf("stack_sim: FEM step part %-11s median %.3f p99 %.3f slowest %.3f\n", part.name,
+                at(0.5), at(0.99), 1e-6 * slow_sum / static_cast<double>(slow_count));
+  }
+  std::printf(
+      "stack_sim: FEM step part %-11s slowest %.3f (the state's message, the set's intake)\n",
+      "other", 1e-6 * (slow_thread - slow_parts) / static_cast<double>(slow_count));
+}
+
+}  // namespace
+
 // A function-try-block: what the set-up before the inner try throws ends in a message too.
 int main(int argc, char** argv) try {
   fahr::common::run_solver_libraries_on_one_thread(argv);
@@ -245,6 +309,7 @@ int main(int argc, char** argv) try {
         thread_cpu.count() == 0 ? 0.0
                                 : 1e-6 * static_cast<double>(sim.fem_background_cpu().count()) /
                                       static_cast<double>(thread_cpu.count()));
+    print_fem_step_parts(sim.fem_step_parts());
     const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
     std::printf("stack_sim: haptic tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f\n",
                 us(cpu.percentile(0.5)), us(cpu.percentile(0.99)), us(cpu.percentile(0.999)),

@@ -697,10 +697,20 @@ StepReport Body::step(const ContactSet* contacts, const SphereLinks* links) {
     return report;
   }
   // 1. forces at x^n, 2. A as the solver settings ask, 3. A v' = M v + h f.
+  std::int64_t t0 = thread_cpu_ns();
+  const auto lap = [&t0](std::int64_t& part) {
+    const std::int64_t t = thread_cpu_ns();
+    part += t - t0;
+    t0 = t;
+  };
   const double elastic_energy_j = compute_forces(report);
+  lap(report.cpu.forces_ns);
   prepare_system(report);
+  lap(report.cpu.system_ns);
   solve_velocity(report);
+  lap(report.cpu.solve_ns);
   if (snh_ && v_next_.allFinite()) search_line(elastic_energy_j, report);
+  lap(report.cpu.line_search_ns);
   if (!v_next_.allFinite()) {
     // Guard against a broken factorisation or CG breakdown: keep the state,
     // stop the motion, and report; never publish NaN.

@@ -452,19 +452,28 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   const auto start = body_.positions_m();
   std::copy(start.begin(), start.end(), start_positions_.begin());
   StepReport report = body_.step(nullptr, nullptr);
+  std::int64_t t0 = thread_cpu_ns();
+  const auto lap = [&t0](std::int64_t& part) {
+    const std::int64_t t = thread_cpu_ns();
+    part += t - t0;
+    t0 = t;
+  };
   const auto x = body_.positions_m();
   std::copy(x.begin(), x.end(), free_positions_.begin());
   update_compliance(report.refactorised);
   update_free_centres();
+  lap(report.cpu.compliance_ns);
   projection_ = {};
   if (obstacles_ || volume_floor_ || (contacts != nullptr && !contacts->contacts.empty())) {
     project(contacts);
   }
+  lap(report.cpu.projection_ns);
   const double h = body_.time_step_s();
   tool_reaction_n_ = tool_force_n_ + projection_.tool_push_kg_m / (h * h);
   if (supports_ && supports_->update(*obstacles_, start_positions_, free_positions_)) {
     body_.set_supports(supports_->supports(), obstacles_->settings().support_stiffness_ratio);
   }
+  lap(report.cpu.supports_ns);
   projection_.obstacle_supported = static_cast<int>(body_.support_count());
   report.projection = projection_;
   report.contacts_applied = contacts != nullptr;

@@ -142,6 +142,7 @@ void StackSim::step() {
   if (fem_stepped_) {
     std::chrono::nanoseconds thread{0};
     std::chrono::nanoseconds background{0};
+    FemStepCpu parts;
     for (std::size_t b = 0; b < bodies; ++b) {
       fem_service::ServiceStep& fem = *fems_[b];
       if (k > 0) fem.take(contacts_[b], contacts_[b].header().seq());
@@ -149,12 +150,22 @@ void StackSim::step() {
       fem.step();
       // The step's thread and the background factorisation since the last step.
       thread += std::chrono::nanoseconds(common::thread_cpu_now_ns() - cpu0);
+      const fem::StepParts& p = fem.last_report().cpu;
+      parts.parts.forces_ns += p.forces_ns;
+      parts.parts.system_ns += p.system_ns;
+      parts.parts.solve_ns += p.solve_ns;
+      parts.parts.line_search_ns += p.line_search_ns;
+      parts.parts.compliance_ns += p.compliance_ns;
+      parts.parts.projection_ns += p.projection_ns;
+      parts.parts.supports_ns += p.supports_ns;
       background += std::chrono::nanoseconds(fem.take_background_cpu_ns());
       fem.state().header().sim_step(k);
       fem.state().header().sim_time_ns(now_ns);
       fem_hash_.add(fem.state());
     }
     fem_step_thread_cpu_.record(thread);
+    parts.thread_ns = thread.count();
+    fem_step_parts_.push_back(parts);
     fem_background_cpu_ += background;
     last_fem_step_cpu_ = thread + background;
     fem_step_cpu_.record(last_fem_step_cpu_);

@@ -45,6 +45,7 @@
 #include "fahr/fem/solver_settings.h"
 #include "fahr/fem/sphere_links.h"
 #include "fahr/fem/stable_neo_hookean.h"
+#include "fahr/fem/step_parts.h"
 #include "fahr/fem/warped_factor.h"
 
 namespace fahr::fem {
@@ -87,6 +88,9 @@ struct StepReport {
   // ... and after all of them still uphill: the shortest step was taken (a
   // factor far from the tangent, or non-finite energy).
   bool line_search_exhausted = false;
+  // The step thread's CPU per part (Body::step fills its parts,
+  // ContactStep::step the rest).
+  StepParts cpu;
 };
 
 struct Energy {

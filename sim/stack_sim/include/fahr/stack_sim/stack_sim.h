@@ -117,6 +117,13 @@ class StackSim {
   const metrics::DurationHistogram& fem_step_thread_cpu() const { return fem_step_thread_cpu_; }
   std::chrono::nanoseconds fem_background_cpu() const { return fem_background_cpu_; }
   std::chrono::nanoseconds last_fem_step_cpu() const { return last_fem_step_cpu_; }
+  // Every FEM step's thread CPU and its parts (summed over the bodies), in
+  // step order: which part the slow steps spend it in.
+  struct FemStepCpu {
+    std::int64_t thread_ns = 0;
+    fem::StepParts parts;
+  };
+  const std::vector<FemStepCpu>& fem_step_parts() const { return fem_step_parts_; }
 
   // Output hashes as the distributed lockstep computes them.
   std::uint64_t gateway_hash() const { return gateway_hash_.value(); }
@@ -163,6 +170,7 @@ class StackSim {
   metrics::DurationHistogram fem_step_thread_cpu_{std::chrono::microseconds(50)};
   std::chrono::nanoseconds fem_background_cpu_{0};
   std::chrono::nanoseconds last_fem_step_cpu_{0};
+  std::vector<FemStepCpu> fem_step_parts_;
   common::OutputHash gateway_hash_;
   common::OutputHash haptic_hash_;
   common::OutputHash fem_hash_;
