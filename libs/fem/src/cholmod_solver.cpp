@@ -51,17 +51,39 @@ std::size_t tree_reach(const std::vector<int>& column_supernode, const std::vect
 
 }  // namespace
 
+// One supernode of a supernodal LL' factor: its columns [first, first +
+// columns) in the factor's ordering, its block of rows x columns (column-
+// major, leading dimension rows: the lower-triangular diagonal block on top,
+// the `below` rows under it) and those rows' indices.
+struct Supernode {
+  std::size_t first;
+  std::size_t columns;
+  std::size_t rows;
+  std::size_t below;
+  const double* l;
+  const int* below_rows;
+};
+
+Supernode supernode(const cholmod_factor& f, std::size_t k) {
+  const int* super = static_cast<const int*>(f.super);
+  const int* pi = static_cast<const int*>(f.pi);
+  const int* px = static_cast<const int*>(f.px);
+  Supernode s{};
+  s.first = std::size_t(super[k]);
+  s.columns = std::size_t(super[k + 1]) - s.first;
+  s.rows = std::size_t(pi[k + 1] - pi[k]);
+  s.below = s.rows - s.columns;
+  s.l = static_cast<const double*>(f.x) + px[k];
+  s.below_rows = static_cast<const int*>(f.s) + pi[k] + static_cast<std::ptrdiff_t>(s.columns);
+  return s;
+}
+
 // Y := L^-1 Y on the supernodes in `reach` (CholmodSolver::forward3_on_reach)
 // for the factor f of n rows, with `update` as the below-diagonal buffer.
 // External linkage: target_clones makes an ifunc of it.
 FAHR_VECTOR_CLONES void forward3_on_factor(const cholmod_factor& f, std::size_t n,
                                            std::vector<double>& update, std::span<const int> reach,
                                            std::span<double> y) {
-  const int* super = static_cast<const int*>(f.super);
-  const int* pi = static_cast<const int*>(f.pi);
-  const int* px = static_cast<const int*>(f.px);
-  const int* srow = static_cast<const int*>(f.s);
-  const double* lx = static_cast<const double*>(f.x);
   double* y0 = y.data();
   double* y1 = y0 + n;
   double* y2 = y1 + n;
@@ -70,13 +92,12 @@ FAHR_VECTOR_CLONES void forward3_on_factor(const cholmod_factor& f, std::size_t 
   double* u1 = u0 + room;
   double* u2 = u1 + room;
   for (const int k : reach) {
-    const auto first = std::size_t(super[k]);
-    const auto columns = std::size_t(super[k + 1]) - first;
-    const auto rows_k = std::size_t(pi[k + 1] - pi[k]);
-    const auto below = rows_k - columns;
-    // The supernode's block, column-major with leading dimension rows_k:
-    // the lower-triangular diagonal block on top, the rows below under it.
-    const double* l = lx + px[k];
+    const Supernode node = supernode(f, std::size_t(k));
+    const std::size_t first = node.first;
+    const std::size_t columns = node.columns;
+    const std::size_t rows_k = node.rows;
+    const std::size_t below = node.below;
+    const double* l = node.l;
     double* x0 = y0 + first;
     double* x1 = y1 + first;
     double* x2 = y2 + first;
@@ -101,13 +122,51 @@ FAHR_VECTOR_CLONES void forward3_on_factor(const cholmod_factor& f, std::size_t 
         u2[r] += lb[r] * a2;
       }
     }
-    const int* below_rows = srow + pi[k] + static_cast<std::ptrdiff_t>(columns);
     for (std::size_t r = 0; r < below; ++r) {
-      const auto row = std::size_t(below_rows[r]);
+      const auto row = std::size_t(node.below_rows[r]);
       y0[row] -= u0[r];
       y1[row] -= u1[r];
       y2[row] -= u2[r];
     }
+  }
+}
+
+// x := L^-1 x on the supernodes in `reach` (ascending), for one column in
+// the factor's ordering that is zero outside them; `update` holds one
+// supernode's update of the rows below its diagonal block.
+void forward_on_reach(const cholmod_factor& f, std::vector<double>& update,
+                      std::span<const int> reach, double* x) {
+  double* u = update.data();
+  for (const int k : reach) {
+    const Supernode n = supernode(f, std::size_t(k));
+    double* xs = x + n.first;
+    const auto m = static_cast<int>(n.columns);
+    const auto ld = static_cast<int>(n.rows);
+    cblas_dtrsv(CblasColMajor, CblasLower, CblasNoTrans, CblasNonUnit, m, n.l, ld, xs, 1);
+    if (n.below == 0) continue;
+    cblas_dgemv(CblasColMajor, CblasNoTrans, static_cast<int>(n.below), m, 1.0, n.l + n.columns, ld,
+                xs, 1, 0.0, u, 1);
+    for (std::size_t r = 0; r < n.below; ++r) x[n.below_rows[r]] -= u[r];
+  }
+}
+
+// x := L^-T x, in place, over every supernode of f (last to first), x in the
+// factor's ordering; `gather` holds one supernode's rows below its diagonal
+// block. The backward half of a dense solve, for right-hand sides whose
+// forward half ran on their reach (CholmodSolver::solve_sparse).
+void backward_on_factor(const cholmod_factor& f, std::vector<double>& gather, double* x) {
+  double* xb = gather.data();
+  for (std::size_t k = f.nsuper; k-- > 0;) {
+    const Supernode n = supernode(f, k);
+    for (std::size_t r = 0; r < n.below; ++r) xb[r] = x[n.below_rows[r]];
+    double* xs = x + n.first;
+    const auto m = static_cast<int>(n.columns);
+    const auto ld = static_cast<int>(n.rows);
+    if (n.below > 0) {
+      cblas_dgemv(CblasColMajor, CblasTrans, static_cast<int>(n.below), m, -1.0, n.l + n.columns,
+                  ld, xb, 1, 1.0, xs, 1);
+    }
+    cblas_dtrsv(CblasColMajor, CblasLower, CblasTrans, CblasNonUnit, m, n.l, ld, xs, 1);
   }
 }
 
@@ -135,11 +194,6 @@ void size_panels(const cholmod_factor& f, std::size_t groups, PanelWorkspace& wo
 void forward_gram_on_factor(const cholmod_factor& f, std::size_t n,
                             std::span<const HalfSolveColumns> groups, PanelWorkspace& work,
                             std::span<double> gram) {
-  const int* super = static_cast<const int*>(f.super);
-  const int* pi = static_cast<const int*>(f.pi);
-  const int* px = static_cast<const int*>(f.px);
-  const int* srow = static_cast<const int*>(f.s);
-  const double* lx = static_cast<const double*>(f.x);
   const std::size_t count = groups.size();
   const std::size_t width = 3 * count;
   std::fill(gram.begin(), gram.begin() + static_cast<std::ptrdiff_t>(width * width), 0.0);
@@ -159,14 +213,14 @@ void forward_gram_on_factor(const cholmod_factor& f, std::size_t n,
       }
     }
     if (active == 0) continue;
-    const auto first = std::size_t(super[k]);
-    const auto columns = std::size_t(super[k + 1]) - first;
-    const auto rows_k = std::size_t(pi[k + 1] - pi[k]);
-    const auto below = rows_k - columns;
+    const Supernode node = supernode(f, k);
+    const std::size_t first = node.first;
+    const std::size_t columns = node.columns;
+    const std::size_t below = node.below;
     const int panel_columns = static_cast<int>(3 * active);
     const int m = static_cast<int>(columns);
-    const int ld = static_cast<int>(rows_k);
-    const double* l = lx + px[k];
+    const int ld = static_cast<int>(node.rows);
+    const double* l = node.l;
     // The panel: the active columns' rows of this supernode, column-major.
     for (std::size_t a = 0; a < active; ++a) {
       for (std::size_t d = 0; d < 3; ++d) {
@@ -182,7 +236,7 @@ void forward_gram_on_factor(const cholmod_factor& f, std::size_t n,
     }
     cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, panel_columns, m, 1.0, panel, m, 0.0,
                 panel_gram, panel_columns);
-    const int* below_rows = srow + pi[k] + static_cast<std::ptrdiff_t>(columns);
+    const int* below_rows = node.below_rows;
     for (std::size_t a = 0; a < active; ++a) {
       for (std::size_t d = 0; d < 3; ++d) {
         const std::size_t c = 3 * a + d;
@@ -235,6 +289,9 @@ struct CholmodSolver::State {
   std::vector<std::uint32_t> marks;
   std::uint32_t mark = 0;
   std::vector<double> update;
+  // solve_sparse: its right-hand side in the factor's ordering, the reach.
+  std::vector<double> sparse_y;
+  std::vector<int> sparse_reach;
   bool numeric = false;
   std::size_t rows = 0;
 
@@ -368,6 +425,8 @@ struct CholmodSolver::State {
     marks.assign(std::size_t(nsuper), 0);
     mark = 0;
     update.assign(3 * std::max<std::size_t>(widest, 1), 0.0);
+    sparse_y.assign(rows, 0.0);
+    sparse_reach.assign(std::size_t(nsuper), 0);
   }
 
   ~State() {
@@ -596,6 +655,17 @@ std::size_t CholmodSolver::reach(std::span<const std::uint32_t> dofs, std::span<
 void CholmodSolver::forward3_on_reach(std::span<const int> reach, std::span<double> y) {
   State& s = *state_;
   forward3_on_factor(*s.factor, s.rows, s.update, reach, y);
+}
+
+void CholmodSolver::solve_sparse(std::span<const std::uint32_t> dofs, std::span<const double> b,
+                                 std::span<double> x) {
+  State& s = *state_;
+  const std::size_t count = reach(dofs, s.sparse_reach);
+  std::fill(s.sparse_y.begin(), s.sparse_y.end(), 0.0);
+  for (const std::uint32_t dof : dofs) s.sparse_y[std::size_t(s.position[dof])] = b[dof];
+  forward_on_reach(*s.factor, s.update, {s.sparse_reach.data(), count}, s.sparse_y.data());
+  backward_on_factor(*s.factor, s.update, s.sparse_y.data());
+  for (std::size_t dof = 0; dof < s.rows; ++dof) x[dof] = s.sparse_y[std::size_t(s.position[dof])];
 }
 
 void CholmodSolver::forward_gram_on_reach(std::span<const HalfSolveColumns> groups,

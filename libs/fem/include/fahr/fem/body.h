@@ -357,7 +357,8 @@ class Body {
   WarpedFactor warp_;
   CgSolver cg_;
   ComplianceBlock compliance_;
-  std::vector<double> motion_rhs_;  // step_motion()'s right-hand side
+  std::vector<double> motion_rhs_;          // step_motion()'s right-hand side
+  std::vector<std::uint32_t> motion_dofs_;  // ... its non-zero DOFs
   SleepMonitor sleep_;
   std::vector<NodeSupport> supports_;  // capacity: every node
   std::size_t support_count_ = 0;

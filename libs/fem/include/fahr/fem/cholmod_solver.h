@@ -151,6 +151,12 @@ class CholmodSolver {
   // before scattering B; other rows are neither read nor written). L is
   // read once for the three. No allocation.
   void forward3_on_reach(std::span<const int> reach, std::span<double> y);
+  // x = A^-1 b for a b that is zero but on `dofs` (b and x of A.rows()
+  // entries): the forward solve on the supernodes those DOFs reach, the
+  // backward solve on all of L. Needs sparse_forward_ready(). The same x
+  // as solve() within rounding. No allocation.
+  void solve_sparse(std::span<const std::uint32_t> dofs, std::span<const double> b,
+                    std::span<double> x);
   // Y := L^-1 Y for several spheres' columns at once, and gram := Y^T Y,
   // row-major, (3 x groups) squared. Each supernode of L is read once for
   // all the groups that reach it, as one dense panel (BLAS level 3: the
