@@ -161,6 +161,7 @@ int main(int argc, char** argv) try {
     std::vector<double> state_sizes;
     // Wall time of the tick's phases (a preempted tick shows in the tail).
     std::vector<double> tissue_query_us, anatomy_query_us, response_us;
+    std::vector<double> load_us, move_us, output_us;  // the response's parts
     std::vector<double> query_nodes, query_spheres, query_contacts,
         query_inside;  // the AIST query's work per tick
     // The tissue query on the first tick of a FEM state (every sphere moved:
@@ -206,6 +207,9 @@ int main(int argc, char** argv) try {
       tissue_query_us.push_back(phases.tissue_query_us);
       anatomy_query_us.push_back(phases.anatomy_query_us);
       response_us.push_back(phases.response_us);
+      load_us.push_back(report.load_us);
+      move_us.push_back(report.move_us);
+      output_us.push_back(report.output_us);
       query_nodes.push_back(phases.tissue_query.nodes_visited);
       query_spheres.push_back(phases.tissue_query.spheres_tested);
       query_contacts.push_back(phases.tissue_query.contacts);
@@ -344,6 +348,9 @@ int main(int argc, char** argv) try {
     print_phase("  same state", query_same_state_us);
     print_phase("anatomy query", anatomy_query_us);
     print_phase("response", response_us);
+    print_phase("  load", load_us);
+    print_phase("  move", move_us);
+    print_phase("  output", output_us);
     std::printf(
         "stack_sim: AIST query per tick: tree nodes p50 %.0f p99 %.0f, spheres tested p50 %.0f p99 "
         "%.0f, "

@@ -3,6 +3,7 @@
 #include "fahr/contact/contact_response.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -487,9 +488,14 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   const EffectiveCoupling coupling =
       effective_coupling(settings_.coupling, device.max_stiffness_npm, device.dt_s,
                          device.position_m, device.velocity_mps, p0);
+  using Clock = std::chrono::steady_clock;
+  using Micro = std::chrono::duration<double, std::micro>;
+  const auto start = Clock::now();
   report_.load = solver_.load(input.rows, input.compliance);
   if (settings_.mode == ResponseMode::kNaive) solver_.make_rigid();
+  const auto loaded = Clock::now();
   const Eigen::Vector3d step = keep_out_of_bone(move_proxy(input, coupling));
+  const auto moved = Clock::now();
   solver_.store_warm_start();
   report_.pgs = solver_.last_report();
   report_.state = state_;
@@ -513,6 +519,9 @@ const ForceOutput& ContactResponse::tick(const TickInput& input) {
   const Eigen::Vector3d plane_shift =
       settings_.mode == ResponseMode::kNaive ? Eigen::Vector3d(device.position_m - p0) : step;
   write_contacts(input, plane_shift);
+  report_.load_us = Micro(loaded - start).count();
+  report_.move_us = Micro(moved - loaded).count();
+  report_.output_us = Micro(Clock::now() - moved).count();
   return output_;
 }
 
