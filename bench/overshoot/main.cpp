@@ -20,7 +20,8 @@
 // (libs/fem compression_stiffening.h; 0: off), instead of the scene's.
 // --trace: one CSV line per FEM step of each run (FILE with the response's
 // name appended): inversions and where they are, the anatomy projection,
-// the tool's contacts.
+// the tool's contacts, the largest principal Green strain, the elements past
+// twice their rest length and the most strained one.
 //
 // --check: exit 1 unless the force-aware run meets the targets
 // (no NaN, no inverted tet, the device lost track for at least 4 s of the
@@ -93,6 +94,8 @@ struct Result {
   // and where the most strained one lay at 1x.
   int torn_1x = 0, torn_3x = 0;
   int torn_1x_light = 0;       // torn at 1x with a node under kLightNode x the median node's mass
+  int torn_1x_fixed = 0;       // torn at 1x with a node fixed to bone
+  int torn_1x_held = 0;        // torn at 1x with the free node of a held tet (three nodes fixed)
   int light_elements = 0;      // elements with such a node
   int torn_1x_near_bone = 0;   // torn at 1x with a node within kNearM of a bone
   int torn_1x_near_blade = 0;  // ... with its centroid within kNearM of the blade
@@ -345,6 +348,8 @@ constexpr double kTornStrain = 1.5;
 struct StrainSurvey {
   int beyond = 0;         // elements past kTornStrain
   int beyond_light = 0;   // ... of which with a node lighter than kLightNode x the median node
+  int beyond_fixed = 0;   // ... of which with a node fixed to bone
+  int beyond_held = 0;    // ... with a free node of a held tet (three nodes fixed)
   int light = 0;          // elements with such a node, torn or not
   std::size_t worst = 0;  // the most strained element
   double largest = 0.0;
@@ -390,12 +395,33 @@ StrainSurvey survey_strain(const fem::Body& body) {
     for (const std::uint32_t n : rest.tets[e]) m = std::min(m, mass[n] / median);
     return m;
   };
+  // Fixed nodes have no inverse mass. A held tet has three: its fourth, free
+  // node is the apex over a face of the attachment.
+  const auto inverse_mass = body.inverse_mass_per_kg();
+  const auto fixed_in = [&](std::size_t e) {
+    int count = 0;
+    for (const std::uint32_t n : rest.tets[e]) count += inverse_mass[n] == 0.0 ? 1 : 0;
+    return count;
+  };
+  const auto any_fixed = [&](std::size_t e) { return fixed_in(e) > 0; };
+  std::vector<std::uint8_t> held_apex(body.node_count(), 0);
+  for (std::size_t e = 0; e < rest.size(); ++e) {
+    if (fixed_in(e) != 3) continue;
+    for (const std::uint32_t n : rest.tets[e])
+      if (inverse_mass[n] != 0.0) held_apex[n] = 1;
+  }
+  const auto next_to_held = [&](std::size_t e) {
+    return std::any_of(rest.tets[e].begin(), rest.tets[e].end(),
+                       [&](std::uint32_t n) { return held_apex[n] != 0; });
+  };
   for (std::size_t e = 0; e < rest.size(); ++e) {
     const double strain = fem::principal_green_strain(
         geometry::deformation_gradient(x.data(), rest.tets[e], rest.dm_inv[e]));
     const bool light = lightest(e) < kLightNode;
     out.light += light ? 1 : 0;
     if (strain > kTornStrain) {
+      out.beyond_fixed += any_fixed(e) ? 1 : 0;
+      out.beyond_held += next_to_held(e) ? 1 : 0;
       ++out.beyond;
       out.beyond_light += light ? 1 : 0;
     }
@@ -460,7 +486,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,"
       "inverted_free,fem_cpu_ms,supported_nodes,"
       "volume_floor_below,volume_floor_unresolved,tool_force_sum_n,tool_largest_force_n,"
-      "fem_tool_reaction_n,fem_tool_projection_n\n");
+      "fem_tool_reaction_n,fem_tool_projection_n,largest_strain,torn,worst_element\n");
   std::FILE* tick_trace = open_trace(
       tick_trace_path, r.name,
       "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,"
@@ -541,6 +567,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         r.strain_1x = survey.largest;
         r.torn_1x = survey.beyond;
         r.torn_1x_light = survey.beyond_light;
+        r.torn_1x_fixed = survey.beyond_fixed;
+        r.torn_1x_held = survey.beyond_held;
         r.light_elements = survey.light;
         std::tie(r.torn_1x_near_bone, r.torn_1x_near_blade) = torn_near_bone_and_blade(sim);
         r.worst_1x_lightest_mass = survey.worst_lightest;
@@ -624,10 +652,11 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         // 1 mm: a tet that close to bone or blade is pressed by it.
         const Inversions inv = locate_inversions(sim, 1e-3);
         const ToolContacts tc = count_contacts(sim.contacts());
+        const StrainSurvey survey = survey_strain(sim.body());
         std::fprintf(trace,
                      "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,"
                      "%d,%d,%.3f,"
-                     "%.3f,%.4f,%.4f\n",
+                     "%.3f,%.4f,%.4f,%.3f,%d,%zu\n",
                      sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
                      report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
                      report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
@@ -640,7 +669,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                      report.projection.volume_floor_unresolved, tc.force_sum_n, tc.largest_force_n,
                      sim.fem().contact_step().tool_reaction_n().norm(),
                      sim.fem().contact_step().projection().tool_push_kg_m.norm() /
-                         (sim.body().time_step_s() * sim.body().time_step_s()));
+                         (sim.body().time_step_s() * sim.body().time_step_s()),
+                     survey.largest, survey.beyond, survey.worst);
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
@@ -803,6 +833,10 @@ int main(int argc, char** argv) {
         "| ... of those at 1x, with a node lighter than %.2f x the median node (elements with one: "
         "%d) | %d | - |\n",
         kLightNode, fa.light_elements, fa.torn_1x_light);
+    std::printf(
+        "| ... of those at 1x, with a node fixed to bone / with the free node of a tet whose "
+        "other three are fixed | %d / %d | - |\n",
+        fa.torn_1x_fixed, fa.torn_1x_held);
     std::printf(
         "| ... of those at 1x, with a node within %.0f mm of a bone / with the centroid within "
         "%.0f "
