@@ -1,8 +1,10 @@
 // The volume floor (fem::VolumeFloor, and inside fem::ContactStep): a tet
 // pressed below its share of the rest volume, or through itself, is opened
 // back to the floor along its volume gradient, mass-weighted, fixed nodes
-// untouched; a tet above the floor is left exactly as it was; and a soft bar
-// crushed by a large load keeps every tet above the floor through the step.
+// untouched; a held tet's free node is recorded with its direction for the
+// step's support spring; a tet above the floor is left exactly as it was;
+// and a soft bar crushed by a large load keeps every tet above the floor
+// through the step.
 #include "fahr/fem/volume_floor.h"
 
 #include <gtest/gtest.h>
@@ -67,6 +69,30 @@ TEST(VolumeFloor, AnInvertedTetIsTurnedBackAndFixedNodesStay) {
   EXPECT_EQ(report.unresolved, 0);
   EXPECT_GE(signed_volume(x, tet.tets[0]), kVolumeFloorSlack * 0.3 * tet.element.volume_m3[0]);
   for (int i = 0; i < 6; ++i) EXPECT_EQ(x[i], before[i]) << "a fixed node moved";
+}
+
+// A held tet (three nodes fixed) opens by its fourth node alone; the pass
+// records that node and the direction off the fixed face, for the step's
+// support spring, until the next step begins. A tet with two fixed nodes is
+// not held.
+TEST(VolumeFloor, AHeldTetRecordsItsFreeNodeAndTheFixedFacesNormal) {
+  const OneTet tet;
+  VolumeFloor floor(tet.element, {.ratio = 0.5, .max_sweeps = 8});
+  std::vector<double> x = tet.positions_with_apex_at(0.001);
+  const VolumeFloorReport report = floor.project(x, std::vector<double>{0.0, 0.0, 0.0, 1.0});
+  EXPECT_EQ(report.below, 1);
+  for (std::size_t n = 0; n < 3; ++n) EXPECT_FALSE(floor.held_moved(n)) << n;
+  ASSERT_TRUE(floor.held_moved(3));
+  EXPECT_NEAR(floor.held_normal(3).z(), 1.0, 1e-12);
+  EXPECT_NEAR(floor.held_normal(3).head<2>().norm(), 0.0, 1e-12);
+  floor.begin_step();
+  EXPECT_FALSE(floor.held_moved(3));
+
+  VolumeFloor two_fixed(tet.element, {.ratio = 0.5, .max_sweeps = 8});
+  std::vector<double> y = tet.positions_with_apex_at(0.001);
+  two_fixed.project(y, std::vector<double>{0.0, 0.0, 1.0, 1.0});
+  EXPECT_GE(signed_volume(y, tet.tets[0]), kVolumeFloorSlack * 0.5 * tet.element.volume_m3[0]);
+  for (std::size_t n = 0; n < 4; ++n) EXPECT_FALSE(two_fixed.held_moved(n)) << n;
 }
 
 TEST(VolumeFloor, ATetAboveItsFloorIsLeftExactly) {

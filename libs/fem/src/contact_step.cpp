@@ -427,6 +427,7 @@ void ContactStep::correct_through_compliance(const ContactSet* contacts) {
 void ContactStep::project(const ContactSet* contacts) {
   std::copy(free_positions_.begin(), free_positions_.end(), projected_.begin());
   compliance_push_kg_m_.setZero();
+  if (volume_floor_) volume_floor_->begin_step();
   correct_through_compliance(contacts);
   alternate_with_anatomy(contacts);
   const double h2 = body_.time_step_s() * body_.time_step_s();
@@ -470,7 +471,8 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   lap(report.cpu.projection_ns);
   const double h = body_.time_step_s();
   tool_reaction_n_ = tool_force_n_ + projection_.tool_push_kg_m / (h * h);
-  if (supports_ && supports_->update(*obstacles_, start_positions_, free_positions_)) {
+  if (supports_ &&
+      supports_->update(*obstacles_, volume_floor_.get(), start_positions_, free_positions_)) {
     body_.set_supports(supports_->supports(), obstacles_->settings().support_stiffness_ratio);
   }
   lap(report.cpu.supports_ns);

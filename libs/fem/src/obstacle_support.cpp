@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "fahr/fem/obstacle_projection.h"
+#include "fahr/fem/volume_floor.h"
 
 namespace fahr::fem {
 namespace {
@@ -31,8 +32,8 @@ bool ObstacleSupport::clear() {
   return had;
 }
 
-bool ObstacleSupport::update(const ObstacleProjection& anatomy, std::span<const double> start_m,
-                             std::span<const double> free_m) {
+bool ObstacleSupport::update(const ObstacleProjection& anatomy, const VolumeFloor* floor,
+                             std::span<const double> start_m, std::span<const double> free_m) {
   const std::size_t previous_count = count_;
   std::copy_n(supports_.begin(), previous_count, previous_.begin());
   for (std::size_t i = 0; i < previous_count; ++i)
@@ -44,8 +45,9 @@ bool ObstacleSupport::update(const ObstacleProjection& anatomy, std::span<const 
   // Node order, so the set (and A) does not depend on the order of moves.
   for (std::size_t n = 0; n < nodes; ++n) {
     const std::int32_t slot = slot_of_node_[n];
-    if (anatomy.moved(n)) {
-      const Eigen::Vector3d& normal = anatomy.move_normal(n);
+    const bool on_bone = anatomy.moved(n);
+    if (on_bone || (floor != nullptr && floor->held_moved(n))) {
+      const Eigen::Vector3d& normal = on_bone ? anatomy.move_normal(n) : floor->held_normal(n);
       if (slot >= 0 &&
           previous_[static_cast<std::size_t>(slot)].normal.dot(normal) >= kSameNormalCos) {
         supports_[count_++] = previous_[static_cast<std::size_t>(slot)];

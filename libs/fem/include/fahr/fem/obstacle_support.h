@@ -18,6 +18,10 @@
 // active set: a node the anatomy pass moved this step is held from the next
 // step on; a held node whose free motion heads away from the bone is let go
 // (its spring would have pulled), so tissue lifts off after one step.
+//
+// The same holds for the free node of a held tet that the volume floor
+// pushed off its fixed face (volume_floor.h): the fixed face is the
+// attachment's bone, and the node is held along the floor's direction.
 #pragma once
 
 #include <Eigen/Core>
@@ -29,6 +33,7 @@
 namespace fahr::fem {
 
 class ObstacleProjection;
+class VolumeFloor;
 
 // One held node: its index and the bone's outward unit normal there.
 struct NodeSupport {
@@ -42,10 +47,12 @@ class ObstacleSupport {
 
   // After a step's projections. start_m and free_m (3 per node, m): the
   // positions at the start of the step and after its implicit solve, before
-  // any projection. Returns true if the held set or a normal changed. No
-  // allocation.
-  bool update(const ObstacleProjection& anatomy, std::span<const double> start_m,
-              std::span<const double> free_m);
+  // any projection. `floor` (may be null): the step's volume floor, whose
+  // moves of held tets' free nodes hold them too (where the anatomy moved a
+  // node as well, the anatomy's normal is taken). Returns true if the held
+  // set or a normal changed. No allocation.
+  bool update(const ObstacleProjection& anatomy, const VolumeFloor* floor,
+              std::span<const double> start_m, std::span<const double> free_m);
   // Lets every node go (a reset); returns true if any was held.
   bool clear();
 

@@ -31,8 +31,19 @@
 // makes the tets around its nodes unchecked. Each tet is tested exactly when
 // a sweep over all of them would have found it changed, so the moves are
 // the same, bit for bit, as testing every tet in every sweep.
+//
+// A held tet, three of whose nodes are fixed (it rests on the body's
+// attachment to bone), can open only by its fourth node: for that node the
+// floor is a wall over the fixed face, as bone is for a node the anatomy
+// holds. The pass records each such move and its direction, so the step
+// can hold the node with a support spring in A as it does a node on bone
+// (ObstacleSupport): left as a wall that A does not know, the elastic step
+// drove the node into it every step, the floor put it back, and the moves
+// carried into the next step kept the tets around it stretched to several
+// times their length (docs/design/neonatal-scene.md).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -78,6 +89,14 @@ class VolumeFloor {
 
   const VolumeFloorSettings& settings() const { return settings_; }
 
+  // Forgets the held tets' moves of the last step. No allocation.
+  void begin_step();
+  // Whether a pass since begin_step() moved `node` as the free node of a
+  // held tet, and the direction it was pushed (unit, away from the fixed
+  // face) the last time it was.
+  bool held_moved(std::size_t node) const { return held_moved_[node] != 0; }
+  const Eigen::Vector3d& held_normal(std::size_t node) const { return held_normal_[node]; }
+
  private:
   // One tet's move toward its floor; false if it was not below (slack
   // included). A move marks the tets around its nodes unchecked.
@@ -95,8 +114,12 @@ class VolumeFloor {
   // node_tets_[node_start_[n] .. node_start_[n + 1])).
   std::vector<std::uint32_t> node_start_;
   std::vector<std::uint32_t> node_tets_;
-  std::vector<std::uint8_t> unchecked_;  // per tet: to be tested by the next sweep that reaches it
-  std::vector<double> last_positions_;   // where the last pass left the nodes; empty before it
+  std::vector<std::uint8_t> unchecked_;   // per tet: to be tested by the next sweep that reaches it
+  std::vector<double> last_positions_;    // where the last pass left the nodes; empty before it
+  std::vector<std::uint8_t> held_moved_;  // per node (see held_moved)
+  std::vector<Eigen::Vector3d> held_normal_;  // per node
+  std::vector<std::uint32_t>
+      held_nodes_;  // the nodes marked since begin_step; capacity: every node
 };
 
 }  // namespace fahr::fem
