@@ -94,7 +94,9 @@ class VolumeFloor {
   // Whether a pass since begin_step() moved `node` as the free node of a
   // held tet, and the direction it was pushed (unit, away from the fixed
   // face) the last time it was.
-  bool held_moved(std::size_t node) const { return held_moved_[node] != 0; }
+  bool held_moved(std::size_t node) const {
+    return node < held_moved_.size() && held_moved_[node] != 0;  // a node in no tet: never
+  }
   const Eigen::Vector3d& held_normal(std::size_t node) const { return held_normal_[node]; }
 
  private:
