@@ -103,7 +103,7 @@ bool VolumeFloor::open(std::size_t e, std::span<double> positions_m,
     const Eigen::Vector3d move = scale * w * gradient[a];
     for (int d = 0; d < 3; ++d) positions_m[3 * std::size_t{tet[a]} + d] += move[d];
     mark_around(tet[a]);
-    if (fixed == 3 && tet[a] < held_moved_.size()) {
+    if (fixed == 3) {
       if (held_moved_[tet[a]] == 0) held_nodes_.push_back(tet[a]);
       held_moved_[tet[a]] = 1;
       held_normal_[tet[a]] = gradient[a].normalized();

@@ -116,12 +116,13 @@ class VolumeFloor {
   // node_tets_[node_start_[n] .. node_start_[n + 1])).
   std::vector<std::uint32_t> node_start_;
   std::vector<std::uint32_t> node_tets_;
-  std::vector<std::uint8_t> unchecked_;   // per tet: to be tested by the next sweep that reaches it
-  std::vector<double> last_positions_;    // where the last pass left the nodes; empty before it
-  std::vector<std::uint8_t> held_moved_;  // per node (see held_moved)
-  std::vector<Eigen::Vector3d> held_normal_;  // per node
-  std::vector<std::uint32_t>
-      held_nodes_;  // the nodes marked since begin_step; capacity: every node
+  std::vector<std::uint8_t> unchecked_;  // per tet: to be tested by the next sweep that reaches it
+  std::vector<double> last_positions_;   // where the last pass left the nodes; empty before it
+  // Per node (see held_moved), and the nodes marked since begin_step
+  // (capacity: every node, so marking allocates nothing).
+  std::vector<std::uint8_t> held_moved_;
+  std::vector<Eigen::Vector3d> held_normal_;
+  std::vector<std::uint32_t> held_nodes_;
 };
 
 }  // namespace fahr::fem
