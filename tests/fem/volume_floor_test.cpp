@@ -13,8 +13,11 @@
 #include <array>
 #include <vector>
 
+#include "fahr/fem/assembly.h"
 #include "fahr/fem/contact_step.h"
 #include "fahr/fem/element_rest.h"
+#include "fahr/fem/obstacle_projection.h"
+#include "fahr/fem/obstacle_support.h"
 #include "scenes.h"
 
 namespace fahr::fem {
@@ -71,28 +74,119 @@ TEST(VolumeFloor, AnInvertedTetIsTurnedBackAndFixedNodesStay) {
   for (int i = 0; i < 6; ++i) EXPECT_EQ(x[i], before[i]) << "a fixed node moved";
 }
 
-// A held tet (three nodes fixed) opens by its fourth node alone; the pass
-// records that node and the direction off the fixed face, for the step's
-// support spring, until the next step begins. A tet with two fixed nodes is
-// not held.
-TEST(VolumeFloor, AHeldTetRecordsItsFreeNodeAndTheFixedFacesNormal) {
+// The pass records each tet it moved and the direction it opened it along,
+// for the step's support spring, until the next step begins: the gradient
+// of the volume over the free nodes, of unit length. A held tet (three
+// nodes fixed) opens by its fourth node alone, along the fixed face's
+// normal.
+TEST(VolumeFloor, AMovedTetRecordsTheDirectionItOpenedAlong) {
   const OneTet tet;
   VolumeFloor floor(tet.element, {.ratio = 0.5, .max_sweeps = 8});
   std::vector<double> x = tet.positions_with_apex_at(0.001);
   const VolumeFloorReport report = floor.project(x, std::vector<double>{0.0, 0.0, 0.0, 1.0});
   EXPECT_EQ(report.below, 1);
-  for (std::size_t n = 0; n < 3; ++n) EXPECT_FALSE(floor.held_moved(n)) << n;
-  ASSERT_TRUE(floor.held_moved(3));
-  EXPECT_NEAR(floor.held_normal(3).z(), 1.0, 1e-12);
-  EXPECT_NEAR(floor.held_normal(3).head<2>().norm(), 0.0, 1e-12);
+  ASSERT_TRUE(floor.moved(0));
+  for (std::size_t n = 0; n < 3; ++n) EXPECT_EQ(floor.direction(0)[n].norm(), 0.0) << n;
+  EXPECT_NEAR(floor.direction(0)[3].z(), 1.0, 1e-12);
+  EXPECT_NEAR(floor.direction(0)[3].head<2>().norm(), 0.0, 1e-12);
   floor.begin_step();
-  EXPECT_FALSE(floor.held_moved(3));
+  EXPECT_FALSE(floor.moved(0));
 
+  // Two fixed nodes: the two free ones share the direction, each along its
+  // own gradient.
   VolumeFloor two_fixed(tet.element, {.ratio = 0.5, .max_sweeps = 8});
   std::vector<double> y = tet.positions_with_apex_at(0.001);
   two_fixed.project(y, std::vector<double>{0.0, 0.0, 1.0, 1.0});
   EXPECT_GE(signed_volume(y, tet.tets[0]), kVolumeFloorSlack * 0.5 * tet.element.volume_m3[0]);
-  for (std::size_t n = 0; n < 4; ++n) EXPECT_FALSE(two_fixed.held_moved(n)) << n;
+  ASSERT_TRUE(two_fixed.moved(0));
+  const auto& d = two_fixed.direction(0);
+  EXPECT_EQ(d[0].norm() + d[1].norm(), 0.0);
+  EXPECT_NEAR(d[2].squaredNorm() + d[3].squaredNorm(), 1.0, 1e-12);
+  EXPECT_GT(d[2].norm(), 0.0);
+  EXPECT_GT(d[3].norm(), 0.0);
+}
+
+// A floored tet's spring in A (SystemAssembly::add_supports): k d d^T with
+// k = ratio x the mean diagonal of its free nodes, so it stiffens the
+// tet's volume direction d by exactly k and leaves a rigid translation
+// (orthogonal to d: the volume gradients sum to zero) free.
+TEST(VolumeFloor, ATetSpringStiffensItsVolumeAndNotATranslation) {
+  const OneTet tet;
+  VolumeFloor floor(tet.element, {.ratio = 0.5, .max_sweeps = 8});
+  std::vector<double> x = tet.positions_with_apex_at(0.001);
+  floor.project(x, std::vector<double>(4, 1.0));
+  ASSERT_TRUE(floor.moved(0));
+  const TetSupport support{0, floor.direction(0)};
+
+  SystemAssembly assembly;
+  assembly.build(4, tet.element, std::vector<std::uint8_t>(12, 0));
+  const std::vector<double> mass{1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0};
+  assembly.zero();
+  assembly.add_mass(mass, 1.0);
+  const Eigen::MatrixXd before = Eigen::MatrixXd(assembly.matrix());
+  constexpr double kRatio = 100.0;
+  assembly.add_supports({}, {&support, 1}, kRatio);
+  const Eigen::MatrixXd added = Eigen::MatrixXd(assembly.matrix()) - before;
+
+  Eigen::VectorXd d(12);
+  for (std::size_t a = 0; a < 4; ++a)
+    d.segment<3>(3 * static_cast<Eigen::Index>(a)) = support.direction[a];
+  EXPECT_NEAR(d.norm(), 1.0, 1e-12);
+  const double k = kRatio * 6.5;  // the mean of the diagonal 1..12
+  EXPECT_NEAR(d.dot(added * d), k, 1e-9 * k);
+  EXPECT_NEAR((added - k * d * d.transpose()).norm(), 0.0, 1e-9 * k);
+  Eigen::VectorXd translation = Eigen::VectorXd::Zero(12);
+  for (int a = 0; a < 4; ++a) translation[3 * a + 1] = 1.0;
+  EXPECT_NEAR((added * translation).norm(), 0.0, 1e-9 * k);
+
+  // With nodes 0-2 fixed it is a spring on node 3 alone, along the fixed
+  // face's normal, and the fixed rows stay untouched.
+  VolumeFloor held(tet.element, {.ratio = 0.5, .max_sweeps = 8});
+  std::vector<double> y = tet.positions_with_apex_at(0.001);
+  held.project(y, std::vector<double>{0.0, 0.0, 0.0, 1.0});
+  const TetSupport on_face{0, held.direction(0)};
+  std::vector<std::uint8_t> fixed(12, 1);
+  for (int dof = 9; dof < 12; ++dof) fixed[static_cast<std::size_t>(dof)] = 0;
+  SystemAssembly held_assembly;
+  held_assembly.build(4, tet.element, fixed);
+  held_assembly.zero();
+  held_assembly.add_mass(mass, 1.0);
+  const Eigen::MatrixXd held_before = Eigen::MatrixXd(held_assembly.matrix());
+  held_assembly.add_supports({}, {&on_face, 1}, kRatio);
+  const Eigen::MatrixXd held_added = Eigen::MatrixXd(held_assembly.matrix()) - held_before;
+  const double k3 = kRatio * 11.0;  // node 3's diagonal 10, 11, 12
+  EXPECT_NEAR(held_added(11, 11), k3, 1e-9 * k3);
+  EXPECT_NEAR(held_added.norm(), k3, 1e-9 * k3);
+}
+
+// The step's record of floored tets (ObstacleSupport::update): a tet the
+// floor moved is held from the next step on, kept while its free motion
+// squeezes it, let go once its free motion opens it.
+TEST(VolumeFloor, AFlooredTetIsHeldUntilItsFreeMotionOpensIt) {
+  const OneTet tet;
+  VolumeFloor floor(tet.element, {.ratio = 0.5, .max_sweeps = 8});
+  const std::vector<const ObstacleField*> no_fields;
+  const ObstacleProjection anatomy(no_fields, 4, ObstacleProjectionSettings{});
+  ObstacleSupport supports(4, 1);
+  std::vector<double> x = tet.positions_with_apex_at(0.001);
+  floor.begin_step();
+  floor.project(x, std::vector<double>(4, 1.0));
+  const std::vector<double> start = x;
+  EXPECT_TRUE(supports.update(anatomy, &floor, start, start));
+  ASSERT_EQ(supports.tet_supports().size(), 1U);
+
+  // The next step: the floor moves nothing, the free motion squeezes it
+  // further (the apex down): still held, nothing changed.
+  floor.begin_step();
+  std::vector<double> squeezed = start;
+  squeezed[11] -= 1e-5;
+  EXPECT_FALSE(supports.update(anatomy, &floor, start, squeezed));
+  EXPECT_EQ(supports.tet_supports().size(), 1U);
+  // The apex up: it opens, and is let go.
+  std::vector<double> opened = start;
+  opened[11] += 1e-5;
+  EXPECT_TRUE(supports.update(anatomy, &floor, start, opened));
+  EXPECT_TRUE(supports.tet_supports().empty());
 }
 
 TEST(VolumeFloor, ATetAboveItsFloorIsLeftExactly) {

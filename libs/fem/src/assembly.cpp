@@ -80,6 +80,10 @@ void SystemAssembly::build(std::size_t node_count, const ElementRest& rest,
   }
   fixed_off_diagonal_.clear();
   fixed_diagonal_dof_.clear();
+  fixed_dof_.assign(fixed_dof.begin(), fixed_dof.end());
+  fixed_dof_.resize(dofs, 0);
+  tets_ = rest.tets;
+  base_diagonal_.assign(dofs, 0.0);
   for (std::size_t col = 0; col < dofs; ++col) {
     if (fixed_dof[col] != 0) fixed_diagonal_dof_.push_back(static_cast<int>(col));
     for (int k = outer[col]; k < outer[col + 1]; ++k) {
@@ -162,19 +166,53 @@ void SystemAssembly::add_mass(std::span<const double> mass_per_dof_kg, double ma
 // Within column 3 node + c the node's own three rows are contiguous (rows
 // are sorted and the node's DOFs are consecutive), so the block's column c
 // starts c entries above the diagonal.
-void SystemAssembly::add_normal_stiffness(std::uint32_t node, const Eigen::Vector3d& unit_normal,
-                                          double ratio) {
-  const std::size_t first = 3 * std::size_t{node};
-  if (first + 2 >= diagonal_index_.size()) return;
+void SystemAssembly::add_supports(std::span<const NodeSupport> nodes,
+                                  std::span<const TetSupport> tets, double ratio) {
+  if (nodes.empty() && tets.empty()) return;
   double* values = a_.valuePtr();
-  const double mean_diagonal =
-      (values[diagonal_index_[first]] + values[diagonal_index_[first + 1]] +
-       values[diagonal_index_[first + 2]]) /
-      3.0;
-  const double k = ratio * mean_diagonal;
-  for (int c = 0; c < 3; ++c) {
-    double* column = values + diagonal_index_[first + static_cast<std::size_t>(c)] - c;
-    for (int r = 0; r < 3; ++r) column[r] += k * unit_normal[r] * unit_normal[c];
+  const std::size_t dofs = diagonal_index_.size();
+  for (std::size_t k = 0; k < dofs; ++k) base_diagonal_[k] = values[diagonal_index_[k]];
+  const auto node_diagonal = [&](std::size_t node) {
+    return (base_diagonal_[3 * node] + base_diagonal_[3 * node + 1] +
+            base_diagonal_[3 * node + 2]) /
+           3.0;
+  };
+  const auto free_node = [&](std::size_t node) {
+    return 3 * node + 2 < dofs && fixed_dof_[3 * node] == 0;
+  };
+  for (const NodeSupport& support : nodes) {
+    const std::size_t node = support.node;
+    if (!free_node(node)) continue;
+    const double k = ratio * node_diagonal(node);
+    for (int c = 0; c < 3; ++c) {
+      double* column = values + diagonal_index_[3 * node + static_cast<std::size_t>(c)] - c;
+      for (int r = 0; r < 3; ++r) column[r] += k * support.normal[r] * support.normal[c];
+    }
+  }
+  for (const TetSupport& support : tets) {
+    if (support.tet >= tets_.size()) continue;
+    const Tet& tet = tets_[support.tet];
+    double diagonal = 0.0;
+    int free = 0;
+    for (std::size_t a = 0; a < 4; ++a) {
+      if (!free_node(tet[a]) || support.direction[a].squaredNorm() == 0.0) continue;
+      diagonal += node_diagonal(tet[a]);
+      ++free;
+    }
+    if (free == 0) continue;
+    const double k = ratio * diagonal / free;
+    const std::uint32_t* starts = &block_column_start_[48 * std::size_t{support.tet}];
+    for (std::size_t a = 0; a < 4; ++a) {
+      if (!free_node(tet[a])) continue;
+      for (std::size_t b = 0; b < 4; ++b) {
+        if (!free_node(tet[b])) continue;
+        for (std::size_t c = 0; c < 3; ++c) {
+          double* column = values + starts[12 * a + 3 * b + c];
+          const double dbc = k * support.direction[b][static_cast<Eigen::Index>(c)];
+          for (Eigen::Index d = 0; d < 3; ++d) column[d] += support.direction[a][d] * dbc;
+        }
+      }
+    }
   }
 }
 

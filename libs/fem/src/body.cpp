@@ -126,6 +126,9 @@ std::string Body::initialise(std::span<const Eigen::Vector3d> rest_positions_m,
   supports_.assign(n, NodeSupport{});
   held_at_factor_.assign(n, 0);
   factor_held_.assign(n, 0);
+  tet_supports_.assign(rest_.size(), TetSupport{});
+  tet_held_at_factor_.assign(rest_.size(), 0);
+  factor_held_tets_.assign(rest_.size(), 0);
   rotations_.assign(rest_.size(), Eigen::Matrix3d::Identity());
   rotations_at_factor_ = rotations_;
   if (settings_.material.model == MaterialModel::kStableNeoHookean) {
@@ -168,6 +171,8 @@ std::string Body::configure_background_factor() {
   job_scales_.assign(stiffening_scales_.size(), 1.0);
   job_supports_.assign(supports_.size(), NodeSupport{});
   job_support_count_ = 0;
+  job_tet_supports_.assign(tet_supports_.size(), TetSupport{});
+  job_tet_support_count_ = 0;
   factor_latency_steps_ = static_cast<std::uint64_t>(
       std::max(1.0, std::ceil(solver.background_factor_latency_s / h_ - 1e-9)));
   return {};
@@ -187,13 +192,15 @@ void Body::cancel_background_factor() {
 
 void Body::assemble_system() {
   assemble_into(assembly_, deformations_, rotations_, stiffening_scales_,
-                {supports_.data(), support_count_}, support_ratio_);
+                {supports_.data(), support_count_}, {tet_supports_.data(), tet_support_count_},
+                support_ratio_);
 }
 
 void Body::assemble_job(void* body, std::span<double> values) {
   Body& b = *static_cast<Body*>(body);
   b.assemble_into(b.job_assembly_, b.job_deformations_, b.job_rotations_, b.job_scales_,
-                  {b.job_supports_.data(), b.job_support_count_}, b.job_support_ratio_);
+                  {b.job_supports_.data(), b.job_support_count_},
+                  {b.job_tet_supports_.data(), b.job_tet_support_count_}, b.job_support_ratio_);
   const SparseMatrix& a = b.job_assembly_.matrix();
   std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), values.begin());
 }
@@ -204,7 +211,8 @@ void Body::refresh_job(void* body, CholmodSolver::NewFactor& new_factor) {
 
 void Body::assemble_into(SystemAssembly& out, std::span<const Eigen::Matrix3d> deformations,
                          std::span<const Eigen::Matrix3d> rotations, std::span<const double> scales,
-                         std::span<const NodeSupport> supports, double support_ratio) {
+                         std::span<const NodeSupport> supports,
+                         std::span<const TetSupport> tet_supports, double support_ratio) {
   const double alpha = settings_.material.rayleigh_mass_per_s;
   const double beta = settings_.material.rayleigh_stiffness_s;
   if (snh_) {
@@ -232,8 +240,7 @@ void Body::assemble_into(SystemAssembly& out, std::span<const Eigen::Matrix3d> d
     out.assemble(rest_, rotations, lame_, mass_per_dof_, 1.0 + h_ * alpha, h_ * beta + h_ * h_,
                  scales);
   }
-  for (const NodeSupport& support : supports)
-    out.add_normal_stiffness(support.node, support.normal, support_ratio);
+  out.add_supports(supports, tet_supports, support_ratio);
 }
 
 void Body::assemble_current(SystemAssembly& out) const {
@@ -262,15 +269,16 @@ void Body::assemble_current(SystemAssembly& out) const {
     }
     out.assemble(rest_, rotations, lame_, mass_per_dof_, 1.0 + h_ * alpha, stiffness_scale, scales);
   }
-  for (std::size_t i = 0; i < support_count_; ++i) {
-    out.add_normal_stiffness(supports_[i].node, supports_[i].normal, support_ratio_);
-  }
+  out.add_supports({supports_.data(), support_count_}, {tet_supports_.data(), tet_support_count_},
+                   support_ratio_);
 }
 
-void Body::set_supports(std::span<const NodeSupport> supports, double stiffness_ratio) {
+void Body::set_supports(std::span<const NodeSupport> supports,
+                        std::span<const TetSupport> tet_supports, double stiffness_ratio) {
   support_count_ = 0;
+  tet_support_count_ = 0;
   support_ratio_ = stiffness_ratio > 0.0 ? stiffness_ratio : 0.0;
-  std::size_t held_then = 0;  // of the new set, nodes the factorisation holds too
+  std::size_t held_then = 0;  // of the new sets, nodes and tets the factorisation holds too
   if (support_ratio_ > 0.0) {
     for (const NodeSupport& s : supports) {
       if (s.node >= node_count() || fixed(s.node) || !s.normal.allFinite() ||
@@ -280,9 +288,18 @@ void Body::set_supports(std::span<const NodeSupport> supports, double stiffness_
       supports_[support_count_++] = s;
       held_then += held_at_factor_[s.node];
     }
+    for (const TetSupport& s : tet_supports) {
+      bool finite = true;
+      for (const Eigen::Vector3d& part : s.direction) finite = finite && part.allFinite();
+      if (s.tet >= rest_.size() || !finite || tet_support_count_ == tet_supports_.size()) continue;
+      tet_supports_[tet_support_count_++] = s;
+      held_then += tet_held_at_factor_[s.tet];
+    }
   }
-  // Nodes held now and not in the factorisation, and the other way round.
-  support_changes_ = (support_count_ - held_then) + (held_at_factor_count_ - held_then);
+  // Nodes and tets held now and not in the factorisation, and the other way
+  // round.
+  const std::size_t held_now = support_count_ + tet_support_count_;
+  support_changes_ = (held_now - held_then) + (held_at_factor_count_ - held_then);
 }
 
 std::string Body::set_solver(const SolverSettings& solver) {
@@ -311,11 +328,19 @@ bool Body::refactorise() {
 void Body::mark_factor_state() {
   steps_since_factor_ = 0;
   refresh_due_ = false;
-  for (std::size_t i = 0; i < held_at_factor_count_; ++i) held_at_factor_[factor_held_[i]] = 0;
-  held_at_factor_count_ = support_count_;
+  for (std::size_t i = 0; i < held_at_factor_count_ - factor_held_tet_count_; ++i)
+    held_at_factor_[factor_held_[i]] = 0;
+  for (std::size_t i = 0; i < factor_held_tet_count_; ++i)
+    tet_held_at_factor_[factor_held_tets_[i]] = 0;
+  held_at_factor_count_ = support_count_ + tet_support_count_;
   for (std::size_t i = 0; i < support_count_; ++i) {
     factor_held_[i] = supports_[i].node;
     held_at_factor_[supports_[i].node] = 1;
+  }
+  factor_held_tet_count_ = tet_support_count_;
+  for (std::size_t i = 0; i < tet_support_count_; ++i) {
+    factor_held_tets_[i] = tet_supports_[i].tet;
+    tet_held_at_factor_[tet_supports_[i].tet] = 1;
   }
   support_changes_ = 0;
   std::copy(rotations_.begin(), rotations_.end(), rotations_at_factor_.begin());
@@ -628,6 +653,8 @@ void Body::prepare_system(StepReport& report) {
       std::copy(stiffening_scales_.begin(), stiffening_scales_.end(), job_scales_.begin());
       std::copy_n(supports_.begin(), support_count_, job_supports_.begin());
       job_support_count_ = support_count_;
+      std::copy_n(tet_supports_.begin(), tet_support_count_, job_tet_supports_.begin());
+      job_tet_support_count_ = tet_support_count_;
       job_support_ratio_ = support_ratio_;
       factor_pending_ = cholmod_.begin_factorize(&Body::assemble_job, this, after);
     } else {
@@ -813,6 +840,7 @@ bool Body::reset_to_rest() {
   clear_external_forces();
   sleep_.wake();
   support_count_ = 0;
+  tet_support_count_ = 0;
   std::fill(rotations_.begin(), rotations_.end(), Eigen::Matrix3d::Identity());
   std::fill(stiffening_scales_.begin(), stiffening_scales_.end(), 1.0);
   std::fill(deformations_.begin(), deformations_.end(), Eigen::Matrix3d::Identity());

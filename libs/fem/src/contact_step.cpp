@@ -100,14 +100,15 @@ void ContactStep::set_obstacles(std::span<const ObstacleField* const> fields,
                    : std::make_unique<ObstacleProjection>(fields, body_.node_count(), settings);
   projection_settings_.project_obstacle_contacts = obstacles_ == nullptr;
   supports_ = obstacles_ && settings.support_stiffness_ratio > 0.0
-                  ? std::make_unique<ObstacleSupport>(body_.node_count())
+                  ? std::make_unique<ObstacleSupport>(
+                        body_.node_count(), volume_floor_ ? body_.element_rest().size() : 0)
                   : nullptr;
-  body_.set_supports({}, 0.0);
+  body_.set_supports({}, {}, 0.0);
 }
 
 bool ContactStep::reset() {
   if (obstacles_) obstacles_->forget_clearances();
-  if (supports_ && supports_->clear()) body_.set_supports({}, 0.0);
+  if (supports_ && supports_->clear()) body_.set_supports({}, {}, 0.0);
   std::fill(carry_n_.begin(), carry_n_.end(), 0.0);
   std::fill(lambda_n_.begin(), lambda_n_.end(), 0.0);
   const auto x = body_.positions_m();
@@ -473,7 +474,8 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   tool_reaction_n_ = tool_force_n_ + projection_.tool_push_kg_m / (h * h);
   if (supports_ &&
       supports_->update(*obstacles_, volume_floor_.get(), start_positions_, free_positions_)) {
-    body_.set_supports(supports_->supports(), obstacles_->settings().support_stiffness_ratio);
+    body_.set_supports(supports_->supports(), supports_->tet_supports(),
+                       obstacles_->settings().support_stiffness_ratio);
   }
   lap(report.cpu.supports_ns);
   projection_.obstacle_supported = static_cast<int>(body_.support_count());

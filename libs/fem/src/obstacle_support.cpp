@@ -23,14 +23,28 @@ constexpr double kSameNormalCos = 0.995004165278025766;
 
 }  // namespace
 
-ObstacleSupport::ObstacleSupport(std::size_t node_count)
-    : supports_(node_count), previous_(node_count), slot_of_node_(node_count, -1) {}
+ObstacleSupport::ObstacleSupport(std::size_t node_count, std::size_t tet_count)
+    : supports_(node_count),
+      previous_(node_count),
+      slot_of_node_(node_count, -1),
+      tets_(tet_count),
+      previous_tets_(tet_count),
+      slot_of_tet_(tet_count, -1) {}
 
 bool ObstacleSupport::clear() {
-  const bool had = count_ > 0;
+  const bool had = count_ > 0 || tet_count_ > 0;
   count_ = 0;
+  tet_count_ = 0;
   return had;
 }
+
+namespace {
+
+double dot12(const std::array<Eigen::Vector3d, 4>& a, const std::array<Eigen::Vector3d, 4>& b) {
+  return a[0].dot(b[0]) + a[1].dot(b[1]) + a[2].dot(b[2]) + a[3].dot(b[3]);
+}
+
+}  // namespace
 
 bool ObstacleSupport::update(const ObstacleProjection& anatomy, const VolumeFloor* floor,
                              std::span<const double> start_m, std::span<const double> free_m) {
@@ -45,9 +59,8 @@ bool ObstacleSupport::update(const ObstacleProjection& anatomy, const VolumeFloo
   // Node order, so the set (and A) does not depend on the order of moves.
   for (std::size_t n = 0; n < nodes; ++n) {
     const std::int32_t slot = slot_of_node_[n];
-    const bool on_bone = anatomy.moved(n);
-    if (on_bone || (floor != nullptr && floor->held_moved(n))) {
-      const Eigen::Vector3d& normal = on_bone ? anatomy.move_normal(n) : floor->held_normal(n);
+    if (anatomy.moved(n)) {
+      const Eigen::Vector3d& normal = anatomy.move_normal(n);
       if (slot >= 0 &&
           previous_[static_cast<std::size_t>(slot)].normal.dot(normal) >= kSameNormalCos) {
         supports_[count_++] = previous_[static_cast<std::size_t>(slot)];
@@ -69,6 +82,57 @@ bool ObstacleSupport::update(const ObstacleProjection& anatomy, const VolumeFloo
     supports_[count_++] = held;
   }
   for (std::size_t i = 0; i < previous_count; ++i) slot_of_node_[previous_[i].node] = -1;
+  return update_tets(floor, start_m, free_m) || changed;
+}
+
+// The floor's tets, as the nodes above: held from the step after the floor
+// moved them, along the direction it moved them; let go when the free
+// motion opens them.
+bool ObstacleSupport::update_tets(const VolumeFloor* floor, std::span<const double> start_m,
+                                  std::span<const double> free_m) {
+  const std::size_t previous_count = tet_count_;
+  std::copy_n(tets_.begin(), previous_count, previous_tets_.begin());
+  for (std::size_t i = 0; i < previous_count; ++i)
+    slot_of_tet_[previous_tets_[i].tet] = static_cast<std::int32_t>(i);
+  bool changed = false;
+  tet_count_ = 0;
+  const std::size_t tets = floor == nullptr ? 0 : std::min(floor->tet_count(), tets_.size());
+  const std::vector<Tet>* rest_tets = floor == nullptr ? nullptr : &floor->tets();
+  for (std::size_t e = 0; e < tets_.size(); ++e) {
+    const std::int32_t slot = slot_of_tet_[e];
+    if (e < tets && floor->moved(e)) {
+      const std::array<Eigen::Vector3d, 4>& direction = floor->direction(e);
+      if (slot >= 0 && dot12(previous_tets_[static_cast<std::size_t>(slot)].direction, direction) >=
+                           kSameNormalCos) {
+        tets_[tet_count_++] = previous_tets_[static_cast<std::size_t>(slot)];
+        continue;
+      }
+      tets_[tet_count_++] = TetSupport{static_cast<std::uint32_t>(e), direction};
+      changed = true;
+      continue;
+    }
+    if (slot < 0) continue;
+    const TetSupport& held = previous_tets_[static_cast<std::size_t>(slot)];
+    double opening = 0.0;  // the free motion along the held direction
+    bool finite = true;
+    if (rest_tets != nullptr) {
+      const Tet& tet = (*rest_tets)[e];
+      for (int a = 0; a < 4; ++a) {
+        const std::size_t n = tet[static_cast<std::size_t>(a)];
+        const Eigen::Vector3d free_motion(free_m[3 * n] - start_m[3 * n],
+                                          free_m[3 * n + 1] - start_m[3 * n + 1],
+                                          free_m[3 * n + 2] - start_m[3 * n + 2]);
+        finite = finite && free_motion.allFinite();
+        opening += held.direction[static_cast<std::size_t>(a)].dot(free_motion);
+      }
+    }
+    if (rest_tets == nullptr || opening > kLiftOffM || !finite) {
+      changed = true;  // opens, or no floor any more: the spring would pull
+      continue;
+    }
+    tets_[tet_count_++] = held;
+  }
+  for (std::size_t i = 0; i < previous_count; ++i) slot_of_tet_[previous_tets_[i].tet] = -1;
   return changed;
 }
 

@@ -36,9 +36,9 @@ VolumeFloor::VolumeFloor(const ElementRest& rest, const VolumeFloorSettings& set
     for (const std::uint32_t n : tet) ++node_start_[std::size_t{n} + 1];
   }
   for (std::size_t n = 0; n < nodes; ++n) node_start_[n + 1] += node_start_[n];
-  held_moved_.assign(nodes, 0);
-  held_normal_.assign(nodes, Eigen::Vector3d::Zero());
-  held_nodes_.reserve(nodes);
+  moved_.assign(rest.size(), 0);
+  direction_.resize(rest.size());
+  moved_tets_.reserve(rest.size());
   node_tets_.resize(node_start_.back());
   std::vector<std::uint32_t> fill(node_start_.begin(), node_start_.end() - 1);
   for (std::size_t e = 0; e < rest.size(); ++e) {
@@ -48,8 +48,8 @@ VolumeFloor::VolumeFloor(const ElementRest& rest, const VolumeFloorSettings& set
 }
 
 void VolumeFloor::begin_step() {
-  for (const std::uint32_t n : held_nodes_) held_moved_[n] = 0;
-  held_nodes_.clear();
+  for (const std::uint32_t e : moved_tets_) moved_[e] = 0;
+  moved_tets_.clear();
 }
 
 void VolumeFloor::mark_around(std::uint32_t node) {
@@ -95,20 +95,22 @@ bool VolumeFloor::open(std::size_t e, std::span<double> positions_m,
   // it in a later sweep.
   if (!(weight > 0.0) || !std::isfinite(weight)) return true;
   const double scale = (floor_m3_[e] - volume) / weight;
-  int fixed = 0;
-  for (int a = 0; a < 4; ++a) fixed += inverse_mass_per_kg[tet[a]] == 0.0 ? 1 : 0;
+  std::array<Eigen::Vector3d, 4>& direction = direction_[e];
+  double length_squared = 0.0;
   for (int a = 0; a < 4; ++a) {
     const double w = inverse_mass_per_kg[tet[a]];
+    direction[a] = w == 0.0 ? Eigen::Vector3d::Zero() : gradient[a];
+    length_squared += direction[a].squaredNorm();
     if (w == 0.0) continue;
     const Eigen::Vector3d move = scale * w * gradient[a];
     for (int d = 0; d < 3; ++d) positions_m[3 * std::size_t{tet[a]} + d] += move[d];
     mark_around(tet[a]);
-    if (fixed == 3) {
-      if (held_moved_[tet[a]] == 0) held_nodes_.push_back(tet[a]);
-      held_moved_[tet[a]] = 1;
-      held_normal_[tet[a]] = gradient[a].normalized();
-    }
   }
+  // weight > 0, so some free node has a non-zero gradient.
+  const double length = std::sqrt(length_squared);
+  for (Eigen::Vector3d& part : direction) part /= length;
+  if (moved_[e] == 0) moved_tets_.push_back(static_cast<std::uint32_t>(e));
+  moved_[e] = 1;
   return true;
 }
 

@@ -13,6 +13,7 @@
 #include "fahr/fem/element_rest.h"
 #include "fahr/fem/hyperelastic_element.h"
 #include "fahr/fem/material.h"
+#include "fahr/fem/obstacle_support.h"
 
 namespace fahr::fem {
 
@@ -47,13 +48,17 @@ class SystemAssembly {
   // columns zero, the diagonal mass_scale m): the end of an assembly.
   void add_mass(std::span<const double> mass_per_dof_kg, double mass_scale);
 
-  // Adds k n n^T to the diagonal block of `node`, with k = ratio times the
-  // mean of the block's three diagonal entries as they are now (so the
-  // spring is that much stiffer than the node's own inertia and elasticity
-  // in the step, whatever the units and time step). unit_normal must be of
-  // length 1. Not for a fixed node (its row must stay m v = 0): the caller
-  // skips those. No allocation.
-  void add_normal_stiffness(std::uint32_t node, const Eigen::Vector3d& unit_normal, double ratio);
+  // Adds the support springs (obstacle_support.h): k n n^T to the diagonal
+  // block of each held node, and k d d^T over the four nodes' blocks of each
+  // held tet (d its unit 12-vector, zero on fixed nodes). k is `ratio` times
+  // the mean diagonal entry of the nodes the spring acts on, as assembled
+  // before any spring (so a spring is that much stiffer than its nodes' own
+  // inertia and elasticity in the step, whatever the units and time step,
+  // and the springs do not depend on their order). Fixed nodes are skipped
+  // (their rows must stay m v = 0). The end of an assembly, after
+  // add_mass(). No allocation.
+  void add_supports(std::span<const NodeSupport> nodes, std::span<const TetSupport> tets,
+                    double ratio);
 
   const SparseMatrix& matrix() const { return a_; }
   // Index into matrix().valuePtr() of each DOF's diagonal entry.
@@ -67,6 +72,9 @@ class SystemAssembly {
   std::vector<int> diagonal_index_;
   std::vector<int> fixed_off_diagonal_;  // non-zeros zeroed for fixed DOFs
   std::vector<int> fixed_diagonal_dof_;  // DOFs whose diagonal is set alone
+  std::vector<std::uint8_t> fixed_dof_;
+  std::vector<Tet> tets_;
+  std::vector<double> base_diagonal_;  // add_supports' copy of the diagonal
 };
 
 }  // namespace fahr::fem

@@ -160,15 +160,19 @@ class Body {
                         std::span<const Eigen::Vector3d> normals, const SphereLinks& links,
                         std::span<float> out);
 
-  // Nodes the static anatomy holds (obstacle_support.h): from the next step
-  // on, each gets a spring of stiffness_ratio times its diagonal of A along
-  // its normal in A (and so in W). Replaces the previous set; an empty span
-  // removes them. A changed set makes a lagged factorisation due. Fixed nodes
+  // Nodes the static anatomy holds and tets the volume floor holds
+  // (obstacle_support.h): from the next step on, each gets a spring of
+  // stiffness_ratio times its nodes' diagonal of A along its normal or
+  // direction in A (and so in W). Replaces the previous sets; empty spans
+  // remove them. A changed set makes a lagged factorisation due. Fixed nodes
   // are ignored. No allocation.
-  void set_supports(std::span<const NodeSupport> supports, double stiffness_ratio);
+  void set_supports(std::span<const NodeSupport> supports, std::span<const TetSupport> tet_supports,
+                    double stiffness_ratio);
   std::size_t support_count() const { return support_count_; }
-  // Nodes that joined or left the held set since the factorisation in use
-  // (its A holds the old set's springs; audits of W read it).
+  std::size_t tet_support_count() const { return tet_support_count_; }
+  // Nodes and tets that joined or left the held sets since the
+  // factorisation in use (its A holds the old sets' springs; audits of W
+  // read it).
   std::size_t support_changes_since_factor() const { return support_changes_; }
 
   // External nodal force, N, held until changed; a non-zero force wakes.
@@ -282,7 +286,8 @@ class Body {
   // hyperelastic tangents kept in element_tangents_ are used and updated.
   void assemble_into(SystemAssembly& out, std::span<const Eigen::Matrix3d> deformations,
                      std::span<const Eigen::Matrix3d> rotations, std::span<const double> scales,
-                     std::span<const NodeSupport> supports, double support_ratio);
+                     std::span<const NodeSupport> supports,
+                     std::span<const TetSupport> tet_supports, double support_ratio);
   // The background factorisation's own assembly (CholmodSolver::FillValues):
   // A at the state copied when the job began, off the step's thread.
   static void assemble_job(void* body, std::span<double> values);
@@ -352,6 +357,8 @@ class Body {
   std::vector<double> job_scales_;
   std::vector<NodeSupport> job_supports_;
   std::size_t job_support_count_ = 0;
+  std::vector<TetSupport> job_tet_supports_;
+  std::size_t job_tet_support_count_ = 0;
   double job_support_ratio_ = 0.0;
   CholmodSolver cholmod_;
   WarpedFactor warp_;
@@ -362,11 +369,17 @@ class Body {
   SleepMonitor sleep_;
   std::vector<NodeSupport> supports_;  // capacity: every node
   std::size_t support_count_ = 0;
+  std::vector<TetSupport> tet_supports_;  // capacity: every tet
+  std::size_t tet_support_count_ = 0;
   double support_ratio_ = 0.0;
-  // The held set in the last factorisation: a flag per node, its nodes, and
-  // how many nodes joined or left it since (set_supports).
+  // The held sets in the last factorisation: a flag per node and per tet,
+  // their nodes and tets, how many of both (held_at_factor_count_), and how
+  // many joined or left them since (set_supports).
   std::vector<std::uint8_t> held_at_factor_;
   std::vector<std::uint32_t> factor_held_;
+  std::vector<std::uint8_t> tet_held_at_factor_;
+  std::vector<std::uint32_t> factor_held_tets_;
+  std::size_t factor_held_tet_count_ = 0;
   std::size_t held_at_factor_count_ = 0;
   std::size_t support_changes_ = 0;
   static constexpr std::size_t kSupportChangesForRefresh = 8;

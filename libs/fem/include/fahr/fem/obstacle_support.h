@@ -19,12 +19,16 @@
 // step on; a held node whose free motion heads away from the bone is let go
 // (its spring would have pulled), so tissue lifts off after one step.
 //
-// The same holds for the free node of a held tet that the volume floor
-// pushed off its fixed face (volume_floor.h): the fixed face is the
-// attachment's bone, and the node is held along the floor's direction.
+// The volume floor (volume_floor.h) is held the same way: a tet the floor
+// opened in a step gets, from the next step on, a spring along the
+// direction it was opened in (its volume's gradient over its free nodes)
+// in A, k d d^T over its four nodes' blocks; it is let go when its free
+// motion opens it. For a held tet (three nodes fixed) that is a node
+// support of its fourth node along the fixed face's normal.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -41,28 +45,43 @@ struct NodeSupport {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
 };
 
+// One tet the volume floor holds: its index and the unit direction (per
+// node, zero on fixed nodes; the 12 entries of length 1) it is held along.
+struct TetSupport {
+  std::uint32_t tet = 0;
+  std::array<Eigen::Vector3d, 4> direction{};
+};
+
 class ObstacleSupport {
  public:
-  explicit ObstacleSupport(std::size_t node_count);
+  // tet_count: the body's tets (0: no volume floor).
+  ObstacleSupport(std::size_t node_count, std::size_t tet_count);
 
   // After a step's projections. start_m and free_m (3 per node, m): the
   // positions at the start of the step and after its implicit solve, before
   // any projection. `floor` (may be null): the step's volume floor, whose
-  // moves of held tets' free nodes hold them too (where the anatomy moved a
-  // node as well, the anatomy's normal is taken). Returns true if the held
-  // set or a normal changed. No allocation.
+  // moved tets are held too. Returns true if a held set or a direction
+  // changed. No allocation.
   bool update(const ObstacleProjection& anatomy, const VolumeFloor* floor,
               std::span<const double> start_m, std::span<const double> free_m);
-  // Lets every node go (a reset); returns true if any was held.
+  // Lets every node and tet go (a reset); returns true if any was held.
   bool clear();
 
   std::span<const NodeSupport> supports() const { return {supports_.data(), count_}; }
+  std::span<const TetSupport> tet_supports() const { return {tets_.data(), tet_count_}; }
 
  private:
+  bool update_tets(const VolumeFloor* floor, std::span<const double> start_m,
+                   std::span<const double> free_m);
+
   std::vector<NodeSupport> supports_;  // capacity: every node
   std::vector<NodeSupport> previous_;
   std::size_t count_ = 0;
   std::vector<std::int32_t> slot_of_node_;  // index into previous_ while updating, -1 if not held
+  std::vector<TetSupport> tets_;            // capacity: every tet
+  std::vector<TetSupport> previous_tets_;
+  std::size_t tet_count_ = 0;
+  std::vector<std::int32_t> slot_of_tet_;
 };
 
 }  // namespace fahr::fem

@@ -32,18 +32,20 @@
 // a sweep over all of them would have found it changed, so the moves are
 // the same, bit for bit, as testing every tet in every sweep.
 //
-// A held tet, three of whose nodes are fixed (it rests on the body's
-// attachment to bone), can open only by its fourth node: for that node the
-// floor is a wall over the fixed face, as bone is for a node the anatomy
-// holds. The pass records each such move and its direction, so the step
-// can hold the node with a support spring in A as it does a node on bone
-// (ObstacleSupport): left as a wall that A does not know, the elastic step
-// drove the node into it every step, the floor put it back, and the moves
-// carried into the next step kept the tets around it stretched to several
-// times their length (docs/design/neonatal-scene.md).
+// The floor is a wall that A does not know: the elastic step drives the
+// squeezed tissue into it, the pass puts it back, and the moves carried
+// into the next step keep the tets around it cycling. So the pass records
+// every tet it moved and the direction it opened it along (the gradient of
+// its volume over its free nodes), and the step holds each such tet with a
+// spring along that direction in A, as it holds a node on bone
+// (ObstacleSupport, docs/design/anatomy-contact.md). For a held tet, three
+// of whose nodes are fixed (it rests on the body's attachment), that
+// spring is a node support of its fourth node along the fixed face's
+// normal.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -89,15 +91,15 @@ class VolumeFloor {
 
   const VolumeFloorSettings& settings() const { return settings_; }
 
-  // Forgets the held tets' moves of the last step. No allocation.
+  // Forgets the tets moved in the last step. No allocation.
   void begin_step();
-  // Whether a pass since begin_step() moved `node` as the free node of a
-  // held tet, and the direction it was pushed (unit, away from the fixed
-  // face) the last time it was.
-  bool held_moved(std::size_t node) const {
-    return node < held_moved_.size() && held_moved_[node] != 0;  // a node in no tet: never
-  }
-  const Eigen::Vector3d& held_normal(std::size_t node) const { return held_normal_[node]; }
+  // Whether a pass since begin_step() moved tet `tet`, and the direction it
+  // moved it along the last time: per node, the gradient of its volume,
+  // zero on the fixed nodes, the 12 entries of unit length.
+  bool moved(std::size_t tet) const { return moved_[tet] != 0; }
+  const std::array<Eigen::Vector3d, 4>& direction(std::size_t tet) const { return direction_[tet]; }
+  std::size_t tet_count() const { return moved_.size(); }
+  const std::vector<Tet>& tets() const { return rest_.tets; }
 
  private:
   // One tet's move toward its floor; false if it was not below (slack
@@ -118,11 +120,11 @@ class VolumeFloor {
   std::vector<std::uint32_t> node_tets_;
   std::vector<std::uint8_t> unchecked_;  // per tet: to be tested by the next sweep that reaches it
   std::vector<double> last_positions_;   // where the last pass left the nodes; empty before it
-  // Per node (see held_moved), and the nodes marked since begin_step
-  // (capacity: every node, so marking allocates nothing).
-  std::vector<std::uint8_t> held_moved_;
-  std::vector<Eigen::Vector3d> held_normal_;
-  std::vector<std::uint32_t> held_nodes_;
+  // Per tet (see moved), and the tets marked since begin_step (capacity:
+  // every tet, so marking allocates nothing).
+  std::vector<std::uint8_t> moved_;
+  std::vector<std::array<Eigen::Vector3d, 4>> direction_;
+  std::vector<std::uint32_t> moved_tets_;
 };
 
 }  // namespace fahr::fem
