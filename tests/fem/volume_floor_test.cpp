@@ -16,7 +16,6 @@
 #include "fahr/fem/assembly.h"
 #include "fahr/fem/contact_step.h"
 #include "fahr/fem/element_rest.h"
-#include "fahr/fem/obstacle_projection.h"
 #include "fahr/fem/obstacle_support.h"
 #include "scenes.h"
 
@@ -165,14 +164,12 @@ TEST(VolumeFloor, ATetSpringStiffensItsVolumeAndNotATranslation) {
 TEST(VolumeFloor, AFlooredTetIsHeldUntilItsFreeMotionOpensIt) {
   const OneTet tet;
   VolumeFloor floor(tet.element, {.ratio = 0.5, .max_sweeps = 8});
-  const std::vector<const ObstacleField*> no_fields;
-  const ObstacleProjection anatomy(no_fields, 4, ObstacleProjectionSettings{});
   ObstacleSupport supports(4, 1);
   std::vector<double> x = tet.positions_with_apex_at(0.001);
   floor.begin_step();
   floor.project(x, std::vector<double>(4, 1.0));
   const std::vector<double> start = x;
-  EXPECT_TRUE(supports.update(anatomy, &floor, start, start));
+  EXPECT_TRUE(supports.update(nullptr, &floor, start, start));
   ASSERT_EQ(supports.tet_supports().size(), 1U);
 
   // The next step: the floor moves nothing, the free motion squeezes it
@@ -180,12 +177,12 @@ TEST(VolumeFloor, AFlooredTetIsHeldUntilItsFreeMotionOpensIt) {
   floor.begin_step();
   std::vector<double> squeezed = start;
   squeezed[11] -= 1e-5;
-  EXPECT_FALSE(supports.update(anatomy, &floor, start, squeezed));
+  EXPECT_FALSE(supports.update(nullptr, &floor, start, squeezed));
   EXPECT_EQ(supports.tet_supports().size(), 1U);
   // The apex up: it opens, and is let go.
   std::vector<double> opened = start;
   opened[11] += 1e-5;
-  EXPECT_TRUE(supports.update(anatomy, &floor, start, opened));
+  EXPECT_TRUE(supports.update(nullptr, &floor, start, opened));
   EXPECT_TRUE(supports.tet_supports().empty());
 }
 

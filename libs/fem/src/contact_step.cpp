@@ -99,7 +99,9 @@ void ContactStep::set_obstacles(std::span<const ObstacleField* const> fields,
                    ? nullptr
                    : std::make_unique<ObstacleProjection>(fields, body_.node_count(), settings);
   projection_settings_.project_obstacle_contacts = obstacles_ == nullptr;
-  supports_ = obstacles_ && settings.support_stiffness_ratio > 0.0
+  // The floor's tets are held in A with or without anatomy.
+  support_ratio_ = settings.support_stiffness_ratio;
+  supports_ = (obstacles_ || volume_floor_) && support_ratio_ > 0.0
                   ? std::make_unique<ObstacleSupport>(
                         body_.node_count(), volume_floor_ ? body_.element_rest().size() : 0)
                   : nullptr;
@@ -473,9 +475,8 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   const double h = body_.time_step_s();
   tool_reaction_n_ = tool_force_n_ + projection_.tool_push_kg_m / (h * h);
   if (supports_ &&
-      supports_->update(*obstacles_, volume_floor_.get(), start_positions_, free_positions_)) {
-    body_.set_supports(supports_->supports(), supports_->tet_supports(),
-                       obstacles_->settings().support_stiffness_ratio);
+      supports_->update(obstacles_.get(), volume_floor_.get(), start_positions_, free_positions_)) {
+    body_.set_supports(supports_->supports(), supports_->tet_supports(), support_ratio_);
   }
   lap(report.cpu.supports_ns);
   projection_.obstacle_supported = static_cast<int>(body_.support_count());

@@ -46,21 +46,21 @@ double dot12(const std::array<Eigen::Vector3d, 4>& a, const std::array<Eigen::Ve
 
 }  // namespace
 
-bool ObstacleSupport::update(const ObstacleProjection& anatomy, const VolumeFloor* floor,
+bool ObstacleSupport::update(const ObstacleProjection* anatomy, const VolumeFloor* floor,
                              std::span<const double> start_m, std::span<const double> free_m) {
   const std::size_t previous_count = count_;
   std::copy_n(supports_.begin(), previous_count, previous_.begin());
   for (std::size_t i = 0; i < previous_count; ++i)
     slot_of_node_[previous_[i].node] = static_cast<std::int32_t>(i);
-  const std::size_t nodes =
-      std::min({anatomy.node_count(), supports_.size(), start_m.size() / 3, free_m.size() / 3});
+  const std::size_t nodes = std::min({anatomy == nullptr ? supports_.size() : anatomy->node_count(),
+                                      supports_.size(), start_m.size() / 3, free_m.size() / 3});
   bool changed = false;
   count_ = 0;
   // Node order, so the set (and A) does not depend on the order of moves.
   for (std::size_t n = 0; n < nodes; ++n) {
     const std::int32_t slot = slot_of_node_[n];
-    if (anatomy.moved(n)) {
-      const Eigen::Vector3d& normal = anatomy.move_normal(n);
+    if (anatomy != nullptr && anatomy->moved(n)) {
+      const Eigen::Vector3d& normal = anatomy->move_normal(n);
       if (slot >= 0 &&
           previous_[static_cast<std::size_t>(slot)].normal.dot(normal) >= kSameNormalCos) {
         supports_[count_++] = previous_[static_cast<std::size_t>(slot)];

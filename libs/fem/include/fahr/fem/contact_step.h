@@ -186,7 +186,9 @@ class ContactStep {
   Eigen::Vector3d compliance_push_kg_m_ = Eigen::Vector3d::Zero();
   ProjectionSettings projection_settings_;
   std::unique_ptr<ObstacleProjection> obstacles_;
-  std::unique_ptr<ObstacleSupport> supports_;  // with obstacles_ and a ratio > 0
+  // With obstacles_ or volume_floor_, and a ratio > 0.
+  std::unique_ptr<ObstacleSupport> supports_;
+  double support_ratio_ = 0.0;
   std::unique_ptr<VolumeFloor> volume_floor_;  // with a floor ratio > 0
   bool external_load_ = false;                 // this step's extra forces are not all 0
   ProjectionReport projection_;

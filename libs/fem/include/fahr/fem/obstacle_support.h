@@ -59,10 +59,11 @@ class ObstacleSupport {
 
   // After a step's projections. start_m and free_m (3 per node, m): the
   // positions at the start of the step and after its implicit solve, before
-  // any projection. `floor` (may be null): the step's volume floor, whose
-  // moved tets are held too. Returns true if a held set or a direction
-  // changed. No allocation.
-  bool update(const ObstacleProjection& anatomy, const VolumeFloor* floor,
+  // any projection. `anatomy` and `floor` (either may be null): the step's
+  // anatomy pass, whose moved nodes are held, and its volume floor, whose
+  // moved tets are held. Returns true if a held set or a direction changed.
+  // No allocation.
+  bool update(const ObstacleProjection* anatomy, const VolumeFloor* floor,
               std::span<const double> start_m, std::span<const double> free_m);
   // Lets every node and tet go (a reset); returns true if any was held.
   bool clear();
