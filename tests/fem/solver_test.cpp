@@ -252,6 +252,57 @@ TEST(Solvers, ASparseRightHandSideSolvesAsTheDenseOne) {
   }
 }
 
+// Refactorisations after the first run fahr's own numeric pass on
+// CHOLMOD's supernodal structure (SupernodalNumeric). On new values of the
+// same pattern its solve must be a fresh CHOLMOD factorisation's; an
+// indefinite matrix is refused, and the next definite one factorised again.
+TEST(Solvers, ARefactorisationOnTheSamePatternSolvesAsAFreshCholmodFactor) {
+  const int side = 14;
+  SparseMatrix a = grid_matrix(side);
+  const auto n = static_cast<std::size_t>(a.rows());
+  CholmodSolver refactored;
+  ASSERT_TRUE(refactored.analyze(a, {.factor = CholmodFactorKind::kSupernodal}));
+  ASSERT_TRUE(refactored.factorize());  // CHOLMOD's own, the first time
+  // New values: every diagonal and coupling changed, A still definite.
+  for (int j = 0; j < a.outerSize(); ++j) {
+    for (SparseMatrix::InnerIterator it(a, j); it; ++it) {
+      it.valueRef() =
+          it.row() == it.col() ? 6.2 + std::sin(0.7 * j) : -0.8 - 0.15 * std::cos(1.3 * j);
+    }
+  }
+  ASSERT_TRUE(refactored.factorize());
+  CholmodSolver fresh;
+  ASSERT_TRUE(fresh.analyze(a, {.factor = CholmodFactorKind::kSupernodal}));
+  ASSERT_TRUE(fresh.factorize());
+  std::vector<double> b(n), x(n), y(n);
+  for (std::size_t i = 0; i < n; ++i) b[i] = std::cos(0.37 * static_cast<double>(i));
+  refactored.solve(b, x);
+  fresh.solve(b, y);
+  // And the residual against A itself (upper triangle stored: A x = U x + U' x - diag x).
+  const Eigen::Map<const Eigen::VectorXd> xv(x.data(), static_cast<Eigen::Index>(n));
+  const Eigen::VectorXd ax = a.selfadjointView<Eigen::Upper>() * xv;
+  double largest = 0.0, difference = 0.0, residual = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    largest = std::max(largest, std::abs(y[i]));
+    difference = std::max(difference, std::abs(x[i] - y[i]));
+    residual = std::max(residual, std::abs(ax[static_cast<Eigen::Index>(i)] - b[i]));
+  }
+  EXPECT_GT(largest, 0.0);
+  EXPECT_LT(difference, 1e-12 * largest);
+  EXPECT_LT(residual, 1e-12);
+  // Indefinite: one diagonal entry negative.
+  const int last = static_cast<int>(n) - 1;
+  const double kept = a.coeff(last / 2, last / 2);
+  a.coeffRef(last / 2, last / 2) = -1.0;
+  EXPECT_FALSE(refactored.factorize());
+  a.coeffRef(last / 2, last / 2) = kept;
+  ASSERT_TRUE(refactored.factorize());
+  refactored.solve(b, x);
+  difference = 0.0;
+  for (std::size_t i = 0; i < n; ++i) difference = std::max(difference, std::abs(x[i] - y[i]));
+  EXPECT_LT(difference, 1e-12 * largest);
+}
+
 TEST(Solvers, ABackgroundFactorisationUnderWayIsNotDoneUntilItEnds) {
   // The job's fill (run on the background thread) is held at a gate: the
   // solver must report the job under way, keep solving with the factor

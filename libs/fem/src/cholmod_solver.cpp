@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/fem/supernodal_numeric.h"
 #include "fahr/geometry/vector_clones.h"
 
 namespace fahr::fem {
@@ -24,6 +25,22 @@ namespace fahr::fem {
 namespace {
 // The background factorisation's nice value (the logger's writer has 10).
 constexpr int kBackgroundNice = 10;
+
+// A numeric factorisation of `a` into `f`: CHOLMOD's the first time (it
+// allocates L's values and makes the factor numeric), `numeric`'s on the
+// same structure after that.
+bool factorize_into(cholmod_sparse& a, cholmod_factor* f, cholmod_common& common,
+                    SupernodalNumeric& numeric) {
+  if (numeric.prepared() && f->is_super != 0 && f->is_ll != 0 && f->xtype == CHOLMOD_REAL &&
+      f->x != nullptr) {
+    const bool ok = numeric.factorize({static_cast<const double*>(a.x), a.nzmax},
+                                      {static_cast<double*>(f->x), f->xsize});
+    f->minor = ok ? f->n : numeric.failed_column();
+    common.status = ok ? CHOLMOD_OK : CHOLMOD_NOT_POSDEF;
+    return ok;
+  }
+  return cholmod_factorize(&a, f, &common) != 0 && common.status == CHOLMOD_OK;
+}
 
 // The supernodes L^-1 P b reaches for a b with non-zeros at `dofs`,
 // ascending (CholmodSolver::reach), with the given visit marks.
@@ -265,6 +282,7 @@ struct CholmodSolver::State {
   cholmod_common common{};
   cholmod_sparse view{};  // borrows the arrays of the caller's matrix
   cholmod_factor* factor = nullptr;
+  SupernodalNumeric numeric_pass;  // refactorisations after the first
   // Reused by cholmod_solve2: X (result), Y and E (workspace). CHOLMOD
   // reallocates them whenever the column count changes, so each count in use
   // keeps its own set: single solves (CG, the step) and the compliance
@@ -303,6 +321,7 @@ struct CholmodSolver::State {
   struct Background {
     cholmod_common common{};
     cholmod_factor* factor = nullptr;
+    SupernodalNumeric numeric_pass;
     cholmod_sparse view{};
     std::vector<double> values;
     std::thread thread;
@@ -338,8 +357,7 @@ struct CholmodSolver::State {
       void* const context = b.fill_context;
       lock.unlock();
       if (fill != nullptr) fill(context, b.values);
-      const int ok = cholmod_factorize(&b.view, b.factor, &b.common);
-      const bool good = ok != 0 && b.common.status == CHOLMOD_OK;
+      const bool good = factorize_into(b.view, b.factor, b.common, b.numeric_pass);
       if (good && after != nullptr) {
         NewFactor new_factor(this);
         after(context, new_factor);
@@ -427,6 +445,22 @@ struct CholmodSolver::State {
     update.assign(3 * std::max<std::size_t>(widest, 1), 0.0);
     sparse_y.assign(rows, 0.0);
     sparse_reach.assign(std::size_t(nsuper), 0);
+  }
+
+  // The structure of `factor` for SupernodalNumeric, if supernodal LL'.
+  void prepare_numeric_pass(SupernodalNumeric& pass) const {
+    if (factor == nullptr || factor->is_super == 0 || factor->itype != CHOLMOD_INT) return;
+    const auto nsuper = static_cast<std::size_t>(factor->nsuper);
+    const auto* pi = static_cast<const int*>(factor->pi);
+    const SupernodalPattern pattern{
+        .super = {static_cast<const int*>(factor->super), nsuper + 1},
+        .row_start = {pi, nsuper + 1},
+        .rows = {static_cast<const int*>(factor->s), static_cast<std::size_t>(pi[nsuper])},
+        .value_start = {static_cast<const int*>(factor->px), nsuper + 1},
+        .perm = {static_cast<const int*>(factor->Perm), rows}};
+    // An error leaves the pass unprepared: CHOLMOD factorises then.
+    (void)pass.prepare(pattern, {static_cast<const int*>(view.p), rows + 1},
+                       {static_cast<const int*>(view.i), view.nzmax});
   }
 
   ~State() {
@@ -517,7 +551,10 @@ bool CholmodSolver::analyze(const SparseMatrix& matrix, const CholmodOptions& op
   s.view.packed = 1;
   s.factor = cholmod_analyze(&s.view, &s.common);
   const bool analysed = s.factor != nullptr && s.common.status >= CHOLMOD_OK;
-  if (analysed) s.build_tree();
+  if (analysed) {
+    s.build_tree();
+    s.prepare_numeric_pass(s.numeric_pass);
+  }
   return analysed && (!had_background || enable_background());
 }
 
@@ -541,6 +578,7 @@ bool CholmodSolver::enable_background() {
   b->update.assign(s.update.size(), 0.0);
   b->view = s.view;
   b->view.x = b->values.data();
+  s.prepare_numeric_pass(b->numeric_pass);
   s.background = std::move(b);
   State* state = &s;
   s.background->thread = std::thread([state] { state->run_background(); });
@@ -599,8 +637,7 @@ std::int64_t CholmodSolver::background_cpu_ns() const {
 bool CholmodSolver::factorize() {
   State& s = *state_;
   if (s.factor == nullptr) return false;
-  const int ok = cholmod_factorize(&s.view, s.factor, &s.common);
-  s.numeric = ok != 0 && s.common.status == CHOLMOD_OK;
+  s.numeric = factorize_into(s.view, s.factor, s.common, s.numeric_pass);
   if (s.numeric) ++s.factorisations;
   return s.numeric;
 }
