@@ -60,6 +60,6 @@ set(CPACK_DEBIAN_PACKAGE_SECTION science)
 # The shared libraries the programs link (ldd of the installed programs,
 # Debian 12 package names), and the lab tools fahr_lab starts.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-  "libfastrtps2.9, libfastcdr1, libddsc0debian (>= 0.10), libyaml-cpp0.7, libcholmod3, libblas3 | libblas.so.3, libassimp5, libbullet3.24, liblz4-1, libzstd1, zlib1g, libstdc++6, fastdds-tools, nftables")
+  "libfastrtps2.9, libfastcdr1, libddsc0debian (>= 0.10), libyaml-cpp0.7, libcholmod3, libblas3 | libblas.so.3, liblapack3 | liblapack.so.3, libassimp5, libbullet3.24, liblz4-1, libzstd1, zlib1g, libstdc++6, fastdds-tools, nftables")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "libopenblas0-pthread, chrony")
 include(CPack)

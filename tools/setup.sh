@@ -12,7 +12,7 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   cyclonedds-dev cyclonedds-tools libcycloneddsidl0
   # numerics and geometry
-  libeigen3-dev libsuitesparse-dev libblas-dev libopenblas0-pthread libbullet-dev libassimp-dev
+  libeigen3-dev libsuitesparse-dev libblas-dev liblapack-dev libopenblas0-pthread libbullet-dev libassimp-dev
   # configuration, command lines, tests and benchmarks
   libyaml-cpp-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   # fuzzing (libFuzzer ships with clang's runtime) and sanitizers
