@@ -578,7 +578,7 @@ bool CholmodSolver::enable_background() {
   b->update.assign(s.update.size(), 0.0);
   b->view = s.view;
   b->view.x = b->values.data();
-  s.prepare_numeric_pass(b->numeric_pass);
+  b->numeric_pass = s.numeric_pass;  // the same structure, its own workspace
   s.background = std::move(b);
   State* state = &s;
   s.background->thread = std::thread([state] { state->run_background(); });

@@ -21,6 +21,37 @@ std::vector<T> copy_of(std::span<const T> s) {
 
 }  // namespace
 
+template <typename Update>
+void SupernodalNumeric::for_each_update(std::size_t s, Update update) {
+  const int end = super_[s + 1];
+  for (int d = head_[s]; d >= 0;) {
+    const auto du = std::size_t(d);
+    const int d_next = next_[du];
+    const int first = row_start_[du] + next_row_[du];
+    int last = first;
+    while (last < row_start_[du + 1] && rows_[std::size_t(last)] < end) ++last;
+    update(d, first, last);
+    next_row_[du] = last - row_start_[du];
+    link(d);
+    d = d_next;
+  }
+  head_[s] = -1;
+}
+
+void SupernodalNumeric::link_below(std::size_t s) {
+  next_row_[s] = super_[s + 1] - super_[s];
+  link(int(s));
+}
+
+void SupernodalNumeric::link(int d) {
+  const auto du = std::size_t(d);
+  const int position = row_start_[du] + next_row_[du];
+  if (position >= row_start_[du + 1]) return;  // no rows left below
+  const auto t = std::size_t(column_supernode_[std::size_t(rows_[std::size_t(position)])]);
+  next_[du] = head_[t];
+  head_[t] = d;
+}
+
 std::string SupernodalNumeric::prepare(const SupernodalPattern& pattern,
                                        std::span<const int> column_start,
                                        std::span<const int> row_index) {
@@ -73,45 +104,18 @@ std::string SupernodalNumeric::prepare(const SupernodalPattern& pattern,
     }
   }
 
-  // One dry run of the descendant lists sizes the update block and counts
-  // the flops.
+  // One dry run of the descendant lists sizes the update block.
   head_.assign(nsuper, -1);
   next_.assign(nsuper, -1);
   next_row_.assign(nsuper, 0);
   local_.assign(n, 0);
   std::size_t largest_update = 1;
-  flops_ = 0.0;
   for (std::size_t s = 0; s < nsuper; ++s) {
-    const int k2 = super_[s + 1];
-    for (int d = head_[s]; d >= 0;) {
-      const int d_next = next_[std::size_t(d)];
-      const int d_end = row_start_[std::size_t(d) + 1];
-      const int first = row_start_[std::size_t(d)] + next_row_[std::size_t(d)];
-      int last = first;
-      while (last < d_end && rows_[std::size_t(last)] < k2) ++last;
-      const double above = last - first;
-      const double all = d_end - first;
-      const double columns = super_[std::size_t(d) + 1] - super_[std::size_t(d)];
-      largest_update = std::max(largest_update, std::size_t(all * above));
-      flops_ += above * (above + 1.0) * columns + 2.0 * (all - above) * above * columns;
-      next_row_[std::size_t(d)] = last - row_start_[std::size_t(d)];
-      if (last < d_end) {
-        const int t = column_supernode_[std::size_t(rows_[std::size_t(last)])];
-        next_[std::size_t(d)] = head_[std::size_t(t)];
-        head_[std::size_t(t)] = d;
-      }
-      d = d_next;
-    }
-    const double columns = k2 - super_[s];
-    const double below = row_start_[s + 1] - row_start_[s] - columns;
-    flops_ += columns * columns * columns / 3.0 + below * columns * columns;
-    next_row_[s] = int(columns);
-    if (below > 0) {
-      const int t =
-          column_supernode_[std::size_t(rows_[std::size_t(row_start_[s]) + std::size_t(columns)])];
-      next_[s] = head_[std::size_t(t)];
-      head_[std::size_t(t)] = int(s);
-    }
+    for_each_update(s, [&](int d, int first, int last) {
+      const auto all = std::size_t(row_start_[std::size_t(d) + 1] - first);
+      largest_update = std::max(largest_update, all * std::size_t(last - first));
+    });
+    link_below(s);
   }
   update_.assign(largest_update, 0.0);
   return "";
@@ -139,19 +143,13 @@ bool SupernodalNumeric::factorize(std::span<const double> values, std::span<doub
     for (int i = 0; i < s_rows; ++i) local_[std::size_t(rows[s_first + i])] = i;
 
     // Every supernode whose rows reach into [k1, k2) subtracts its share.
-    for (int d = head_[s]; d >= 0;) {
+    for_each_update(s, [&](int d, int first, int last) {
       const auto du = std::size_t(d);
-      const int d_next = next_[du];
-      const int d_first = row_start_[du];
-      const int d_end = row_start_[du + 1];
-      const int d_rows = d_end - d_first;
+      const int d_rows = row_start_[du + 1] - row_start_[du];
       const int d_columns = super_[du + 1] - super_[du];
-      const int first = d_first + next_row_[du];
-      int last = first;
-      while (last < d_end && rows[last] < k2) ++last;
-      const int above = last - first;  // rows in this supernode's columns
-      const int all = d_end - first;   // those and every row below them
-      const double* const top = l + value_start_[du] + (first - d_first);
+      const int above = last - first;              // rows in this supernode's columns
+      const int all = row_start_[du + 1] - first;  // those and every row below them
+      const double* const top = l + value_start_[du] + (first - row_start_[du]);
       double* const c = update_.data();
       cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, above, d_columns, 1.0, top, d_rows, 0.0,
                   c, all);
@@ -164,14 +162,7 @@ bool SupernodalNumeric::factorize(std::span<const double> values, std::span<doub
         const double* const cj = c + std::ptrdiff_t{j} * all;
         for (int i = j; i < all; ++i) column[local_[std::size_t(rows[first + i])]] -= cj[i];
       }
-      next_row_[du] = last - d_first;
-      if (last < d_end) {
-        const auto t = std::size_t(column_supernode_[std::size_t(rows[last])]);
-        next_[du] = head_[t];
-        head_[t] = d;
-      }
-      d = d_next;
-    }
+    });
 
     int info = 0;
     dpotrf_("L", &s_columns, block, &s_rows, &info);
@@ -182,11 +173,8 @@ bool SupernodalNumeric::factorize(std::span<const double> values, std::span<doub
     if (s_rows > s_columns) {
       cblas_dtrsm(CblasColMajor, CblasRight, CblasLower, CblasTrans, CblasNonUnit,
                   s_rows - s_columns, s_columns, 1.0, block, s_rows, block + s_columns, s_rows);
-      next_row_[s] = s_columns;
-      const auto t = std::size_t(column_supernode_[std::size_t(rows[s_first + s_columns])]);
-      next_[s] = head_[t];
-      head_[t] = int(s);
     }
+    link_below(s);
   }
   return true;
 }

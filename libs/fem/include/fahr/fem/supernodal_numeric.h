@@ -11,7 +11,7 @@
 // frees its workspace, and opens OpenMP regions; here A's entries go
 // straight to their places in L through a map built once, and every buffer
 // is sized once, so a factorisation allocates nothing. On the neonatal
-// tongue (5,175 unknowns, 0.97 M non-zeros in L) it takes about half of
+// tongue (5,175 unknowns, 0.97 M non-zeros in L) it takes about 60 % of
 // cholmod_factorize's time with the same BLAS (docs/design/fem-step-and-solvers.md).
 #pragma once
 
@@ -56,9 +56,6 @@ class SupernodalNumeric {
 
   std::size_t failed_column() const { return failed_column_; }
 
-  // Floating-point operations of one factorisation (SYRK, GEMM, POTRF, TRSM).
-  double flops() const { return flops_; }
-
  private:
   std::vector<int> super_, row_start_, rows_, value_start_;
   std::vector<int> column_supernode_;
@@ -69,8 +66,17 @@ class SupernodalNumeric {
   // (head_/next_ lists), where each one's next unused row is, the local row
   // of each row in the supernode being assembled, and the update block.
   std::vector<int> head_, next_, next_row_, local_;
+
+  // Calls update(d, first, last) for each supernode d in s's list, with
+  // rows_[first, last) its unused rows in s's columns, then moves d to the
+  // list of the supernode its next row falls in.
+  template <typename Update>
+  void for_each_update(std::size_t s, Update update);
+  // Once s is factorised: into the list of the supernode of its first row
+  // below the diagonal block.
+  void link_below(std::size_t s);
+  void link(int d);
   std::vector<double> update_;
-  double flops_ = 0.0;
   std::size_t failed_column_ = 0;
 };
 
