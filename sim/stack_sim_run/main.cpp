@@ -313,6 +313,14 @@ int main(int argc, char** argv) try {
         thread_cpu.count() == 0 ? 0.0
                                 : 1e-6 * static_cast<double>(sim.fem_background_cpu().count()) /
                                       static_cast<double>(thread_cpu.count()));
+    const fem::BackgroundCpu bg = sim.fem().setup().body->background_parts();
+    const double jobs = bg.jobs == 0 ? 1.0 : static_cast<double>(bg.jobs);
+    std::printf(
+        "stack_sim: background factorisation CPU ms a job over %llu jobs: assembly %.2f, "
+        "factorisation %.2f, W's columns %.2f\n",
+        static_cast<unsigned long long>(bg.jobs), 1e-6 * static_cast<double>(bg.fill_ns) / jobs,
+        1e-6 * static_cast<double>(bg.factor_ns) / jobs,
+        1e-6 * static_cast<double>(bg.after_ns) / jobs);
     print_fem_step_parts(sim.fem_step_parts());
     const auto us = [](std::chrono::nanoseconds d) { return static_cast<double>(d.count()) / 1e3; };
     std::printf("stack_sim: haptic tick CPU us median %.0f p99 %.0f p99.9 %.0f max %.0f\n",

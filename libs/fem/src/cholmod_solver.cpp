@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "fahr/fem/step_parts.h"
 #include "fahr/fem/supernodal_numeric.h"
 #include "fahr/geometry/vector_clones.h"
 
@@ -335,6 +336,8 @@ struct CholmodSolver::State {
     std::vector<std::uint32_t> marks;
     std::uint32_t mark = 0;
     std::vector<double> update;
+    // Thread CPU of the jobs so far by part (read while no job runs).
+    BackgroundCpu cpu;
     bool job = false;      // a factorisation was asked for and not taken yet
     bool running = false;  // begun and not finished or cancelled
     bool ok = false;
@@ -356,13 +359,21 @@ struct CholmodSolver::State {
       const AfterFactor after = b.after;
       void* const context = b.fill_context;
       lock.unlock();
+      const std::int64_t t0 = thread_cpu_ns();
       if (fill != nullptr) fill(context, b.values);
+      const std::int64_t t1 = thread_cpu_ns();
       const bool good = factorize_into(b.view, b.factor, b.common, b.numeric_pass);
+      const std::int64_t t2 = thread_cpu_ns();
       if (good && after != nullptr) {
         NewFactor new_factor(this);
         after(context, new_factor);
       }
+      const std::int64_t t3 = thread_cpu_ns();
       lock.lock();
+      b.cpu.fill_ns += t1 - t0;
+      b.cpu.factor_ns += t2 - t1;
+      b.cpu.after_ns += t3 - t2;
+      ++b.cpu.jobs;
       b.ok = good;
       b.job = false;
       b.wake.notify_all();
@@ -625,6 +636,13 @@ bool CholmodSolver::background_done() const {
 
 void CholmodSolver::cancel_factorize() {
   if (state_->background) state_->wait_background();
+}
+
+BackgroundCpu CholmodSolver::background_parts() const {
+  if (!state_->background) return {};
+  State::Background& b = *state_->background;
+  std::lock_guard lock(b.mutex);
+  return b.cpu;
 }
 
 std::int64_t CholmodSolver::background_cpu_ns() const {

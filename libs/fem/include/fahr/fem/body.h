@@ -238,6 +238,7 @@ class Body {
   // CPU time of the background factorisation thread so far, ns
   // (SolverSettings::background_factor_latency_s; 0 without it).
   std::int64_t background_cpu_ns() const { return cholmod_.background_cpu_ns(); }
+  BackgroundCpu background_parts() const { return cholmod_.background_parts(); }
   // Background factorisations not done when their latency had passed: the
   // step waited for them (FactorInstall::kWait) or went on with the factor
   // before (kWhenDone). A machine too slow for the latency shows here.

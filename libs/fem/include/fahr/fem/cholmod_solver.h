@@ -55,6 +55,16 @@ struct PanelWorkspace {
   std::vector<std::size_t> active;
 };
 
+// The background thread's CPU over its jobs, ns, by part: the caller's
+// fill (assembly), the numeric factorisation, the caller's after (W's
+// columns on the new factor).
+struct BackgroundCpu {
+  std::int64_t fill_ns = 0;
+  std::int64_t factor_ns = 0;
+  std::int64_t after_ns = 0;
+  std::uint64_t jobs = 0;
+};
+
 class CholmodSolver {
   struct State;
 
@@ -124,6 +134,8 @@ class CholmodSolver {
   bool background_done() const;
   // CPU time the background thread has used so far, ns (0 without one).
   std::int64_t background_cpu_ns() const;
+  // The same by part, over the jobs that have ended.
+  BackgroundCpu background_parts() const;
 
   // Solves with sparse right-hand sides (the compliance block, compliance.h).
   // With a supernodal LL' factor, A = P^T L L^T P, so b^T A^-1 c =
