@@ -203,7 +203,7 @@ TEST(ContactSolver, TissueRowWithoutComplianceIsLeftOutAndCounted) {
 // solve converges to a force between the two factorisations' own. (On the
 // tongue in real time PGS diverged on such an A: contact-contract.md.)
 TEST(ContactSolver, BlockFromTwoFactorisationsIsMadeSemidefinite) {
-  constexpr std::size_t n = 16;
+  const std::size_t n = 16;
   const double local = 2e-4;   // m/N
   const double shared = 2e-3;  // m/N: the patch moving together
   test::SyntheticPatch older = test::make_patch(n, -0.001, local, shared);
@@ -285,7 +285,7 @@ TEST(Coupling, IsClampedToTheDevice) {
 // floored one grew past the double range (the haptic service sent NaN
 // stiffness about once a second while pressing).
 TEST(DenseCholesky, DependentAndSlightlyIndefiniteRowsGiveAFiniteSolution) {
-  constexpr std::size_t n = 64;
+  const std::size_t n = 64;
   std::vector<Eigen::Vector3d> normals(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double t = 0.01 * static_cast<double>(i);

@@ -225,11 +225,24 @@ std::optional<Eigen::Vector3d> ContactResponse::held_step(const TickInput& input
   const bool release = holds_load() ? should_release(settings_.force_aware, pull, limit)
                                     : releases_position_hold(input.device, coupling);
   if (release) return std::nullopt;
-  solver_.solve_pinned(zero, settings_.pgs);
+  solver_.solve_pinned(zero, settings_.pgs, held_load_facing());
   if (settings_.force_aware.held_proxy != HeldProxy::kBackOff) return zero;
   const Eigen::Vector3d back = yield_to_limit(zero, limit);
   if (back != zero) capture_holds(input.compliance);
   return back;
+}
+
+// kHoldLoad, held: the pinned solve loads only the tissue the tool pushes
+// along the push it froze with. A load keeps no geometry, so tissue beside
+// the blade closes over its plate; rows on that tissue face against the
+// push, and a solve over both faces asks for forces that push the two
+// layers apart and cancel in the resultant. Bounded as a sum by the limit
+// (scale_tissue_forces), they starved the push: the held tissue got 4 % of
+// the limit on the neonatal tongue and 0.7 % on the ArtiSynth tongue while
+// the hand felt all of it (docs/design/force-aware-decision.md).
+Eigen::Vector3d ContactResponse::held_load_facing() const {
+  return holds_load() && state_ == TrackingState::kLostTrack ? held_push_direction_
+                                                             : Eigen::Vector3d::Zero();
 }
 
 // kStay and kBackOff release when the coupling spring falls within the
@@ -254,7 +267,7 @@ Eigen::Vector3d ContactResponse::hold_after_implausible_step(double limit) {
   report_.implausible_step = true;
   // The refused solve's lambda is no start for this one.
   solver_.clear_lambda();
-  solver_.solve_pinned(zero, settings_.pgs);
+  solver_.solve_pinned(zero, settings_.pgs, held_load_facing());
   return holds_load() ? zero : yield_to_limit(zero, limit);
 }
 
@@ -295,7 +308,7 @@ bool ContactResponse::freezes(double pull, double limit) const {
 Eigen::Vector3d ContactResponse::freeze(const TissueCompliance& compliance, double limit) {
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   state_ = TrackingState::kLostTrack;
-  solver_.solve_pinned(zero, settings_.pgs);
+  solver_.solve_pinned(zero, settings_.pgs, held_load_facing());
   const Eigen::Vector3d push = solver_.resultant(RowKind::kTissue);
   held_push_direction_ =
       push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
@@ -376,7 +389,7 @@ Eigen::Vector3d ContactResponse::keep_out_of_bone(const Eigen::Vector3d& step) {
     return step;
   Eigen::Vector3d kept_out = solver_.project_on_obstacles(step, settings_.pgs);
   if (!kept_out.allFinite() || !((kept_out - step).squaredNorm() > 0.0)) return step;
-  solver_.solve_pinned(kept_out, settings_.pgs);
+  solver_.solve_pinned(kept_out, settings_.pgs, held_load_facing());
   return kept_out;
 }
 
@@ -417,13 +430,12 @@ double ContactResponse::scale_tissue_forces(const DeviceSample& device) {
   if (holds_proxy) {
     // Held where it froze: the tissue forces are scaled to the limit; the
     // spheres stay frozen (kStay) or carry that load alone (kHoldLoad,
-    // force only: write_contacts). A load alone keeps no geometry, so
-    // tissue reaches into the held blade and the pinned solve then asks for
-    // rows on both faces of its plate that push the two layers apart and
-    // cancel in the resultant (thousands of newtons under a 7.9 N
-    // resultant): kHoldLoad bounds the sum of the rows' magnitudes by the
-    // limit as well, so no load the device could not render reaches the
-    // tissue in any form (docs/design/force-aware-decision.md).
+    // force only: write_contacts). kHoldLoad bounds the sum of the rows'
+    // magnitudes by the limit as well, so no load the device could not
+    // render reaches the tissue in any form: rows that push sideways can
+    // still squeeze the tissue under a small resultant (its pinned solve
+    // leaves out only the rows facing against the held push,
+    // held_load_facing; docs/design/force-aware-decision.md).
     const double held_load =
         held == HeldProxy::kHoldLoad ? std::max(load, tissue_magnitudes()) : load;
     if (held_load > device.renderable_force_n) {

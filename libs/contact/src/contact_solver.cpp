@@ -32,6 +32,11 @@ constexpr double kSemidefiniteTolerance = 1e-4;
 constexpr double kFirstDiagonalShift = 1.0 / 16.0;
 constexpr double kLargestDiagonalShift = 4.0;
 
+// A left-out row's right-hand side: a gap of a metre, which no solve of
+// tissue compliances (~1e-3 m/N) and rows' forces can close, so PGS keeps
+// its lambda at 0.
+constexpr double kLeftOutGapM = -1.0;
+
 std::uint64_t row_key(const ContactRow& row) {
   return (std::uint64_t{row.kind == RowKind::kObstacle ? 1u : 0u} << 32) | row.id;
 }
@@ -169,11 +174,15 @@ Eigen::Vector3d ContactSolver::solve_coupled(double k_eff_npm,
   return target_offset_m - push * inverse_k;
 }
 
-void ContactSolver::solve_pinned(const Eigen::Vector3d& proxy_offset_m,
-                                 const PgsSettings& settings) {
+void ContactSolver::solve_pinned(const Eigen::Vector3d& proxy_offset_m, const PgsSettings& settings,
+                                 const Eigen::Vector3d& facing) {
   for (std::size_t i = 0; i < k_; ++i) {
     for (std::size_t j = 0; j < k_; ++j) s_[i * capacity_ + j] = a_[i * capacity_ + j];
     b_[i] = depth_[i] + rows_[i].normal.dot(proxy_offset_m);
+    if (rows_[i].kind == RowKind::kTissue && rows_[i].normal.dot(facing) < 0.0) {
+      b_[i] = kLeftOutGapM;
+      lambda_[i] = 0.0;
+    }
   }
   report_ =
       solve_pgs(s_.data(), capacity_, k_, b_.data(), lambda_.data(), residual_.data(), settings);

@@ -146,6 +146,9 @@ class ContactResponse {
   bool freezes(double pull, double limit) const;
   Eigen::Vector3d freeze(const TissueCompliance& compliance, double limit);
   bool holds_load() const { return settings_.force_aware.held_proxy == HeldProxy::kHoldLoad; }
+  // The pinned solve's `facing` while a held tool holds the tissue by a
+  // load: the push it froze with; zero otherwise (every row takes part).
+  Eigen::Vector3d held_load_facing() const;
   // tick()'s phases after the proxy moved.
   Eigen::Vector3d keep_out_of_bone(const Eigen::Vector3d& step);
   void fill_output(const DeviceSample& device, const EffectiveCoupling& coupling);

@@ -54,8 +54,12 @@ class ContactSolver {
 
   // The proxy held at p0 + proxy_offset_m: A lambda >= d + N^T offset. Rows
   // that cannot yield (A_ii = 0: obstacles, fully fixed spheres) carry no
-  // force here, since a held proxy needs none from them.
-  void solve_pinned(const Eigen::Vector3d& proxy_offset_m, const PgsSettings& settings);
+  // force here, since a held proxy needs none from them. With `facing`
+  // non-zero, tissue rows whose normal points against it (n . facing < 0)
+  // take no part and keep lambda = 0: the load a held tool puts on the
+  // tissue along the push it froze with (ContactResponse, kHoldLoad).
+  void solve_pinned(const Eigen::Vector3d& proxy_offset_m, const PgsSettings& settings,
+                    const Eigen::Vector3d& facing = Eigen::Vector3d::Zero());
 
   // The proxy step nearest `step_m` that leaves no obstacle row penetrating
   // (n_i . step <= -d_i for every obstacle row): what a held or catching-up
