@@ -63,6 +63,18 @@ Trace press(ContactResponse& response, test::SyntheticPatch& patch, double limit
   return trace;
 }
 
+// One tick with the hand at (0, y, 0), the patch's tool face at the proxy.
+const ForceOutput& tick_on(ContactResponse& response, test::SyntheticPatch& patch, double y,
+                           double limit) {
+  test::set_tool_height(patch, response.proxy().position_m.y());
+  TickInput in;
+  in.device.position_m = Eigen::Vector3d(0, y, 0);
+  in.device.renderable_force_n = limit;
+  in.rows = patch.rows;
+  in.compliance = patch.compliance();
+  return response.tick(in);
+}
+
 // Both ways of holding: kBackOff holds the spheres (kFrozen), kHoldLoad
 // (the default) holds the tissue by its load (force only).
 TEST(ForceAware, FreezesPastTheLimitHoldsAndCatchesUpSmoothly) {
@@ -98,13 +110,7 @@ TEST(ForceAware, AHeldLoadReleasesWhenTheHandDrawsBackOut) {
   ContactResponse response{ResponseSettings{}};
   response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
   const auto tick = [&](double y) -> const ForceOutput& {
-    test::set_tool_height(patch, response.proxy().position_m.y());
-    TickInput in;
-    in.device.position_m = Eigen::Vector3d(0, y, 0);
-    in.device.renderable_force_n = 0.5;
-    in.rows = patch.rows;
-    in.compliance = patch.compliance();
-    return response.tick(in);
+    return tick_on(response, patch, y, 0.5);
   };
   double y = 0.002;
   while (!tick(y).lost_track) {
@@ -117,6 +123,49 @@ TEST(ForceAware, AHeldLoadReleasesWhenTheHandDrawsBackOut) {
   // Drawn back 5 mm above it: the spring's stretch is as long, but it pulls out.
   EXPECT_FALSE(tick(held_y + 0.005).lost_track);
   EXPECT_EQ(response.state(), TrackingState::kCatchingUp);
+}
+
+// A second hold takes the push it froze with, not the first hold's: the
+// blade pressed down on one patch, drawn back, then pressed up on a patch
+// above it (its rows face against the first push). Held, the second push
+// reaches the tissue at the limit, and the hold lasts while the hand
+// presses on (taken with the first push, the freeze's solve left every row
+// out, the push came out zero and the hold let go at once).
+TEST(ForceAware, ASecondHoldHoldsAlongItsOwnPush) {
+  constexpr double kLimit = 0.5;
+  constexpr std::size_t kPerPatch = 4;
+  constexpr double kUpperY = 0.010;  // the upper patch's sphere centres
+  test::SyntheticPatch patch = test::make_patch(2 * kPerPatch, 0.0, 0.002, 0.005);
+  for (ContactRow& row : patch.rows) {
+    if (row.id < kPerPatch) continue;
+    row.normal = Eigen::Vector3d(0, 1, 0);
+    row.other_point_m.y() = kUpperY;
+  }
+  ContactResponse response{ResponseSettings{}};
+  response.reset(Eigen::Vector3d(0, 0.002, 0), Eigen::Quaterniond::Identity());
+  const auto tick = [&](double y) -> const ForceOutput& {
+    return tick_on(response, patch, y, kLimit);
+  };
+  double y = 0.002;
+  while (!tick(y).lost_track) {
+    y -= 1e-5;
+    ASSERT_GT(y, -0.02) << "never froze pressing down";
+  }
+  // Drawn back up to the gap between the patches, until it tracks again.
+  for (int k = 0; k < 2000 && response.state() != TrackingState::kTracking; ++k) tick(0.005);
+  ASSERT_EQ(response.state(), TrackingState::kTracking);
+  y = 0.005;
+  while (!tick(y).lost_track) {
+    y += 1e-5;
+    ASSERT_LT(y, kUpperY + 0.02) << "never froze pressing up";
+  }
+  const double held_y = response.proxy().position_m.y();
+  for (int k = 0; k < 50; ++k) {
+    ASSERT_TRUE(tick(held_y + 0.005).lost_track) << "tick " << k;
+    Eigen::Vector3d resultant = Eigen::Vector3d::Zero();
+    for (const fem::Contact& c : response.contacts()) resultant += c.force_n * c.normal;
+    EXPECT_GE(resultant.y(), 0.9 * kLimit) << "tick " << k;
+  }
 }
 
 // A hand that pulls mostly sideways of the push the tool froze with is not
@@ -196,7 +245,7 @@ TEST(ForceAware, AHeldLoadNeverSendsTheTissueMoreThanTheLimitInAnyForm) {
     test::set_tool_height(patch, response.proxy().position_m.y());
     std::vector<ContactRow> rows = patch.rows;
     if (over_the_plate) {
-      ContactRow r = rows[0];
+      ContactRow r = patch.rows.front();
       r.id = static_cast<std::uint32_t>(kPatchSpheres);
       r.compliance_index = static_cast<std::int32_t>(kPatchSpheres);
       r.normal = Eigen::Vector3d(0, 1, 0);
@@ -263,13 +312,7 @@ TEST(ForceAware, AStayingProxyMeetsALowerLimitByScalingNotBySlipping) {
     for (int k = 0; k < 3000; ++k) {
       const double y = std::max(-0.012, 0.002 - 1e-5 * k);  // down at 10 mm/s, then held there
       const double limit = k < 2000 ? 0.5 : 0.3;
-      test::set_tool_height(patch, response.proxy().position_m.y());
-      TickInput in;
-      in.device.position_m = Eigen::Vector3d(0, y, 0);
-      in.device.renderable_force_n = limit;
-      in.rows = patch.rows;
-      in.compliance = patch.compliance();
-      const ForceOutput& out = response.tick(in);
+      const ForceOutput& out = tick_on(response, patch, y, limit);
       if (!out.lost_track) {
         ASSERT_LT(k, 2000) << "released while the hand still pulls";
         was_lost = false;

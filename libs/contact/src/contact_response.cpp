@@ -308,10 +308,13 @@ bool ContactResponse::freezes(double pull, double limit) const {
 Eigen::Vector3d ContactResponse::freeze(const TissueCompliance& compliance, double limit) {
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   state_ = TrackingState::kLostTrack;
-  solver_.solve_pinned(zero, settings_.pgs, held_load_facing());
+  // The push it froze with, over every row (an earlier hold's direction is
+  // no guide); then, held by a load, the load along it alone.
+  solver_.solve_pinned(zero, settings_.pgs);
   const Eigen::Vector3d push = solver_.resultant(RowKind::kTissue);
   held_push_direction_ =
       push.norm() > 0.0 ? Eigen::Vector3d(push / push.norm()) : Eigen::Vector3d::Zero();
+  if (holds_load()) solver_.solve_pinned(zero, settings_.pgs, held_load_facing());
   Eigen::Vector3d back =
       settings_.force_aware.held_proxy == HeldProxy::kBackOff ? yield_to_limit(zero, limit) : zero;
   if (!holds_load()) capture_holds(compliance);  // kHoldLoad holds no sphere
