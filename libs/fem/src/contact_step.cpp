@@ -290,6 +290,7 @@ void ContactStep::alternate_with_anatomy(const ContactSet* contacts) {
     }
   }
   VolumeFloor* const floor_pass = pressed ? volume_floor_.get() : nullptr;
+  floor_in_force_ = floor_pass != nullptr;
   int volume_below = 0;
   int volume_unresolved = 0;
   Eigen::Vector3d tool_push = Eigen::Vector3d::Zero();
@@ -468,14 +469,21 @@ StepReport ContactStep::step(const ContactSet* contacts, std::span<const double>
   update_free_centres();
   lap(report.cpu.compliance_ns);
   projection_ = {};
+  floor_in_force_ = false;
   if (obstacles_ || volume_floor_ || (contacts != nullptr && !contacts->contacts.empty())) {
     project(contacts);
   }
   lap(report.cpu.projection_ns);
   const double h = body_.time_step_s();
   tool_reaction_n_ = tool_force_n_ + projection_.tool_push_kg_m / (h * h);
+  // A tet is held in A only while the floor that moved it is in force: once
+  // nothing presses the body the floor's pass stops, and springs left in A
+  // for it would only slow the tissue's return (tets whose free motion did
+  // not open them stayed held after the blade left, and the tongue crept
+  // back over seconds with a sliver held inverted: docs/design/anatomy-contact.md).
+  VolumeFloor* const held_floor = floor_in_force_ ? volume_floor_.get() : nullptr;
   if (supports_ &&
-      supports_->update(obstacles_.get(), volume_floor_.get(), start_positions_, free_positions_)) {
+      supports_->update(obstacles_.get(), held_floor, start_positions_, free_positions_)) {
     body_.set_supports(supports_->supports(), supports_->tet_supports(), support_ratio_);
   }
   lap(report.cpu.supports_ns);

@@ -191,6 +191,7 @@ class ContactStep {
   double support_ratio_ = 0.0;
   std::unique_ptr<VolumeFloor> volume_floor_;  // with a floor ratio > 0
   bool external_load_ = false;                 // this step's extra forces are not all 0
+  bool floor_in_force_ = false;                // the floor's pass ran in this step
   ProjectionReport projection_;
   Eigen::Vector3d tool_force_n_ = Eigen::Vector3d::Zero();  // this step's applied tool forces
   Eigen::Vector3d tool_reaction_n_ = Eigen::Vector3d::Zero();
