@@ -87,7 +87,8 @@ bool ObstacleSupport::update(const ObstacleProjection* anatomy, const VolumeFloo
 
 // The floor's tets, as the nodes above: held from the step after the floor
 // moved them, along the direction it moved them; let go when the free
-// motion opens them.
+// motion opens them, and all of them when there is no floor (none in the
+// step: nothing presses the body).
 bool ObstacleSupport::update_tets(const VolumeFloor* floor, std::span<const double> start_m,
                                   std::span<const double> free_m) {
   const std::size_t previous_count = tet_count_;

@@ -23,8 +23,10 @@
 // opened in a step gets, from the next step on, a spring along the
 // direction it was opened in (its volume's gradient over its free nodes)
 // in A, k d d^T over its four nodes' blocks; it is let go when its free
-// motion opens it. For a held tet (three nodes fixed) that is a node
-// support of its fourth node along the fixed face's normal.
+// motion opens it, or as soon as the floor is out of force (the step
+// passes no floor: nothing presses the body). For a held tet (three nodes
+// fixed) that is a node support of its fourth node along the fixed face's
+// normal.
 #pragma once
 
 #include <Eigen/Core>
@@ -61,7 +63,8 @@ class ObstacleSupport {
   // positions at the start of the step and after its implicit solve, before
   // any projection. `anatomy` and `floor` (either may be null): the step's
   // anatomy pass, whose moved nodes are held, and its volume floor, whose
-  // moved tets are held. Returns true if a held set or a direction changed.
+  // moved tets are held; a null floor lets every held tet go. Returns true
+  // if a held set or a direction changed.
   // No allocation.
   bool update(const ObstacleProjection* anatomy, const VolumeFloor* floor,
               std::span<const double> start_m, std::span<const double> free_m);
