@@ -30,7 +30,8 @@
 // relative Frobenius error against a fresh factorisation of A linearised at
 // the state the step solves from (W's error: the step's own system solved
 // exactly) and at the state after it (what one step changes), for the
-// leading 1, 8, 32 and 64 spheres; the
+// leading 1, 8, 32 and 64 spheres, and the resultant of the tool's rows
+// solved on each W (the same displacement asked of both; relative); the
 // largest and RMS difference of the force sent to the device (N); the most
 // inverted tets.
 #include <Eigen/Dense>
@@ -42,6 +43,7 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -52,6 +54,7 @@
 #include "fahr/common/lockstep.h"
 #include "fahr/common/solver_threads.h"
 #include "fahr/common/wire_eigen.h"
+#include "fahr/contact/pgs.h"
 #include "fahr/fem_service/fem_body_setup.h"
 #include "fahr/fem_service/service_step.h"
 #include "fahr/scene/load_scene.h"
@@ -184,6 +187,19 @@ struct Shadow {
   fahr::fem::SystemAssembly start_assembly;
   fahr::fem::ComplianceBlock start_block;  // its own: a block keeps columns per factor count
   std::array<std::vector<double>, 5> start_error;
+  // Per audited step, against the start state's A and against the state
+  // after the step: the relative difference of the resultant of the tool's
+  // rows solved on the fresh W from that solved on the W in use
+  // (contact_forces).
+  std::vector<double> start_force_error, audit_force_error;
+  // The PGS's own floor: the resultant solved on the W in use against the
+  // haptic side's, relative.
+  double force_floor_max = 0.0;
+  std::size_t rows_outside_block = 0;  // tool rows whose sphere had no W slot
+  // contact_forces' workspace.
+  std::vector<std::size_t> row_slot;
+  std::vector<Eigen::Vector3d> row_normal;
+  std::vector<double> row_force, row_gap, lambda_used, lambda_fresh, pgs_residual, s_used, s_fresh;
   // The lagged factor's W corrected towards the start state's A (an
   // experiment, audit_corrections): every column solved on the factor in
   // use, then W1 = 2 J X - X^T A X with X = A_f^-1 J^T (first order in
@@ -248,10 +264,92 @@ void leading_errors(std::size_t k, const Fresh& fresh, const Used& used,
   }
 }
 
+// The forces the two W give the same rows. The rows are the tool's
+// entries of the ContactSet the step took that carry a force, on spheres
+// of the block, along their normals: S = N^T W N. The displacement the
+// haptic side's forces make under the W in use, d = S_used lambda_h, is the
+// right side of the tissue's LCP (S lambda >= d, lambda >= 0,
+// complementary, pgs.h) solved on each W alike. The rows share spheres and
+// overlap, so their split of a load is not unique; the resultant
+// sum lambda_i n_i is what the hand feels, and its relative difference is
+// appended to `errors`. The rows alone, without the tool's coupling beside
+// W, are the stricter test: a coupling adds the same compliance to both.
+void contact_forces(Shadow& shadow, const fahr::msg::ContactSet& fed,
+                    std::span<const std::uint32_t> spheres, std::span<const float> w_used,
+                    std::vector<double>& errors) {
+  shadow.row_slot.clear();
+  shadow.row_normal.clear();
+  shadow.row_force.clear();
+  for (const fahr::msg::Contact& c : fed.contacts()) {
+    const bool tool =
+        c.kind() == fahr::msg::CONTACT_TOOL || c.kind() == fahr::msg::CONTACT_FORCE_ONLY;
+    if (!tool || !(c.force_n() > 0.0)) continue;
+    const auto at = std::find(spheres.begin(), spheres.end(), c.sphere_id());
+    if (at == spheres.end()) {
+      ++shadow.rows_outside_block;
+      continue;
+    }
+    shadow.row_slot.push_back(static_cast<std::size_t>(at - spheres.begin()));
+    shadow.row_normal.push_back(fahr::common::to_eigen(c.normal()));
+    shadow.row_force.push_back(c.force_n());
+  }
+  const std::size_t m = shadow.row_slot.size();
+  if (m == 0) return;
+  const std::size_t stride = 3 * spheres.size();
+  const auto fill = [&](auto w_at, std::vector<double>& s) {
+    s.assign(m * m, 0.0);
+    for (std::size_t i = 0; i < m; ++i) {
+      for (std::size_t j = 0; j < m; ++j) {
+        double sum = 0.0;
+        for (std::size_t a = 0; a < 3; ++a) {
+          for (std::size_t b = 0; b < 3; ++b) {
+            sum += shadow.row_normal[i][static_cast<Eigen::Index>(a)] *
+                   w_at((3 * shadow.row_slot[i] + a) * stride + 3 * shadow.row_slot[j] + b) *
+                   shadow.row_normal[j][static_cast<Eigen::Index>(b)];
+          }
+        }
+        s[i * m + j] = sum;
+      }
+    }
+  };
+  fill([&](std::size_t i) { return static_cast<double>(w_used[i]); }, shadow.s_used);
+  fill([&](std::size_t i) { return static_cast<double>(shadow.audit_w[i]); }, shadow.s_fresh);
+  shadow.row_gap.assign(m, 0.0);
+  for (std::size_t i = 0; i < m; ++i) {
+    for (std::size_t j = 0; j < m; ++j) {
+      shadow.row_gap[i] += shadow.s_used[i * m + j] * shadow.row_force[j];
+    }
+  }
+  fahr::contact::PgsSettings settings;
+  settings.max_sweeps = 20000;
+  settings.tolerance_m = 1e-13;
+  shadow.pgs_residual.resize(m);
+  const auto solve = [&](const std::vector<double>& s, std::vector<double>& lambda) {
+    lambda = shadow.row_force;  // warm start at the haptic side's split
+    fahr::contact::solve_pgs(s.data(), m, m, shadow.row_gap.data(), lambda.data(),
+                             shadow.pgs_residual.data(), settings);
+  };
+  solve(shadow.s_used, shadow.lambda_used);
+  solve(shadow.s_fresh, shadow.lambda_fresh);
+  Eigen::Vector3d haptic = Eigen::Vector3d::Zero();
+  Eigen::Vector3d used = Eigen::Vector3d::Zero();
+  Eigen::Vector3d fresh = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < m; ++i) {
+    haptic += shadow.row_force[i] * shadow.row_normal[i];
+    used += shadow.lambda_used[i] * shadow.row_normal[i];
+    fresh += shadow.lambda_fresh[i] * shadow.row_normal[i];
+  }
+  if (haptic.norm() <= 0.0 || used.norm() <= 0.0) return;
+  shadow.force_floor_max = std::max(shadow.force_floor_max, (used - haptic).norm() / haptic.norm());
+  errors.push_back((fresh - used).norm() / used.norm());
+}
+
 // W of a fresh factorisation of the assembled A against the W in use:
-// relative Frobenius error of each leading block, appended to `errors`.
+// relative Frobenius error of each leading block, appended to `errors`, and
+// the forces the two give the rows of `fed`, to `force_errors`.
 void audit_against(Shadow& shadow, fahr::fem::CholmodSolver& fresh_factor,
-                   fahr::fem::ComplianceBlock& block, std::array<std::vector<double>, 5>& errors) {
+                   fahr::fem::ComplianceBlock& block, std::array<std::vector<double>, 5>& errors,
+                   const fahr::msg::ContactSet& fed, std::vector<double>& force_errors) {
   const auto& step = shadow.step->contact_step();
   const auto spheres = step.compliance_spheres();
   const auto w = step.compliance();
@@ -266,6 +364,7 @@ void audit_against(Shadow& shadow, fahr::fem::CholmodSolver& fresh_factor,
   leading_errors(
       k, [&](std::size_t i) { return static_cast<double>(shadow.audit_w[i]); },
       [&](std::size_t i) { return static_cast<double>(w[i]); }, errors);
+  contact_forces(shadow, fed, spheres, w, force_errors);
 }
 
 // The largest node motion of the step just made, and whether that node
@@ -365,15 +464,17 @@ void audit_corrections(Shadow& shadow) {
 }
 
 // After the step; start_assembly holds A at the state it began from.
-void audit_compliance(Shadow& shadow) {
+void audit_compliance(Shadow& shadow, const fahr::msg::ContactSet& fed) {
   record_step_motion(shadow);
   const auto& step = shadow.step->contact_step();
   const std::size_t k = step.compliance_spheres().size();
   if (k == 0 || step.compliance().size() != 9 * k * k) return;
-  audit_against(shadow, *shadow.start_audit, shadow.start_block, shadow.start_error);
+  audit_against(shadow, *shadow.start_audit, shadow.start_block, shadow.start_error, fed,
+                shadow.start_force_error);
   if (g_corrections) audit_corrections(shadow);
   shadow.setup->body->assemble_current(shadow.audit_assembly);
-  audit_against(shadow, *shadow.audit, shadow.audit_block, shadow.audit_error);
+  audit_against(shadow, *shadow.audit, shadow.audit_block, shadow.audit_error, fed,
+                shadow.audit_force_error);
 }
 
 struct Run {
@@ -605,7 +706,7 @@ int main(int argc, char** argv) try {
           const auto& report = shadow.step->last_report();
           const double t_s = exact.sim->time_s();
           if (!report.asleep && t_s >= audit_from_s && t_s <= audit_to_s) {
-            audit_compliance(shadow);
+            audit_compliance(shadow, exact.fed);
           }
           if (!report.asleep) shadow.iterations.push_back(report.solver_iterations);
           shadow.max_inverted = std::max(shadow.max_inverted, report.inverted_elements);
@@ -721,6 +822,27 @@ int main(int argc, char** argv) try {
         "W against A linearised at the state after the step (the next step's system: what one "
         "step changes in the tissue's linearisation)",
         [](const Shadow& shadow) -> const auto& { return shadow.audit_error; });
+    std::printf(
+        "\nThe tool's rows solved on each W (the rows of the set the step took that carry a "
+        "force, on spheres of the block; the displacement the haptic side's forces make under "
+        "the W in use, solved for on the fresh W by PGS): relative difference of the resultant, "
+        "p50 / p99 / max (steps)\n\n");
+    std::printf(
+        "| configuration | against the start state's A | against A after the step | PGS's own "
+        "floor, max | rows without a W slot |\n");
+    std::printf("| --- | ---: | ---: | ---: | ---: |\n");
+    for (const Run& run : runs) {
+      const Shadow& sh = run.shadow;
+      const auto cell3 = [](const std::vector<double>& v) {
+        char text[96];
+        std::snprintf(text, sizeof text, "%.3g / %.3g / %.3g (%zu)", quantile(v, 0.5),
+                      quantile(v, 0.99), quantile(v, 1.0), v.size());
+        return std::string(text);
+      };
+      std::printf("| %s | %s | %s | %.2g | %zu |\n", run.config.name.c_str(),
+                  cell3(sh.start_force_error).c_str(), cell3(sh.audit_force_error).c_str(),
+                  sh.force_floor_max, sh.rows_outside_block);
+    }
     if (g_corrections) {
       using Errors = std::array<std::vector<double>, 5> Shadow::*;
       const std::array<std::pair<const char*, Errors>, 3> corrections{{
