@@ -31,7 +31,8 @@
 // the state the step solves from (W's error: the step's own system solved
 // exactly) and at the state after it (what one step changes), for the
 // leading 1, 8, 32 and 64 spheres, and the resultant of the tool's rows
-// solved on each W (the same displacement asked of both; relative); the
+// solved on each W (the same displacement asked of both; relative), and how
+// much of the tool's load moves between spheres from one set to the next; the
 // largest and RMS difference of the force sent to the device (N); the most
 // inverted tets.
 #include <Eigen/Dense>
@@ -217,6 +218,46 @@ struct Shadow {
   std::vector<double> before_m;     // positions at the start of the step
   std::vector<double> step_m;       // each node's motion in this step
   std::vector<double> last_step_m;  // ... and in the step before
+};
+
+// How much of the tool's load moves between spheres from one ContactSet to
+// the next: sum over spheres of |lambda_now - lambda_before| over the
+// larger of the two sets' sums (0: the same split; 2: no sphere shared).
+struct LoadChurn {
+  std::vector<double> before, now;  // per sphere id, N
+  std::vector<std::uint32_t> touched_before, touched_now;
+  double sum_before = 0.0;
+  std::vector<double> shares;
+  void add(const fahr::msg::ContactSet& set) {
+    double sum = 0.0;
+    for (const fahr::msg::Contact& c : set.contacts()) {
+      const bool tool =
+          c.kind() == fahr::msg::CONTACT_TOOL || c.kind() == fahr::msg::CONTACT_FORCE_ONLY;
+      if (!tool || !(c.force_n() > 0.0)) continue;
+      if (c.sphere_id() >= now.size()) {
+        now.resize(c.sphere_id() + 1, 0.0);
+        before.resize(now.size(), 0.0);
+      }
+      if (now[c.sphere_id()] == 0.0) touched_now.push_back(c.sphere_id());
+      now[c.sphere_id()] += c.force_n();
+      sum += c.force_n();
+    }
+    const double larger = std::max(sum, sum_before);
+    if (larger > 0.0 && sum_before > 0.0) {
+      double moved = 0.0;
+      for (const std::uint32_t s : touched_now) moved += std::abs(now[s] - before[s]);
+      for (const std::uint32_t s : touched_before) {
+        if (now[s] == 0.0) moved += before[s];
+      }
+      shares.push_back(moved / larger);
+    }
+    for (const std::uint32_t s : touched_before) before[s] = 0.0;
+    for (const std::uint32_t s : touched_now) before[s] = now[s];
+    for (const std::uint32_t s : touched_now) now[s] = 0.0;
+    std::swap(touched_before, touched_now);
+    touched_now.clear();
+    sum_before = sum;
+  }
 };
 
 // Leading spheres of the block whose W is audited (0: the whole block).
@@ -670,6 +711,7 @@ int main(int argc, char** argv) try {
     // assembly's arrays.
     for (Run& run : runs) start_audit(run.shadow);
     const auto steps = static_cast<std::uint64_t>(std::llround(seconds * 1000.0));
+    LoadChurn churn;
     for (std::uint64_t k = 0; k < steps; ++k) {
       const bool fem_steps = common::executes_at(k, runs.front().sim->fem_period_steps());
       for (Run& run : runs) {
@@ -688,6 +730,10 @@ int main(int argc, char** argv) try {
         run.max_inverted = std::max(run.max_inverted, report.inverted_elements);
       }
       const Run& exact = runs.front();
+      if (fem_steps && k > 0) {
+        const double t_s = exact.sim->time_s();
+        if (t_s >= audit_from_s && t_s <= audit_to_s) churn.add(exact.fed);
+      }
       if (fem_steps) {
         // The shadows: the exact run's ContactSet, the same step.
         for (Run& run : runs) {
@@ -843,6 +889,13 @@ int main(int argc, char** argv) try {
                   cell3(sh.start_force_error).c_str(), cell3(sh.audit_force_error).c_str(),
                   sh.force_floor_max, sh.rows_outside_block);
     }
+    std::printf(
+        "\nThe tool's load moved between spheres from one ContactSet the FEM took to the next "
+        "(the %s run's sets; sum over spheres of the change of their force over the larger "
+        "sum: 0 the same split, 2 no sphere in common), p50 / p99 / max (%zu sets): %.3g / "
+        "%.3g / %.3g\n",
+        runs.front().config.name.c_str(), churn.shares.size(), quantile(churn.shares, 0.5),
+        quantile(churn.shares, 0.99), quantile(churn.shares, 1.0));
     if (g_corrections) {
       using Errors = std::array<std::vector<double>, 5> Shadow::*;
       const std::array<std::pair<const char*, Errors>, 3> corrections{{
