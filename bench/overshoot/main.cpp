@@ -230,6 +230,13 @@ double deepest_in_blade_m(const stack_sim::StackSim& sim) {
   return deepest;
 }
 
+// The largest node motion of one FEM step (the trace's columns).
+struct StepMotion {
+  double largest_m = 0.0;
+  std::uint32_t node = 0;
+  bool reversed = false;
+};
+
 double max_displacement_m(const fem::Body& body) {
   double largest = 0.0;
   for (std::uint32_t n = 0; n < body.node_count(); ++n) {
@@ -508,7 +515,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       "lost_track,reaction_n,commanded_n,max_displacement_mm,inverted_worst_rest_radius_ratio,"
       "inverted_free,fem_cpu_ms,supported_nodes,"
       "volume_floor_below,volume_floor_unresolved,tool_force_sum_n,tool_largest_force_n,"
-      "fem_tool_reaction_n,fem_tool_projection_n,largest_strain,torn,worst_element\n");
+      "fem_tool_reaction_n,fem_tool_projection_n,largest_strain,torn,worst_element,"
+      "step_motion_mm,step_motion_node,step_motion_reversed\n");
   std::FILE* tick_trace = open_trace(
       tick_trace_path, r.name,
       "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,"
@@ -527,6 +535,9 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
   Eigen::Vector3d previous_hand = Eigen::Vector3d::Zero(),
                   previous_hand_v = Eigen::Vector3d::Zero();
   const auto steps = static_cast<std::uint64_t>((kScriptEndS + 1.5) * 1000.0);
+  // The trace's step motion: each node's position and motion at the FEM
+  // step before.
+  std::vector<Eigen::Vector3d> last_positions, last_motions;
   double fem_step_total_ms = 0.0;
   std::uint64_t fem_steps = 0;
   for (std::uint64_t k = 0; k < steps; ++k) {
@@ -674,6 +685,26 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       r.max_elastic_j = std::max(r.max_elastic_j, sim.body().energy().elastic_j);
       r.max_anatomy_depth_m = std::max(r.max_anatomy_depth_m, report.projection.obstacle_deepest_m);
       if (trace != nullptr) {
+        // The node that moved most in this FEM step, and whether it went
+        // back against its own motion of the step before (a tissue that
+        // rocks step to step, not one that settles).
+        if (last_positions.empty()) {
+          last_positions.resize(sim.body().node_count());
+          last_motions.assign(sim.body().node_count(), Eigen::Vector3d::Zero());
+          for (std::uint32_t n = 0; n < sim.body().node_count(); ++n)
+            last_positions[n] = sim.body().position(n);
+        }
+        StepMotion motion;
+        for (std::uint32_t n = 0; n < sim.body().node_count(); ++n) {
+          const Eigen::Vector3d moved = sim.body().position(n) - last_positions[n];
+          if (moved.norm() > motion.largest_m) {
+            motion.largest_m = moved.norm();
+            motion.node = n;
+            motion.reversed = moved.dot(last_motions[n]) < 0.0;
+          }
+          last_motions[n] = moved;
+          last_positions[n] = sim.body().position(n);
+        }
         // 1 mm: a tet that close to bone or blade is pressed by it.
         const Inversions inv = locate_inversions(sim, 1e-3);
         const ToolContacts tc = count_contacts(sim.contacts());
@@ -681,7 +712,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         std::fprintf(trace,
                      "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,"
                      "%d,%d,%.3f,"
-                     "%.3f,%.4f,%.4f,%.3f,%d,%zu\n",
+                     "%.3f,%.4f,%.4f,%.3f,%d,%zu,%.4f,%u,%d\n",
                      sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
                      report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
                      report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
@@ -695,7 +726,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                      sim.fem().contact_step().tool_reaction_n().norm(),
                      sim.fem().contact_step().projection().tool_push_kg_m.norm() /
                          (sim.body().time_step_s() * sim.body().time_step_s()),
-                     survey.largest, survey.beyond, survey.worst);
+                     survey.largest, survey.beyond, survey.worst, 1e3 * motion.largest_m,
+                     motion.node, motion.reversed ? 1 : 0);
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
