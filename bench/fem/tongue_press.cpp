@@ -228,6 +228,10 @@ struct LoadChurn {
   std::vector<std::uint32_t> touched_before, touched_now;
   double sum_before = 0.0;
   std::vector<double> shares;
+  // Of the spheres carrying force in a set, the share that carried force in
+  // the set before: whether the split moves within one set of rows or the
+  // rows themselves change.
+  std::vector<double> kept;
   void add(const fahr::msg::ContactSet& set) {
     double sum = 0.0;
     for (const fahr::msg::Contact& c : set.contacts()) {
@@ -243,6 +247,11 @@ struct LoadChurn {
       sum += c.force_n();
     }
     const double larger = std::max(sum, sum_before);
+    if (!touched_now.empty() && sum_before > 0.0) {
+      std::size_t both = 0;
+      for (const std::uint32_t sphere : touched_now) both += before[sphere] > 0.0 ? 1 : 0;
+      kept.push_back(static_cast<double>(both) / static_cast<double>(touched_now.size()));
+    }
     if (larger > 0.0 && sum_before > 0.0) {
       double moved = 0.0;
       for (const std::uint32_t s : touched_now) moved += std::abs(now[s] - before[s]);
@@ -896,6 +905,10 @@ int main(int argc, char** argv) try {
         "%.3g / %.3g\n",
         runs.front().config.name.c_str(), churn.shares.size(), quantile(churn.shares, 0.5),
         quantile(churn.shares, 0.99), quantile(churn.shares, 1.0));
+    std::printf(
+        "Of the spheres carrying the tool's load in a set, the share that carried it in the set "
+        "before, p50 / p1 / min: %.3g / %.3g / %.3g\n",
+        quantile(churn.kept, 0.5), quantile(churn.kept, 0.01), quantile(churn.kept, 0.0));
     if (g_corrections) {
       using Errors = std::array<std::vector<double>, 5> Shadow::*;
       const std::array<std::pair<const char*, Errors>, 3> corrections{{
