@@ -56,6 +56,7 @@
 #include "fahr/common/solver_threads.h"
 #include "fahr/common/wire_eigen.h"
 #include "fahr/contact/pgs.h"
+#include "fahr/contact/tissue_compliance.h"
 #include "fahr/fem_service/fem_body_setup.h"
 #include "fahr/fem_service/service_step.h"
 #include "fahr/scene/load_scene.h"
@@ -193,8 +194,8 @@ struct Shadow {
   // rows solved on the fresh W from that solved on the W in use
   // (contact_forces).
   std::vector<double> start_force_error, audit_force_error;
-  // The PGS's own floor: the resultant solved on the W in use against the
-  // haptic side's, relative.
+  // The PGS's own floor: the resultant solved from zero on the W in use
+  // against the haptic side's, relative.
   double force_floor_max = 0.0;
   std::size_t rows_outside_block = 0;  // tool rows whose sphere had no W slot
   // contact_forces' workspace.
@@ -220,6 +221,14 @@ struct Shadow {
   std::vector<double> last_step_m;  // ... and in the step before
 };
 
+// A tool entry of a ContactSet that pushes the tissue (a row the haptic
+// solve gave force, or a held load).
+bool carries_tool_load(const fahr::msg::Contact& c) {
+  const bool tool =
+      c.kind() == fahr::msg::CONTACT_TOOL || c.kind() == fahr::msg::CONTACT_FORCE_ONLY;
+  return tool && c.force_n() > 0.0;
+}
+
 // How much of the tool's load moves between spheres from one ContactSet to
 // the next: sum over spheres of |lambda_now - lambda_before| over the
 // larger of the two sets' sums (0: the same split; 2: no sphere shared).
@@ -235,9 +244,7 @@ struct LoadChurn {
   void add(const fahr::msg::ContactSet& set) {
     double sum = 0.0;
     for (const fahr::msg::Contact& c : set.contacts()) {
-      const bool tool =
-          c.kind() == fahr::msg::CONTACT_TOOL || c.kind() == fahr::msg::CONTACT_FORCE_ONLY;
-      if (!tool || !(c.force_n() > 0.0)) continue;
+      if (!carries_tool_load(c)) continue;
       if (c.sphere_id() >= now.size()) {
         now.resize(c.sphere_id() + 1, 0.0);
         before.resize(now.size(), 0.0);
@@ -331,9 +338,7 @@ void contact_forces(Shadow& shadow, const fahr::msg::ContactSet& fed,
   shadow.row_normal.clear();
   shadow.row_force.clear();
   for (const fahr::msg::Contact& c : fed.contacts()) {
-    const bool tool =
-        c.kind() == fahr::msg::CONTACT_TOOL || c.kind() == fahr::msg::CONTACT_FORCE_ONLY;
-    if (!tool || !(c.force_n() > 0.0)) continue;
+    if (!carries_tool_load(c)) continue;
     const auto at = std::find(spheres.begin(), spheres.end(), c.sphere_id());
     if (at == spheres.end()) {
       ++shadow.rows_outside_block;
@@ -345,25 +350,21 @@ void contact_forces(Shadow& shadow, const fahr::msg::ContactSet& fed,
   }
   const std::size_t m = shadow.row_slot.size();
   if (m == 0) return;
-  const std::size_t stride = 3 * spheres.size();
-  const auto fill = [&](auto w_at, std::vector<double>& s) {
+  // n_i^T W_st n_j, as the tick builds its rows' matrix.
+  const auto fill = [&](std::span<const float> w, std::vector<double>& s) {
+    fahr::contact::TissueCompliance view;
+    view.sphere_ids = spheres;
+    view.w_mpn = w;
     s.assign(m * m, 0.0);
     for (std::size_t i = 0; i < m; ++i) {
       for (std::size_t j = 0; j < m; ++j) {
-        double sum = 0.0;
-        for (std::size_t a = 0; a < 3; ++a) {
-          for (std::size_t b = 0; b < 3; ++b) {
-            sum += shadow.row_normal[i][static_cast<Eigen::Index>(a)] *
-                   w_at((3 * shadow.row_slot[i] + a) * stride + 3 * shadow.row_slot[j] + b) *
-                   shadow.row_normal[j][static_cast<Eigen::Index>(b)];
-          }
-        }
-        s[i * m + j] = sum;
+        s[i * m + j] = view.normal_compliance(shadow.row_slot[i], shadow.row_normal[i],
+                                              shadow.row_slot[j], shadow.row_normal[j]);
       }
     }
   };
-  fill([&](std::size_t i) { return static_cast<double>(w_used[i]); }, shadow.s_used);
-  fill([&](std::size_t i) { return static_cast<double>(shadow.audit_w[i]); }, shadow.s_fresh);
+  fill(w_used, shadow.s_used);
+  fill(shadow.audit_w, shadow.s_fresh);
   shadow.row_gap.assign(m, 0.0);
   for (std::size_t i = 0; i < m; ++i) {
     for (std::size_t j = 0; j < m; ++j) {
@@ -374,8 +375,10 @@ void contact_forces(Shadow& shadow, const fahr::msg::ContactSet& fed,
   settings.max_sweeps = 20000;
   settings.tolerance_m = 1e-13;
   shadow.pgs_residual.resize(m);
+  // Both from zero, so the W in use reproducing the haptic side's resultant
+  // is the solver's own floor, not its starting point.
   const auto solve = [&](const std::vector<double>& s, std::vector<double>& lambda) {
-    lambda = shadow.row_force;  // warm start at the haptic side's split
+    lambda.assign(m, 0.0);
     fahr::contact::solve_pgs(s.data(), m, m, shadow.row_gap.data(), lambda.data(),
                              shadow.pgs_residual.data(), settings);
   };
