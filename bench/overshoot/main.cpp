@@ -230,6 +230,27 @@ double deepest_in_blade_m(const stack_sim::StackSim& sim) {
   return deepest;
 }
 
+// Node n's signed distance from the blade at the proxy's pose, m (< 0 inside).
+// With `free`, of its position after the implicit step, before any projection.
+double blade_distance_m(const stack_sim::StackSim& sim, std::uint32_t n, bool free = false) {
+  const auto& proxy = sim.command().world_from_proxy();
+  const Eigen::Quaterniond q = common::to_eigen(proxy.orientation());
+  const Eigen::Vector3d t = common::to_eigen(proxy.position_m());
+  const auto free_x = sim.fem().contact_step().free_positions_m();
+  const std::size_t i = 3 * std::size_t{n};
+  const Eigen::Vector3d x =
+      free ? Eigen::Vector3d(free_x[i], free_x[i + 1], free_x[i + 2]) : sim.body().position(n);
+  return sim.haptic_setup().tool->sdf->query(q.conjugate() * (x - t)).distance_m;
+}
+
+// Node n's signed distance from the nearest bone, m (< 0 inside).
+double bone_distance_m(const stack_sim::StackSim& sim, std::uint32_t n) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& field : sim.fem().setup().anatomy)
+    nearest = std::min(nearest, field->sample(sim.body().position(n)).distance_m);
+  return nearest;
+}
+
 // The largest node motion of one FEM step (the trace's columns).
 struct StepMotion {
   double largest_m = 0.0;
@@ -516,14 +537,16 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       "inverted_free,fem_cpu_ms,supported_nodes,"
       "volume_floor_below,volume_floor_unresolved,tool_force_sum_n,tool_largest_force_n,"
       "fem_tool_reaction_n,fem_tool_projection_n,largest_strain,torn,worst_element,"
-      "step_motion_mm,step_motion_node,step_motion_reversed\n");
+      "step_motion_mm,step_motion_node,step_motion_reversed,step_motion_blade_mm,step_motion_free_"
+      "blade_mm,step_motion_bone_mm\n");
   std::FILE* tick_trace = open_trace(
       tick_trace_path, r.name,
       "t_s,lost_track,force_n,fx,fy,fz,reaction_n,hand_x,hand_y,hand_z,proxy_x,proxy_y,"
       "proxy_z,gap_mm,"
       "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,"
       "obstacle_reaction_n,rows,"
-      "pgs_converged,contacts_found,fem_step,pgs_sweeps,missing_compliance,row_force_sum_n\n");
+      "pgs_converged,contacts_found,fem_step,pgs_sweeps,missing_compliance,row_force_sum_n,rows_"
+      "dropped\n");
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
   bool seen_1x = false, was_lost = false, reengaged = false, left = false, touched = false;
@@ -540,6 +563,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
   std::vector<Eigen::Vector3d> last_positions, last_motions;
   double fem_step_total_ms = 0.0;
   std::uint64_t fem_steps = 0;
+  std::uint64_t dropped_before = 0;
   for (std::uint64_t k = 0; k < steps; ++k) {
     const auto step_start = std::chrono::steady_clock::now();
     sim.step();
@@ -562,12 +586,15 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
     const double commanded = penalty ? force.norm() : k_c * gap.norm();
     r.max_commanded_n = std::max(r.max_commanded_n, commanded);
     const common::ToolRowForces rows_sent = common::tool_row_forces(sim.contacts());
+    // Contacts within the row margin that were not rows, this tick.
+    const std::uint64_t dropped =
+        sim.haptic().metrics().rows_dropped.load(std::memory_order_relaxed);
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
       std::fprintf(tick_trace,
                    "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,"
-                   "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d,%.4f\n",
+                   "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d,%.4f,%llu\n",
                    sim.time_s(), c.lost_track() ? 1 : 0, force.norm(), force.x(), force.y(),
                    force.z(), c.tissue_reaction_n(), 1e3 * hand.x(), 1e3 * hand.y(), 1e3 * hand.z(),
                    1e3 * proxy.x(), 1e3 * proxy.y(), 1e3 * proxy.z(), 1e3 * gap.norm(), limit,
@@ -577,8 +604,10 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                    static_cast<int>(report.load.rows), report.pgs.converged ? 1 : 0,
                    sim.haptic().last_phases().tissue_query.contacts,
                    static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps,
-                   report.load.missing_compliance, rows_sent.magnitudes_n);
+                   report.load.missing_compliance, rows_sent.magnitudes_n,
+                   static_cast<unsigned long long>(dropped - dropped_before));
     }
+    dropped_before = dropped;
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
     for (const auto& contact : sim.contacts().contacts()) {
       if (contact.kind() == msg::CONTACT_OBSTACLE) continue;
@@ -712,7 +741,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         std::fprintf(trace,
                      "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,"
                      "%d,%d,%.3f,"
-                     "%.3f,%.4f,%.4f,%.3f,%d,%zu,%.4f,%u,%d\n",
+                     "%.3f,%.4f,%.4f,%.3f,%d,%zu,%.4f,%u,%d,%.4f,%.4f,%.4f\n",
                      sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
                      report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
                      report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
@@ -727,7 +756,9 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                      sim.fem().contact_step().projection().tool_push_kg_m.norm() /
                          (sim.body().time_step_s() * sim.body().time_step_s()),
                      survey.largest, survey.beyond, survey.worst, 1e3 * motion.largest_m,
-                     motion.node, motion.reversed ? 1 : 0);
+                     motion.node, motion.reversed ? 1 : 0, 1e3 * blade_distance_m(sim, motion.node),
+                     1e3 * blade_distance_m(sim, motion.node, true),
+                     1e3 * bone_distance_m(sim, motion.node));
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
