@@ -118,6 +118,13 @@ struct Result {
   // both faces of the blade (a pinch: docs/design/force-aware-decision.md).
   double max_row_force_sum_n = 0.0;
   double row_resultant_at_max_sum_n = 0.0;
+  // Per tick, contacts within the row margin that were not rows, and per
+  // FEM step the largest node motion (m) and whether that node went back
+  // against its motion of the step before: while pressing at half the limit
+  // or more before the device first lost track, and while it had lost track.
+  std::vector<double> dropped_pressing, dropped_lost;
+  std::vector<double> motion_pressing_m, motion_lost_m;
+  std::uint64_t reversed_pressing = 0, reversed_lost = 0;
   double max_anatomy_depth_m = 0.0;  // deepest node into bone before the FEM moved it out
   int max_inverted = 0;
   double max_elastic_j = 0.0;
@@ -213,6 +220,14 @@ HeldLoad held_load(const Result& r) {
   held.median = sorted[sorted.size() / 2];
   held.smallest = sorted.front();
   return held;
+}
+
+// The median of `values` (0 for none).
+double median_of(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
 }
 
 // The tongue's deepest node inside the blade at the proxy's pose, m (0 when
@@ -589,6 +604,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
     // Contacts within the row margin that were not rows, this tick.
     const std::uint64_t dropped =
         sim.haptic().metrics().rows_dropped.load(std::memory_order_relaxed);
+    const std::uint64_t dropped_tick = dropped - dropped_before;
+    dropped_before = dropped;
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
@@ -605,9 +622,13 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                    sim.haptic().last_phases().tissue_query.contacts,
                    static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps,
                    report.load.missing_compliance, rows_sent.magnitudes_n,
-                   static_cast<unsigned long long>(dropped - dropped_before));
+                   static_cast<unsigned long long>(dropped_tick));
     }
-    dropped_before = dropped;
+    // Pressing at half the limit or more, before the device first lost track.
+    const bool pressing_before_hold =
+        !penalty && r.lost_ticks == 0 && !c.lost_track() && commanded >= 0.5 * limit && limit > 0.0;
+    if (pressing_before_hold) r.dropped_pressing.push_back(static_cast<double>(dropped_tick));
+    if (!penalty && c.lost_track()) r.dropped_lost.push_back(static_cast<double>(dropped_tick));
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
     for (const auto& contact : sim.contacts().contacts()) {
       if (contact.kind() == msg::CONTACT_OBSTACLE) continue;
@@ -713,17 +734,17 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       mark_inverted(sim.body(), r.ever_inverted);
       r.max_elastic_j = std::max(r.max_elastic_j, sim.body().energy().elastic_j);
       r.max_anatomy_depth_m = std::max(r.max_anatomy_depth_m, report.projection.obstacle_deepest_m);
-      if (trace != nullptr) {
-        // The node that moved most in this FEM step, and whether it went
-        // back against its own motion of the step before (a tissue that
-        // rocks step to step, not one that settles).
+      // The node that moved most in this FEM step, and whether it went
+      // back against its own motion of the step before (a tissue that
+      // rocks step to step, not one that settles).
+      StepMotion motion;
+      {
         if (last_positions.empty()) {
           last_positions.resize(sim.body().node_count());
           last_motions.assign(sim.body().node_count(), Eigen::Vector3d::Zero());
           for (std::uint32_t n = 0; n < sim.body().node_count(); ++n)
             last_positions[n] = sim.body().position(n);
         }
-        StepMotion motion;
         for (std::uint32_t n = 0; n < sim.body().node_count(); ++n) {
           const Eigen::Vector3d moved = sim.body().position(n) - last_positions[n];
           if (moved.norm() > motion.largest_m) {
@@ -734,6 +755,15 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
           last_motions[n] = moved;
           last_positions[n] = sim.body().position(n);
         }
+      }
+      if (pressing_before_hold) {
+        r.motion_pressing_m.push_back(motion.largest_m);
+        r.reversed_pressing += motion.reversed ? 1 : 0;
+      } else if (c.lost_track()) {
+        r.motion_lost_m.push_back(motion.largest_m);
+        r.reversed_lost += motion.reversed ? 1 : 0;
+      }
+      if (trace != nullptr) {
         // 1 mm: a tet that close to bone or blade is pressed by it.
         const Inversions inv = locate_inversions(sim, 1e-3);
         const ToolContacts tc = count_contacts(sim.contacts());
@@ -898,6 +928,20 @@ int main(int argc, char** argv) {
         "%.3f (%.3f) | %.3f (%.3f) |\n",
         fa.max_row_force_sum_n, fa.row_resultant_at_max_sum_n, pe.max_row_force_sum_n,
         pe.row_resultant_at_max_sum_n);
+    std::printf(
+        "| contacts within the row margin that are not rows, per tick, median: pressing at half "
+        "the limit or more before the hold / while lost track | %.0f / %.0f | - |\n",
+        median_of(fa.dropped_pressing), median_of(fa.dropped_lost));
+    const auto share = [](std::uint64_t part, std::size_t of) {
+      return of == 0 ? 0.0 : 100.0 * static_cast<double>(part) / static_cast<double>(of);
+    };
+    std::printf(
+        "| largest node motion a FEM step mm, median (steps where that node went back against "
+        "its motion of the step before): pressing before the hold / while lost track | %.2f "
+        "(%.0f %%) / %.2f (%.0f %%) | - |\n",
+        mm(median_of(fa.motion_pressing_m)),
+        share(fa.reversed_pressing, fa.motion_pressing_m.size()), mm(median_of(fa.motion_lost_m)),
+        share(fa.reversed_lost, fa.motion_lost_m.size()));
     std::printf("| largest reaction / limit while lost track, as sent | %.4f | - |\n",
                 fa.max_reaction_lost_ratio);
     std::printf("| largest reaction / limit while lost track, FEM side | %.4f | - |\n",
