@@ -230,40 +230,38 @@ double median_of(std::vector<double> values) {
   return *middle;
 }
 
-// The tongue's deepest node inside the blade at the proxy's pose, m (0 when
-// none is inside).
-double deepest_in_blade_m(const stack_sim::StackSim& sim) {
+// A point's signed distance from the blade at the proxy's pose, m (< 0
+// inside).
+double blade_distance_at(const stack_sim::StackSim& sim, const Eigen::Vector3d& x) {
   const auto& proxy = sim.command().world_from_proxy();
   const Eigen::Quaterniond q = common::to_eigen(proxy.orientation());
   const Eigen::Vector3d t = common::to_eigen(proxy.position_m());
-  const auto& blade = *sim.haptic_setup().tool->sdf;
-  const fem::Body& body = sim.body();
-  double deepest = 0.0;
-  for (std::uint32_t n = 0; n < body.node_count(); ++n) {
-    deepest = std::max(deepest, -blade.query(q.conjugate() * (body.position(n) - t)).distance_m);
-  }
-  return deepest;
-}
-
-// Node n's signed distance from the blade at the proxy's pose, m (< 0 inside).
-// With `free`, of its position after the implicit step, before any projection.
-double blade_distance_m(const stack_sim::StackSim& sim, std::uint32_t n, bool free = false) {
-  const auto& proxy = sim.command().world_from_proxy();
-  const Eigen::Quaterniond q = common::to_eigen(proxy.orientation());
-  const Eigen::Vector3d t = common::to_eigen(proxy.position_m());
-  const auto free_x = sim.fem().contact_step().free_positions_m();
-  const std::size_t i = 3 * std::size_t{n};
-  const Eigen::Vector3d x =
-      free ? Eigen::Vector3d(free_x[i], free_x[i + 1], free_x[i + 2]) : sim.body().position(n);
   return sim.haptic_setup().tool->sdf->query(q.conjugate() * (x - t)).distance_m;
 }
 
-// Node n's signed distance from the nearest bone, m (< 0 inside).
-double bone_distance_m(const stack_sim::StackSim& sim, std::uint32_t n) {
+// A point's signed distance from the nearest bone, m (< 0 inside).
+double bone_distance_at(const stack_sim::StackSim& sim, const Eigen::Vector3d& x) {
   double nearest = std::numeric_limits<double>::infinity();
   for (const auto& field : sim.fem().setup().anatomy)
-    nearest = std::min(nearest, field->sample(sim.body().position(n)).distance_m);
+    nearest = std::min(nearest, field->sample(x).distance_m);
   return nearest;
+}
+
+// The tongue's deepest node inside the blade at the proxy's pose, m (0 when
+// none is inside).
+double deepest_in_blade_m(const stack_sim::StackSim& sim) {
+  const fem::Body& body = sim.body();
+  double deepest = 0.0;
+  for (std::uint32_t n = 0; n < body.node_count(); ++n)
+    deepest = std::max(deepest, -blade_distance_at(sim, body.position(n)));
+  return deepest;
+}
+
+// Node n's position after the FEM's implicit step, before any projection.
+Eigen::Vector3d free_position(const stack_sim::StackSim& sim, std::uint32_t n) {
+  const auto x = sim.fem().contact_step().free_positions_m();
+  const std::size_t i = 3 * std::size_t{n};
+  return {x[i], x[i + 1], x[i + 2]};
 }
 
 // The largest node motion of one FEM step (the trace's columns).
@@ -306,19 +304,14 @@ struct Inversions {
 std::pair<bool, bool> near_bone_and_blade(const stack_sim::StackSim& sim, std::size_t e,
                                           double near_m) {
   const fem::Body& body = sim.body();
-  const auto& proxy = sim.command().world_from_proxy();
-  const Eigen::Quaterniond q = common::to_eigen(proxy.orientation());
-  const Eigen::Vector3d t = common::to_eigen(proxy.position_m());
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   double nearest_bone = std::numeric_limits<double>::infinity();
   for (const auto node : body.element_rest().tets[e]) {
     const Eigen::Vector3d x = body.position(node);
     centroid += 0.25 * x;
-    for (const auto& field : sim.fem().setup().anatomy)
-      nearest_bone = std::min(nearest_bone, field->sample(x).distance_m);
+    nearest_bone = std::min(nearest_bone, bone_distance_at(sim, x));
   }
-  const auto& blade = *sim.haptic_setup().tool->sdf;
-  return {nearest_bone < near_m, blade.query(q.conjugate() * (centroid - t)).distance_m < near_m};
+  return {nearest_bone < near_m, blade_distance_at(sim, centroid) < near_m};
 }
 
 Inversions locate_inversions(const stack_sim::StackSim& sim, double near_m) {
@@ -737,24 +730,22 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       // The node that moved most in this FEM step, and whether it went
       // back against its own motion of the step before (a tissue that
       // rocks step to step, not one that settles).
-      StepMotion motion;
-      {
-        if (last_positions.empty()) {
-          last_positions.resize(sim.body().node_count());
-          last_motions.assign(sim.body().node_count(), Eigen::Vector3d::Zero());
-          for (std::uint32_t n = 0; n < sim.body().node_count(); ++n)
-            last_positions[n] = sim.body().position(n);
-        }
-        for (std::uint32_t n = 0; n < sim.body().node_count(); ++n) {
-          const Eigen::Vector3d moved = sim.body().position(n) - last_positions[n];
-          if (moved.norm() > motion.largest_m) {
-            motion.largest_m = moved.norm();
-            motion.node = n;
-            motion.reversed = moved.dot(last_motions[n]) < 0.0;
-          }
-          last_motions[n] = moved;
+      if (last_positions.empty()) {
+        last_positions.resize(sim.body().node_count());
+        last_motions.assign(sim.body().node_count(), Eigen::Vector3d::Zero());
+        for (std::uint32_t n = 0; n < sim.body().node_count(); ++n)
           last_positions[n] = sim.body().position(n);
+      }
+      StepMotion motion;
+      for (std::uint32_t n = 0; n < sim.body().node_count(); ++n) {
+        const Eigen::Vector3d moved = sim.body().position(n) - last_positions[n];
+        if (moved.norm() > motion.largest_m) {
+          motion.largest_m = moved.norm();
+          motion.node = n;
+          motion.reversed = moved.dot(last_motions[n]) < 0.0;
         }
+        last_motions[n] = moved;
+        last_positions[n] = sim.body().position(n);
       }
       if (pressing_before_hold) {
         r.motion_pressing_m.push_back(motion.largest_m);
@@ -768,27 +759,27 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         const Inversions inv = locate_inversions(sim, 1e-3);
         const ToolContacts tc = count_contacts(sim.contacts());
         const StrainSurvey survey = survey_strain(sim.body());
-        std::fprintf(trace,
-                     "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,"
-                     "%d,%d,%.3f,"
-                     "%.3f,%.4f,%.4f,%.3f,%d,%zu,%.4f,%u,%d,%.4f,%.4f,%.4f\n",
-                     sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
-                     report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
-                     report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
-                     report.projection.sweeps, tc.active, tc.frozen, tc.force_only, tc.obstacle,
-                     c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
-                     1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio,
-                     inverted_free(sim),
-                     1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
-                     report.projection.obstacle_supported, report.projection.volume_floor_below,
-                     report.projection.volume_floor_unresolved, tc.force_sum_n, tc.largest_force_n,
-                     sim.fem().contact_step().tool_reaction_n().norm(),
-                     sim.fem().contact_step().projection().tool_push_kg_m.norm() /
-                         (sim.body().time_step_s() * sim.body().time_step_s()),
-                     survey.largest, survey.beyond, survey.worst, 1e3 * motion.largest_m,
-                     motion.node, motion.reversed ? 1 : 0, 1e3 * blade_distance_m(sim, motion.node),
-                     1e3 * blade_distance_m(sim, motion.node, true),
-                     1e3 * bone_distance_m(sim, motion.node));
+        std::fprintf(
+            trace,
+            "%.3f,%d,%d,%d,%d,%.3f,%d,%d,%d,%d,%d,%d,%d,%d,%.4f,%.4f,%.3f,%.3f,%d,%.3f,%d,"
+            "%d,%d,%.3f,"
+            "%.3f,%.4f,%.4f,%.3f,%d,%zu,%.4f,%u,%d,%.4f,%.4f,%.4f\n",
+            sim.time_s(), inv.count, inv.near_anatomy, inv.near_blade,
+            report.projection.obstacle_nodes, 1e3 * report.projection.obstacle_deepest_m,
+            report.projection.obstacle_unresolved, report.projection.obstacle_rounds,
+            report.projection.sweeps, tc.active, tc.frozen, tc.force_only, tc.obstacle,
+            c.lost_track() ? 1 : 0, c.tissue_reaction_n(), commanded,
+            1e3 * max_displacement_m(sim.body()), inv.worst_rest_radius_ratio, inverted_free(sim),
+            1e-6 * static_cast<double>(sim.last_fem_step_cpu().count()),
+            report.projection.obstacle_supported, report.projection.volume_floor_below,
+            report.projection.volume_floor_unresolved, tc.force_sum_n, tc.largest_force_n,
+            sim.fem().contact_step().tool_reaction_n().norm(),
+            sim.fem().contact_step().projection().tool_push_kg_m.norm() /
+                (sim.body().time_step_s() * sim.body().time_step_s()),
+            survey.largest, survey.beyond, survey.worst, 1e3 * motion.largest_m, motion.node,
+            motion.reversed ? 1 : 0, 1e3 * blade_distance_at(sim, sim.body().position(motion.node)),
+            1e3 * blade_distance_at(sim, free_position(sim, motion.node)),
+            1e3 * bone_distance_at(sim, sim.body().position(motion.node)));
       }
     }
     // The blade has left the tongue: no tool contact in the set after the hold.
