@@ -249,6 +249,20 @@ double bone_distance_at(const stack_sim::StackSim& sim, const Eigen::Vector3d& x
 
 // The tongue's deepest node inside the blade at the proxy's pose, m (0 when
 // none is inside).
+// Where the tool rows' forces act: their plane points weighted by force, m
+// (zero without a pushing row). Its jumps from tick to tick say which part
+// of the blade the rows are on.
+Eigen::Vector3d row_force_centre_m(const msg::ContactSet& contacts) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double total = 0.0;
+  for (const auto& c : contacts.contacts()) {
+    if (c.kind() == msg::CONTACT_OBSTACLE || !(c.force_n() > 0.0)) continue;
+    sum += c.force_n() * common::to_eigen(c.point_m());
+    total += c.force_n();
+  }
+  return total > 0.0 ? Eigen::Vector3d(sum / total) : Eigen::Vector3d::Zero();
+}
+
 double deepest_in_blade_m(const stack_sim::StackSim& sim) {
   const fem::Body& body = sim.body();
   double deepest = 0.0;
@@ -554,7 +568,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
       "limit_n,state,catch_up_limited,yielded,implausible_step,tissue_force_clamped,"
       "obstacle_reaction_n,rows,"
       "pgs_converged,contacts_found,fem_step,pgs_sweeps,missing_compliance,row_force_sum_n,rows_"
-      "dropped\n");
+      "dropped,row_centre_x_mm,row_centre_y_mm,row_centre_z_mm\n");
   const double k_c = sim.haptic_setup().response.coupling.stiffness_npm;
   const double damping = sim.haptic_setup().response.coupling.damping_nspm;
   bool seen_1x = false, was_lost = false, reengaged = false, left = false, touched = false;
@@ -602,9 +616,10 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
+      const Eigen::Vector3d row_centre = row_force_centre_m(sim.contacts());
       std::fprintf(tick_trace,
                    "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,"
-                   "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d,%.4f,%llu\n",
+                   "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d,%.4f,%llu,%.3f,%.3f,%.3f\n",
                    sim.time_s(), c.lost_track() ? 1 : 0, force.norm(), force.x(), force.y(),
                    force.z(), c.tissue_reaction_n(), 1e3 * hand.x(), 1e3 * hand.y(), 1e3 * hand.z(),
                    1e3 * proxy.x(), 1e3 * proxy.y(), 1e3 * proxy.z(), 1e3 * gap.norm(), limit,
@@ -615,7 +630,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                    sim.haptic().last_phases().tissue_query.contacts,
                    static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps,
                    report.load.missing_compliance, rows_sent.magnitudes_n,
-                   static_cast<unsigned long long>(dropped_tick));
+                   static_cast<unsigned long long>(dropped_tick), 1e3 * row_centre.x(),
+                   1e3 * row_centre.y(), 1e3 * row_centre.z());
     }
     // Pressing at half the limit or more, before the device first lost track.
     const bool pressing_before_hold =
