@@ -125,6 +125,11 @@ struct Result {
   std::vector<double> dropped_pressing, dropped_lost;
   std::vector<double> motion_pressing_m, motion_lost_m;
   std::uint64_t reversed_pressing = 0, reversed_lost = 0;
+  // The tool rows' force centre's move from one FEM state to the next (m, at
+  // the first tick of each state whose rows push, against the state before),
+  // in the same two windows: the load going from one part of the blade to
+  // another.
+  std::vector<double> centre_move_pressing_m, centre_move_lost_m;
   double max_anatomy_depth_m = 0.0;  // deepest node into bone before the FEM moved it out
   int max_inverted = 0;
   double max_elastic_j = 0.0;
@@ -222,12 +227,19 @@ HeldLoad held_load(const Result& r) {
   return held;
 }
 
+// The q-quantile of `values` (the element at floor(q n), 0 for none).
+double quantile_of(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const auto at =
+      std::min(values.size() - 1, static_cast<std::size_t>(q * static_cast<double>(values.size())));
+  const auto it = values.begin() + static_cast<std::ptrdiff_t>(at);
+  std::nth_element(values.begin(), it, values.end());
+  return *it;
+}
+
 // The median of `values` (0 for none).
 double median_of(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
+  return quantile_of(std::move(values), 0.5);
 }
 
 // A point's signed distance from the blade at the proxy's pose, m (< 0
@@ -250,9 +262,14 @@ double bone_distance_at(const stack_sim::StackSim& sim, const Eigen::Vector3d& x
 // The tongue's deepest node inside the blade at the proxy's pose, m (0 when
 // none is inside).
 // Where the tool rows' forces act: their plane points weighted by force, m
-// (zero without a pushing row). Its jumps from tick to tick say which part
-// of the blade the rows are on.
-Eigen::Vector3d row_force_centre_m(const msg::ContactSet& contacts) {
+// (zero, and `pushing` false, without a pushing row). Its moves from one FEM
+// state to the next say which part of the blade the rows are on.
+struct RowCentre {
+  Eigen::Vector3d centre_m = Eigen::Vector3d::Zero();
+  bool pushing = false;
+};
+
+RowCentre row_force_centre(const msg::ContactSet& contacts) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double total = 0.0;
   for (const auto& c : contacts.contacts()) {
@@ -260,7 +277,8 @@ Eigen::Vector3d row_force_centre_m(const msg::ContactSet& contacts) {
     sum += c.force_n() * common::to_eigen(c.point_m());
     total += c.force_n();
   }
-  return total > 0.0 ? Eigen::Vector3d(sum / total) : Eigen::Vector3d::Zero();
+  if (!(total > 0.0)) return {};
+  return {.centre_m = sum / total, .pushing = true};
 }
 
 double deepest_in_blade_m(const stack_sim::StackSim& sim) {
@@ -586,6 +604,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
   double fem_step_total_ms = 0.0;
   std::uint64_t fem_steps = 0;
   std::uint64_t dropped_before = 0;
+  std::uint64_t centre_state = std::numeric_limits<std::uint64_t>::max();
+  RowCentre last_centre;
   for (std::uint64_t k = 0; k < steps; ++k) {
     const auto step_start = std::chrono::steady_clock::now();
     sim.step();
@@ -616,7 +636,7 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
-      const Eigen::Vector3d row_centre = row_force_centre_m(sim.contacts());
+      const Eigen::Vector3d row_centre = row_force_centre(sim.contacts()).centre_m;
       std::fprintf(tick_trace,
                    "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,"
                    "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d,%.4f,%llu,%.3f,%.3f,%.3f\n",
@@ -638,6 +658,16 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         !penalty && r.lost_ticks == 0 && !c.lost_track() && commanded >= 0.5 * limit && limit > 0.0;
     if (pressing_before_hold) r.dropped_pressing.push_back(static_cast<double>(dropped_tick));
     if (!penalty && c.lost_track()) r.dropped_lost.push_back(static_cast<double>(dropped_tick));
+    if (!penalty && sim.contacts().fem_step() != centre_state) {
+      centre_state = sim.contacts().fem_step();
+      const RowCentre now = row_force_centre(sim.contacts());
+      if (now.pushing && last_centre.pushing) {
+        const double move = (now.centre_m - last_centre.centre_m).norm();
+        if (pressing_before_hold) r.centre_move_pressing_m.push_back(move);
+        if (c.lost_track()) r.centre_move_lost_m.push_back(move);
+      }
+      last_centre = now;
+    }
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
     for (const auto& contact : sim.contacts().contacts()) {
       if (contact.kind() == msg::CONTACT_OBSTACLE) continue;
@@ -949,6 +979,11 @@ int main(int argc, char** argv) {
         mm(median_of(fa.motion_pressing_m)),
         share(fa.reversed_pressing, fa.motion_pressing_m.size()), mm(median_of(fa.motion_lost_m)),
         share(fa.reversed_lost, fa.motion_lost_m.size()));
+    std::printf(
+        "| the tool rows' force centre, its move from one FEM state to the next mm, median "
+        "(p90): pressing before the hold / while lost track | %.2f (%.2f) / %.2f (%.2f) | - |\n",
+        mm(median_of(fa.centre_move_pressing_m)), mm(quantile_of(fa.centre_move_pressing_m, 0.9)),
+        mm(median_of(fa.centre_move_lost_m)), mm(quantile_of(fa.centre_move_lost_m, 0.9)));
     std::printf("| largest reaction / limit while lost track, as sent | %.4f | - |\n",
                 fa.max_reaction_lost_ratio);
     std::printf("| largest reaction / limit while lost track, FEM side | %.4f | - |\n",
