@@ -259,8 +259,6 @@ double bone_distance_at(const stack_sim::StackSim& sim, const Eigen::Vector3d& x
   return nearest;
 }
 
-// The tongue's deepest node inside the blade at the proxy's pose, m (0 when
-// none is inside).
 // Where the tool rows' forces act: their plane points weighted by force, m
 // (zero, and `pushing` false, without a pushing row). Its moves from one FEM
 // state to the next say which part of the blade the rows are on.
@@ -281,6 +279,8 @@ RowCentre row_force_centre(const msg::ContactSet& contacts) {
   return {.centre_m = sum / total, .pushing = true};
 }
 
+// The tongue's deepest node inside the blade at the proxy's pose, m (0 when
+// none is inside).
 double deepest_in_blade_m(const stack_sim::StackSim& sim) {
   const fem::Body& body = sim.body();
   double deepest = 0.0;
@@ -633,10 +633,10 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
         sim.haptic().metrics().rows_dropped.load(std::memory_order_relaxed);
     const std::uint64_t dropped_tick = dropped - dropped_before;
     dropped_before = dropped;
+    const RowCentre row_centre = row_force_centre(sim.contacts());
     if (tick_trace != nullptr) {
       const Eigen::Vector3d proxy = common::to_eigen(c.world_from_proxy().position_m());
       const contact::TickReport& report = sim.haptic().response().report();
-      const Eigen::Vector3d row_centre = row_force_centre(sim.contacts()).centre_m;
       std::fprintf(tick_trace,
                    "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%d,"
                    "%d,%d,%d,%.4f,%d,%d,%u,%llu,%d,%d,%.4f,%llu,%.3f,%.3f,%.3f\n",
@@ -650,8 +650,8 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
                    sim.haptic().last_phases().tissue_query.contacts,
                    static_cast<unsigned long long>(sim.contacts().fem_step()), report.pgs.sweeps,
                    report.load.missing_compliance, rows_sent.magnitudes_n,
-                   static_cast<unsigned long long>(dropped_tick), 1e3 * row_centre.x(),
-                   1e3 * row_centre.y(), 1e3 * row_centre.z());
+                   static_cast<unsigned long long>(dropped_tick), 1e3 * row_centre.centre_m.x(),
+                   1e3 * row_centre.centre_m.y(), 1e3 * row_centre.centre_m.z());
     }
     // Pressing at half the limit or more, before the device first lost track.
     const bool pressing_before_hold =
@@ -660,13 +660,12 @@ Result run(const std::shared_ptr<const scene::Scene>& scene, bool penalty,
     if (!penalty && c.lost_track()) r.dropped_lost.push_back(static_cast<double>(dropped_tick));
     if (!penalty && sim.contacts().fem_step() != centre_state) {
       centre_state = sim.contacts().fem_step();
-      const RowCentre now = row_force_centre(sim.contacts());
-      if (now.pushing && last_centre.pushing) {
-        const double move = (now.centre_m - last_centre.centre_m).norm();
+      if (row_centre.pushing && last_centre.pushing) {
+        const double move = (row_centre.centre_m - last_centre.centre_m).norm();
         if (pressing_before_hold) r.centre_move_pressing_m.push_back(move);
         if (c.lost_track()) r.centre_move_lost_m.push_back(move);
       }
-      last_centre = now;
+      last_centre = row_centre;
     }
     r.max_reaction_n = std::max(r.max_reaction_n, c.tissue_reaction_n());
     for (const auto& contact : sim.contacts().contacts()) {
